@@ -1,0 +1,119 @@
+#include "core/brdf_model.h"
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "core/json_reader.h"
+
+namespace ibrdf {
+
+Eigen::Vector3d LambertianBrdf::Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const {
+  if (!(wi.z() > 0.0) || !(wo.z() > 0.0)) return Eigen::Vector3d::Zero();
+  return albedo_ / M_PI;
+}
+
+nlohmann::json LambertianBrdf::ToJson() const {
+  return {{"model", "lambertian"}, {"albedo", ibrdf::ToJson(albedo_)}};
+}
+
+Eigen::Vector3d LafortuneBrdf::Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const {
+  if (!(wi.z() > 0.0) || !(wo.z() > 0.0)) return Eigen::Vector3d::Zero();
+  const double xy = wi.x() * wo.x() + wi.y() * wo.y();
+  const double z = wi.z() * wo.z();
+  Eigen::Vector3d f = diffuse_ / M_PI;
+  for (const LafortuneLobe& lobe : lobes_) {
+    for (int c = 0; c < 3; ++c) {
+      const double base = lobe.cxy[c] * xy + lobe.cz[c] * z;
+      if (base > 0.0) f[c] += std::pow(base, lobe.n[c]);
+    }
+  }
+  return f;
+}
+
+nlohmann::json LafortuneBrdf::ToJson() const {
+  nlohmann::json lobes = nlohmann::json::array();
+  for (const LafortuneLobe& lobe : lobes_) {
+    lobes.push_back({{"Cxy", ibrdf::ToJson(lobe.cxy)},
+                     {"Cz", ibrdf::ToJson(lobe.cz)},
+                     {"n", ibrdf::ToJson(lobe.n)}});
+  }
+  return {{"model", "lafortune"}, {"diffuse", ibrdf::ToJson(diffuse_)}, {"lobes", lobes}};
+}
+
+Eigen::Vector3d GgxBrdf::Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const {
+  if (!(wi.z() > 0.0) || !(wo.z() > 0.0)) return Eigen::Vector3d::Zero();
+  const Eigen::Vector3d h = (wi + wo).normalized();
+  const double a2 = alpha_ * alpha_;
+  const double cos_h = h.z();
+  const double denominator = cos_h * cos_h * (a2 - 1.0) + 1.0;
+  const double d = a2 / (M_PI * denominator * denominator);
+  // Smith G1 for GGX in its tan-free form: 2 cos / (cos + sqrt(a2 + (1 - a2) cos^2)).
+  auto g1 = [a2](double cos_theta) {
+    return 2.0 * cos_theta / (cos_theta + std::sqrt(a2 + (1.0 - a2) * cos_theta * cos_theta));
+  };
+  const double g = g1(wi.z()) * g1(wo.z());
+  const double schlick = std::pow(1.0 - std::max(0.0, wi.dot(h)), 5.0);
+  const Eigen::Vector3d fresnel =
+      specular_f0_ + (Eigen::Vector3d::Ones() - specular_f0_) * schlick;
+  return diffuse_albedo_ / M_PI + fresnel * (d * g / (4.0 * wi.z() * wo.z()));
+}
+
+nlohmann::json GgxBrdf::ToJson() const {
+  return {{"model", "ggx"},
+          {"diffuse_albedo", ibrdf::ToJson(diffuse_albedo_)},
+          {"specular_f0", ibrdf::ToJson(specular_f0_)},
+          {"alpha", alpha_}};
+}
+
+namespace {
+Eigen::Vector3d NonNegative(JsonObject& object, const std::string& key) {
+  const Eigen::Vector3d v = object.Vector3(key);
+  if ((v.array() < 0.0).any()) ThrowError(object.Where(key), "expected non-negative values");
+  return v;
+}
+}  // namespace
+
+std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const std::string& file,
+                                            const std::string& pointer) {
+  JsonObject object(value, file, pointer);
+  object.String("name", "");
+  object.String("description", "");
+  object.String("source", "");
+  const std::string model = object.String("model");
+  std::unique_ptr<BrdfModel> brdf;
+  if (model == "lambertian") {
+    brdf = std::make_unique<LambertianBrdf>(NonNegative(object, "albedo"));
+  } else if (model == "lafortune") {
+    const Eigen::Vector3d diffuse = NonNegative(object, "diffuse");
+    std::vector<LafortuneLobe> lobes;
+    for (JsonObject& lobe_object : object.Objects("lobes")) {
+      LafortuneLobe lobe;
+      lobe.cxy = lobe_object.Vector3("Cxy");
+      lobe.cz = lobe_object.Vector3("Cz");
+      lobe.n = lobe_object.Vector3("n");
+      if ((lobe.n.array() <= 0.0).any()) ThrowError(lobe_object.Where("n"), "exponents must be positive");
+      lobe_object.Finish();
+      lobes.push_back(lobe);
+    }
+    brdf = std::make_unique<LafortuneBrdf>(diffuse, std::move(lobes));
+  } else if (model == "ggx") {
+    const Eigen::Vector3d diffuse = NonNegative(object, "diffuse_albedo");
+    const Eigen::Vector3d f0 = NonNegative(object, "specular_f0");
+    const double alpha = object.Number("alpha");
+    if (!(alpha > 0.0 && alpha <= 1.0)) ThrowError(object.Where("alpha"), "expected 0 < alpha <= 1");
+    brdf = std::make_unique<GgxBrdf>(diffuse, f0, alpha);
+  } else {
+    ThrowError(object.Where("model"),
+               "unknown model \"" + model + "\" (expected lambertian, lafortune or ggx)");
+  }
+  object.Finish();
+  return brdf;
+}
+
+std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path) {
+  return MaterialFromJson(ReadJsonFile(path), path);
+}
+
+}  // namespace ibrdf

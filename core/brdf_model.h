@@ -1,0 +1,89 @@
+// Analytic BRDF models: the materials of synthetic sessions and the ground truth they are compared to.
+//
+// Every model is isotropic and evaluated in the local frame (z = normal) on unit directions wi
+// (towards the light) and wo (towards the camera); below the horizon it is 0. Values are RGB, 1/sr.
+//
+// Material files (samples/materials/*.json) are JSON objects with "model" and the model's parameters:
+//   lambertian: "albedo": [r, g, b]                      f = albedo / pi
+//   lafortune:  "diffuse": [r, g, b], "lobes": [{"Cxy": [r,g,b], "Cz": [r,g,b], "n": [r,g,b]}, ...]
+//               f = diffuse/pi + sum_k max(0, Cxy_k (wi.x wo.x + wi.y wo.y) + Cz_k wi.z wo.z)^n_k
+//               (Lafortune et al. 1997, as in the pbrt fits of the seed paper's materials)
+//   ggx:        "diffuse_albedo": [r,g,b], "specular_f0": [r,g,b], "alpha": a
+//               f = diffuse_albedo/pi + D(h) G(wi, wo) F(wi.h) / (4 cos_i cos_o), GGX D (Walter et al.
+//               2007), separable Smith shadowing for GGX, Schlick's Fresnel
+// plus optional "name" and "description" strings.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
+
+namespace ibrdf {
+
+class BrdfModel {
+ public:
+  virtual ~BrdfModel() = default;
+  // f(wi, wo), RGB in 1/sr; 0 when either direction is below the horizon.
+  virtual Eigen::Vector3d Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const = 0;
+  // The material file's JSON for this model (round-trips through MaterialFromJson).
+  virtual nlohmann::json ToJson() const = 0;
+  // "lambertian", "lafortune" or "ggx".
+  virtual std::string ModelName() const = 0;
+};
+
+class LambertianBrdf : public BrdfModel {
+ public:
+  explicit LambertianBrdf(const Eigen::Vector3d& albedo) : albedo_(albedo) {}
+  Eigen::Vector3d Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const override;
+  nlohmann::json ToJson() const override;
+  std::string ModelName() const override { return "lambertian"; }
+  const Eigen::Vector3d& albedo() const { return albedo_; }
+
+ private:
+  Eigen::Vector3d albedo_;
+};
+
+struct LafortuneLobe {
+  Eigen::Vector3d cxy, cz, n;  // per channel
+};
+
+class LafortuneBrdf : public BrdfModel {
+ public:
+  LafortuneBrdf(const Eigen::Vector3d& diffuse, std::vector<LafortuneLobe> lobes)
+      : diffuse_(diffuse), lobes_(std::move(lobes)) {}
+  Eigen::Vector3d Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const override;
+  nlohmann::json ToJson() const override;
+  std::string ModelName() const override { return "lafortune"; }
+  const Eigen::Vector3d& diffuse() const { return diffuse_; }
+  const std::vector<LafortuneLobe>& lobes() const { return lobes_; }
+
+ private:
+  Eigen::Vector3d diffuse_;
+  std::vector<LafortuneLobe> lobes_;
+};
+
+class GgxBrdf : public BrdfModel {
+ public:
+  GgxBrdf(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& specular_f0, double alpha)
+      : diffuse_albedo_(diffuse_albedo), specular_f0_(specular_f0), alpha_(alpha) {}
+  Eigen::Vector3d Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const override;
+  nlohmann::json ToJson() const override;
+  std::string ModelName() const override { return "ggx"; }
+
+ private:
+  Eigen::Vector3d diffuse_albedo_;
+  Eigen::Vector3d specular_f0_;
+  double alpha_;  // GGX roughness (the slope distribution's width)
+};
+
+// Reads a material from JSON; `where` names the source for errors (a file, or "file: /pointer").
+std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const std::string& file,
+                                            const std::string& pointer = "");
+
+// Reads a material file (see the format above).
+std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path);
+
+}  // namespace ibrdf

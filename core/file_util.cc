@@ -1,0 +1,95 @@
+#include "core/file_util.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+
+#include "core/error.h"
+
+namespace fs = std::filesystem;
+
+namespace ibrdf {
+namespace {
+std::string UniqueSuffix() {
+  static std::atomic<int> counter{0};
+  return ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++);
+}
+}  // namespace
+
+AtomicFile::AtomicFile(std::string final_path) : final_path_(std::move(final_path)) {
+  const fs::path final(final_path_);
+  if (final.has_parent_path() && !fs::is_directory(final.parent_path())) {
+    ThrowError(final_path_, "output folder " + final.parent_path().string() + " does not exist");
+  }
+  const fs::path temporary =
+      final.parent_path() / ("." + final.stem().string() + UniqueSuffix() + final.extension().string());
+  temporary_path_ = temporary.string();
+}
+
+AtomicFile::~AtomicFile() {
+  if (!committed_) {
+    std::error_code ignored;
+    fs::remove(temporary_path_, ignored);
+  }
+}
+
+void AtomicFile::Commit() {
+  std::error_code error;
+  fs::rename(temporary_path_, final_path_, error);
+  if (error) ThrowError(final_path_, "cannot move the finished file into place: " + error.message());
+  committed_ = true;
+}
+
+AtomicDirectory::AtomicDirectory(std::string final_path, bool replace_existing)
+    : final_path_(std::move(final_path)), replace_existing_(replace_existing) {
+  while (!final_path_.empty() && final_path_.back() == '/') final_path_.pop_back();
+  if (fs::exists(final_path_) && !replace_existing_) {
+    ThrowError(final_path_, "already exists (pass --overwrite to replace it)");
+  }
+  const fs::path final(final_path_);
+  const fs::path parent = final.has_parent_path() ? final.parent_path() : fs::path(".");
+  if (!fs::is_directory(parent)) ThrowError(final_path_, "parent folder does not exist");
+  temporary_path_ = (parent / ("." + final.filename().string() + UniqueSuffix())).string();
+  fs::create_directories(temporary_path_);
+}
+
+AtomicDirectory::~AtomicDirectory() {
+  if (!committed_) {
+    std::error_code ignored;
+    fs::remove_all(temporary_path_, ignored);
+  }
+}
+
+void AtomicDirectory::Commit() {
+  std::error_code error;
+  std::string old_path;
+  if (fs::exists(final_path_)) {
+    if (!replace_existing_) ThrowError(final_path_, "appeared while writing; not replaced");
+    old_path = temporary_path_ + ".old";
+    fs::rename(final_path_, old_path, error);
+    if (error) ThrowError(final_path_, "cannot move the old folder aside: " + error.message());
+  }
+  fs::rename(temporary_path_, final_path_, error);
+  if (error) ThrowError(final_path_, "cannot move the finished folder into place: " + error.message());
+  committed_ = true;
+  if (!old_path.empty()) fs::remove_all(old_path, error);
+}
+
+void RequireFile(const std::string& path, const std::string& what) {
+  if (!fs::exists(path)) ThrowError(path, what + " does not exist");
+  if (!fs::is_regular_file(path)) ThrowError(path, what + " is not a regular file");
+}
+
+std::string ResolvePath(const std::string& base_dir, const std::string& path) {
+  if (path.empty() || fs::path(path).is_absolute()) return path;
+  return (fs::path(base_dir) / path).lexically_normal().string();
+}
+
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code error;
+  if (fs::exists(a) && fs::exists(b)) return fs::equivalent(a, b, error);
+  return fs::weakly_canonical(a, error) == fs::weakly_canonical(b, error);
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,57 @@
+// Files that appear only when complete: outputs are written under a temporary name beside their final
+// path and renamed into place (an atomic rename on one file system).
+#pragma once
+
+#include <string>
+
+namespace ibrdf {
+
+// A file being written. Write to temporary_path(); Commit() renames it to the final path. If Commit()
+// is never called (an exception), the destructor removes the temporary file and the final path is
+// untouched. The temporary name keeps the extension, so extension-driven writers (OpenImageIO) work.
+class AtomicFile {
+ public:
+  explicit AtomicFile(std::string final_path);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  const std::string& temporary_path() const { return temporary_path_; }
+  const std::string& final_path() const { return final_path_; }
+  void Commit();
+
+ private:
+  std::string final_path_;
+  std::string temporary_path_;
+  bool committed_ = false;
+};
+
+// A directory being written, committed by rename like AtomicFile. If the final directory exists it is
+// replaced only on Commit() and only when `replace_existing` is set; otherwise the constructor throws.
+class AtomicDirectory {
+ public:
+  AtomicDirectory(std::string final_path, bool replace_existing);
+  ~AtomicDirectory();
+  AtomicDirectory(const AtomicDirectory&) = delete;
+  AtomicDirectory& operator=(const AtomicDirectory&) = delete;
+
+  const std::string& temporary_path() const { return temporary_path_; }
+  void Commit();
+
+ private:
+  std::string final_path_;
+  std::string temporary_path_;
+  bool replace_existing_;
+  bool committed_ = false;
+};
+
+// Throws Error unless `path` is an existing regular file.
+void RequireFile(const std::string& path, const std::string& what);
+
+// Resolves `path` against `base_dir` unless it is absolute.
+std::string ResolvePath(const std::string& base_dir, const std::string& path);
+
+// True if two paths name the same existing file (or the same path when either does not exist).
+bool SameFile(const std::string& a, const std::string& b);
+
+}  // namespace ibrdf

@@ -1,0 +1,84 @@
+#include "core/image_io.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <memory>
+
+#include <OpenImageIO/imageio.h>
+
+#include "core/error.h"
+#include "core/file_util.h"
+
+namespace ibrdf {
+namespace {
+
+std::string LowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+std::unique_ptr<OIIO::ImageInput> Open(const std::string& path) {
+  RequireFile(path, "image");
+  OIIO::ImageSpec config;
+  if (IsRawExtension(path)) {
+    // Linear output: without this the RAW reader applies an sRGB curve.
+    config.attribute("raw:ColorSpace", "sRGB-linear");
+    config.attribute("raw:auto_bright", 0);
+    config.attribute("raw:use_camera_wb", 1);
+  }
+  auto input = OIIO::ImageInput::open(path, &config);
+  if (!input) ThrowError(path, "cannot read image: " + OIIO::geterror());
+  return input;
+}
+
+}  // namespace
+
+bool IsRawExtension(const std::string& path) {
+  static const char* const kRaw[] = {".cr2", ".cr3", ".nef", ".arw", ".dng", ".orf", ".rw2",
+                                     ".raf", ".pef", ".srw", ".crw", ".erf", ".3fr", ".iiq"};
+  const std::string ext = LowerExtension(path);
+  return std::any_of(std::begin(kRaw), std::end(kRaw), [&](const char* e) { return ext == e; });
+}
+
+ImageSpec ReadImageSpec(const std::string& path) {
+  auto input = Open(path);
+  const OIIO::ImageSpec& spec = input->spec();
+  return {spec.width, spec.height, spec.nchannels};
+}
+
+Image ReadImage(const std::string& path) {
+  auto input = Open(path);
+  const OIIO::ImageSpec& spec = input->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) ThrowError(path, "image is empty");
+  Image image(spec.width, spec.height, spec.nchannels);
+  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
+    ThrowError(path, "cannot decode image: " + input->geterror());
+  }
+  input->close();
+  return image;
+}
+
+void WriteImage(const std::string& path, const Image& image, PixelFormat format) {
+  IBRDF_CHECK(image.pixels.size() == size_t(image.width) * image.height * image.channels);
+  AtomicFile file(path);
+  auto output = OIIO::ImageOutput::create(file.temporary_path());
+  if (!output) ThrowError(path, "no image writer for this extension: " + OIIO::geterror());
+  OIIO::TypeDesc type = OIIO::TypeDesc::FLOAT;
+  switch (format) {
+    case PixelFormat::kUint8: type = OIIO::TypeDesc::UINT8; break;
+    case PixelFormat::kUint16: type = OIIO::TypeDesc::UINT16; break;
+    case PixelFormat::kHalf: type = OIIO::TypeDesc::HALF; break;
+    case PixelFormat::kFloat: type = OIIO::TypeDesc::FLOAT; break;
+  }
+  OIIO::ImageSpec spec(image.width, image.height, image.channels, type);
+  if (LowerExtension(path) == ".exr") spec.attribute("compression", "zip");
+  if (!output->open(file.temporary_path(), spec) ||
+      !output->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data()) || !output->close()) {
+    ThrowError(path, "cannot write image: " + output->geterror());
+  }
+  file.Commit();
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,171 @@
+#include "core/json_reader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/file_util.h"
+
+namespace ibrdf {
+
+nlohmann::json ReadJsonFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) ThrowError(path, "cannot open file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  try {
+    return nlohmann::json::parse(buffer.str());
+  } catch (const nlohmann::json::parse_error& e) {
+    // Turn the byte offset into a line number.
+    const std::string text = buffer.str();
+    const size_t offset = std::min<size_t>(e.byte, text.size());
+    const long line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(offset), '\n');
+    ThrowError(path + ":" + std::to_string(line), std::string("invalid JSON: ") + e.what());
+  }
+}
+
+void WriteJsonFile(const std::string& path, const nlohmann::json& value) {
+  AtomicFile file(path);
+  {
+    std::ofstream out(file.temporary_path());
+    if (!out) ThrowError(path, "cannot write file");
+    out << value.dump(2) << "\n";
+    if (!out) ThrowError(path, "write failed");
+  }
+  file.Commit();
+}
+
+std::string JsonTypeName(const nlohmann::json& value) {
+  switch (value.type()) {
+    case nlohmann::json::value_t::null: return "null";
+    case nlohmann::json::value_t::object: return "an object";
+    case nlohmann::json::value_t::array: return "an array";
+    case nlohmann::json::value_t::string: return "a string";
+    case nlohmann::json::value_t::boolean: return "a boolean";
+    case nlohmann::json::value_t::number_integer:
+    case nlohmann::json::value_t::number_unsigned:
+    case nlohmann::json::value_t::number_float: return "a number";
+    default: return "an unsupported value";
+  }
+}
+
+nlohmann::json ToJson(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+
+JsonObject::JsonObject(const nlohmann::json& value, std::string file, std::string pointer)
+    : value_(&value), file_(std::move(file)), pointer_(std::move(pointer)) {
+  if (!value.is_object()) {
+    ThrowError(file_ + ": " + (pointer_.empty() ? "/" : pointer_),
+               "expected an object, got " + JsonTypeName(value));
+  }
+}
+
+bool JsonObject::Has(const std::string& key) const { return value_->contains(key); }
+
+std::string JsonObject::Where(const std::string& key) const {
+  return file_ + ": " + pointer_ + "/" + key;
+}
+
+const nlohmann::json& JsonObject::Field(const std::string& key) {
+  read_.insert(key);
+  const auto it = value_->find(key);
+  if (it == value_->end()) ThrowError(Where(key), "missing required field");
+  return *it;
+}
+
+void JsonObject::TypeError(const std::string& key, const std::string& expected) const {
+  ThrowError(Where(key), "expected " + expected + ", got " + JsonTypeName(value_->at(key)));
+}
+
+double JsonObject::Number(const std::string& key) {
+  const nlohmann::json& v = Field(key);
+  if (!v.is_number()) TypeError(key, "a number");
+  const double x = v.get<double>();
+  if (!std::isfinite(x)) ThrowError(Where(key), "expected a finite number");
+  return x;
+}
+
+int JsonObject::Integer(const std::string& key) {
+  const nlohmann::json& v = Field(key);
+  if (!v.is_number_integer()) TypeError(key, "an integer");
+  return v.get<int>();
+}
+
+bool JsonObject::Boolean(const std::string& key) {
+  const nlohmann::json& v = Field(key);
+  if (!v.is_boolean()) TypeError(key, "true or false");
+  return v.get<bool>();
+}
+
+std::string JsonObject::String(const std::string& key) {
+  const nlohmann::json& v = Field(key);
+  if (!v.is_string()) TypeError(key, "a string");
+  return v.get<std::string>();
+}
+
+std::vector<double> JsonObject::Numbers(const std::string& key) {
+  const nlohmann::json& v = Field(key);
+  if (!v.is_array()) TypeError(key, "an array of numbers");
+  std::vector<double> out;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_number()) {
+      ThrowError(Where(key) + "/" + std::to_string(i), "expected a number, got " + JsonTypeName(v[i]));
+    }
+    out.push_back(v[i].get<double>());
+    if (!std::isfinite(out.back())) {
+      ThrowError(Where(key) + "/" + std::to_string(i), "expected a finite number");
+    }
+  }
+  return out;
+}
+
+Eigen::Vector3d JsonObject::Vector3(const std::string& key) {
+  const nlohmann::json& v = Field(key);
+  if (!v.is_array() || v.size() != 3) TypeError(key, "an array of 3 numbers");
+  const std::vector<double> numbers = Numbers(key);
+  return {numbers[0], numbers[1], numbers[2]};
+}
+
+JsonObject JsonObject::Object(const std::string& key) {
+  const nlohmann::json& v = Field(key);
+  if (!v.is_object()) TypeError(key, "an object");
+  return JsonObject(v, file_, pointer_ + "/" + key);
+}
+
+std::vector<JsonObject> JsonObject::Objects(const std::string& key) {
+  const nlohmann::json& v = Field(key);
+  if (!v.is_array()) TypeError(key, "an array of objects");
+  std::vector<JsonObject> out;
+  for (size_t i = 0; i < v.size(); ++i) {
+    out.emplace_back(v[i], file_, pointer_ + "/" + key + "/" + std::to_string(i));
+  }
+  return out;
+}
+
+const nlohmann::json& JsonObject::Raw(const std::string& key) { return Field(key); }
+
+double JsonObject::Number(const std::string& key, double fallback) {
+  return Has(key) ? Number(key) : fallback;
+}
+int JsonObject::Integer(const std::string& key, int fallback) {
+  return Has(key) ? Integer(key) : fallback;
+}
+bool JsonObject::Boolean(const std::string& key, bool fallback) {
+  return Has(key) ? Boolean(key) : fallback;
+}
+std::string JsonObject::String(const std::string& key, const std::string& fallback) {
+  return Has(key) ? String(key) : fallback;
+}
+
+void JsonObject::Finish() const {
+  for (auto it = value_->begin(); it != value_->end(); ++it) {
+    if (read_.count(it.key())) continue;
+    std::string accepted;
+    for (const std::string& key : read_) accepted += (accepted.empty() ? "" : ", ") + key;
+    ThrowError(Where(it.key()), "unknown key \"" + it.key() + "\"" +
+                                    (accepted.empty() ? "" : " (this object takes: " + accepted + ")"));
+  }
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,291 @@
+#include "core/session.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "core/file_util.h"
+#include "core/image_io.h"
+#include "core/json_reader.h"
+
+namespace fs = std::filesystem;
+
+namespace ibrdf {
+namespace {
+
+constexpr char kFormat[] = "ibrdf-session";
+constexpr int kVersion = 1;
+
+void RequirePositive(JsonObject& object, const std::string& key, double value) {
+  if (!(value > 0.0)) ThrowError(object.Where(key), "must be positive, got " + std::to_string(value));
+}
+
+Camera ParseCamera(JsonObject object) {
+  const std::string model_name = object.String("model");
+  CameraModelId model;
+  if (!CameraModelFromName(model_name, &model)) {
+    ThrowError(object.Where("model"), "unsupported camera model \"" + model_name +
+                                          "\" (expected SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, "
+                                          "RADIAL or OPENCV)");
+  }
+  const int width = object.Integer("width");
+  const int height = object.Integer("height");
+  std::vector<double> params = object.Numbers("params");
+  object.Finish();
+  return Camera::Create(model, width, height, std::move(params), object.Where());
+}
+
+Light ParseLight(JsonObject object) {
+  Light light;
+  const std::string kind = object.String("kind");
+  if (kind == "point") {
+    light.kind = Light::Kind::kPoint;
+    light.position = object.Vector3("position");
+  } else if (kind == "directional") {
+    light.kind = Light::Kind::kDirectional;
+    light.direction = object.Vector3("direction");
+    if (!(light.direction.norm() > 0.0)) ThrowError(object.Where("direction"), "must be non-zero");
+    light.direction.normalize();
+  } else {
+    ThrowError(object.Where("kind"), "unknown light kind \"" + kind + "\" (expected point or directional)");
+  }
+  light.intensity = object.Vector3("intensity");
+  if ((light.intensity.array() < 0.0).any() || !(light.intensity.maxCoeff() > 0.0)) {
+    ThrowError(object.Where("intensity"), "must be non-negative and not all zero");
+  }
+  object.Finish();
+  return light;
+}
+
+SampleSpec ParseSample(JsonObject object) {
+  SampleSpec sample;
+  const std::string kind = object.String("kind");
+  if (kind == "sphere") {
+    sample.kind = SampleSpec::Kind::kSphere;
+    sample.center = object.Vector3("center");
+    sample.radius = object.Number("radius");
+    RequirePositive(object, "radius", sample.radius);
+  } else if (kind == "cylinder") {
+    sample.kind = SampleSpec::Kind::kCylinder;
+    sample.center = object.Vector3("center");
+    sample.axis = object.Vector3("axis");
+    if (!(sample.axis.norm() > 0.0)) ThrowError(object.Where("axis"), "must be non-zero");
+    sample.axis.normalize();
+    sample.radius = object.Number("radius");
+    RequirePositive(object, "radius", sample.radius);
+    sample.length = object.Number("length");
+    RequirePositive(object, "length", sample.length);
+  } else if (kind == "mesh") {
+    sample.kind = SampleSpec::Kind::kMesh;
+    sample.mesh_file = object.String("file");
+  } else {
+    ThrowError(object.Where("kind"), "unknown sample kind \"" + kind + "\" (expected sphere, cylinder or mesh)");
+  }
+  object.Finish();
+  return sample;
+}
+
+Response ParseResponse(JsonObject& parent) {
+  Response response;
+  const nlohmann::json& value = parent.Raw("response");
+  if (value.is_string()) {
+    const std::string name = value.get<std::string>();
+    if (name == "linear") {
+      response.kind = Response::Kind::kLinear;
+    } else if (name == "srgb") {
+      response.kind = Response::Kind::kSrgb;
+    } else {
+      ThrowError(parent.Where("response"), "unknown response \"" + name +
+                                               "\" (expected \"linear\", \"srgb\", {\"gamma\": g} or "
+                                               "{\"table\": [...]})");
+    }
+  } else if (value.is_object()) {
+    JsonObject object = parent.Object("response");
+    if (object.Has("gamma")) {
+      response.kind = Response::Kind::kGamma;
+      response.gamma = object.Number("gamma");
+    } else if (object.Has("table")) {
+      response.kind = Response::Kind::kTable;
+      response.table = object.Numbers("table");
+    } else {
+      ThrowError(parent.Where("response"), "expected {\"gamma\": g} or {\"table\": [...]}");
+    }
+    object.Finish();
+  } else {
+    ThrowError(parent.Where("response"), "expected a string or an object, got " + JsonTypeName(value));
+  }
+  std::string why;
+  if (!response.Check(&why)) ThrowError(parent.Where("response"), why);
+  return response;
+}
+
+RadiometrySpec ParseRadiometry(JsonObject object) {
+  RadiometrySpec radiometry;
+  if (object.Has("response")) radiometry.response = ParseResponse(object);
+  radiometry.black_level = object.Number("black_level", 0.0);
+  radiometry.saturation_level = object.Number("saturation_level", 1.0);
+  if (radiometry.black_level < 0.0) ThrowError(object.Where("black_level"), "must not be negative");
+  if (!(radiometry.saturation_level > radiometry.black_level)) {
+    ThrowError(object.Where("saturation_level"), "must be above black_level");
+  }
+  if (object.Has("noise")) {
+    JsonObject noise_object = object.Object("noise");
+    CameraNoise noise;
+    noise.full_well_e = noise_object.Number("full_well_e");
+    RequirePositive(noise_object, "full_well_e", noise.full_well_e);
+    noise.read_noise_e = noise_object.Number("read_noise_e");
+    if (noise.read_noise_e < 0.0) ThrowError(noise_object.Where("read_noise_e"), "must not be negative");
+    noise.bits = noise_object.Integer("bits", 0);
+    if (noise.bits < 0 || noise.bits > 32) ThrowError(noise_object.Where("bits"), "expected 0 to 32");
+    noise_object.Finish();
+    radiometry.noise = noise;
+  }
+  object.Finish();
+  return radiometry;
+}
+
+Rigid3d ParsePose(JsonObject object) {
+  const std::vector<double> q = object.Numbers("rotation");
+  if (q.size() != 4) ThrowError(object.Where("rotation"), "expected a quaternion [qw, qx, qy, qz]");
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (std::abs(norm - 1.0) > 1e-6) {
+    ThrowError(object.Where("rotation"), "quaternion is not unit length (norm " + std::to_string(norm) + ")");
+  }
+  Rigid3d pose;
+  pose.rotation = Eigen::Quaterniond(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm);
+  pose.translation = object.Vector3("translation");
+  object.Finish();
+  return pose;
+}
+
+PhotoSpec ParsePhoto(JsonObject object, const std::string& directory) {
+  PhotoSpec photo;
+  photo.file = object.String("file");
+  photo.exposure_s = object.Number("exposure_s");
+  RequirePositive(object, "exposure_s", photo.exposure_s);
+  photo.gain = object.Number("gain", 1.0);
+  RequirePositive(object, "gain", photo.gain);
+  if (object.Has("camera_from_world")) photo.camera_from_world = ParsePose(object.Object("camera_from_world"));
+  const std::string path = ResolvePath(directory, photo.file);
+  if (!fs::is_regular_file(path)) ThrowError(object.Where("file"), "photo " + path + " does not exist");
+  object.Finish();
+  return photo;
+}
+
+nlohmann::json PoseToJson(const Rigid3d& pose) {
+  const Eigen::Quaterniond& q = pose.rotation;
+  return {{"rotation", {q.w(), q.x(), q.y(), q.z()}}, {"translation", ToJson(pose.translation)}};
+}
+
+}  // namespace
+
+const char* SampleKindName(SampleSpec::Kind kind) {
+  switch (kind) {
+    case SampleSpec::Kind::kSphere: return "sphere";
+    case SampleSpec::Kind::kCylinder: return "cylinder";
+    case SampleSpec::Kind::kMesh: return "mesh";
+  }
+  return "unknown";
+}
+
+Session Session::Load(const std::string& path) {
+  Session session;
+  session.manifest_path = fs::is_directory(path) ? (fs::path(path) / "session.json").string() : path;
+  RequireFile(session.manifest_path, "session manifest");
+  session.directory = fs::path(session.manifest_path).parent_path().string();
+  if (session.directory.empty()) session.directory = ".";
+  const nlohmann::json json = ReadJsonFile(session.manifest_path);
+  JsonObject root(json, session.manifest_path);
+  const std::string format = root.String("format");
+  if (format != kFormat) ThrowError(root.Where("format"), "expected \"" + std::string(kFormat) + "\"");
+  const int version = root.Integer("version");
+  if (version != kVersion) {
+    ThrowError(root.Where("version"), "unsupported version " + std::to_string(version) +
+                                          " (this ibrdf reads version " + std::to_string(kVersion) + ")");
+  }
+  session.name = root.String("name", fs::path(session.directory).filename().string());
+  root.String("description", "");
+  session.camera = ParseCamera(root.Object("camera"));
+  session.light = ParseLight(root.Object("light"));
+  session.sample = ParseSample(root.Object("sample"));
+  if (root.Has("radiometry")) session.radiometry = ParseRadiometry(root.Object("radiometry"));
+  for (JsonObject& photo : root.Objects("photos")) {
+    session.photos.push_back(ParsePhoto(photo, session.directory));
+  }
+  if (session.photos.empty()) ThrowError(root.Where("photos"), "a session needs at least one photo");
+  root.Finish();
+  return session;
+}
+
+nlohmann::json Session::ToJson() const {
+  nlohmann::json json;
+  json["format"] = kFormat;
+  json["version"] = kVersion;
+  json["name"] = name;
+  json["camera"] = {{"model", CameraModelName(camera.model)},
+                    {"width", camera.width},
+                    {"height", camera.height},
+                    {"params", camera.params}};
+  if (light.kind == Light::Kind::kPoint) {
+    json["light"] = {{"kind", "point"}, {"position", ibrdf::ToJson(light.position)}};
+  } else {
+    json["light"] = {{"kind", "directional"}, {"direction", ibrdf::ToJson(light.direction)}};
+  }
+  json["light"]["intensity"] = ibrdf::ToJson(light.intensity);
+  nlohmann::json& s = json["sample"];
+  s["kind"] = SampleKindName(sample.kind);
+  if (sample.kind == SampleSpec::Kind::kMesh) {
+    s["file"] = sample.mesh_file;
+  } else {
+    s["center"] = ibrdf::ToJson(sample.center);
+    s["radius"] = sample.radius;
+    if (sample.kind == SampleSpec::Kind::kCylinder) {
+      s["axis"] = ibrdf::ToJson(sample.axis);
+      s["length"] = sample.length;
+    }
+  }
+  nlohmann::json& r = json["radiometry"];
+  switch (radiometry.response.kind) {
+    case Response::Kind::kLinear: r["response"] = "linear"; break;
+    case Response::Kind::kSrgb: r["response"] = "srgb"; break;
+    case Response::Kind::kGamma: r["response"] = {{"gamma", radiometry.response.gamma}}; break;
+    case Response::Kind::kTable: r["response"] = {{"table", radiometry.response.table}}; break;
+  }
+  r["black_level"] = radiometry.black_level;
+  r["saturation_level"] = radiometry.saturation_level;
+  if (radiometry.noise) {
+    r["noise"] = {{"full_well_e", radiometry.noise->full_well_e},
+                  {"read_noise_e", radiometry.noise->read_noise_e},
+                  {"bits", radiometry.noise->bits}};
+  }
+  json["photos"] = nlohmann::json::array();
+  for (const PhotoSpec& photo : photos) {
+    nlohmann::json p = {{"file", photo.file}, {"exposure_s", photo.exposure_s}, {"gain", photo.gain}};
+    if (photo.camera_from_world) p["camera_from_world"] = PoseToJson(*photo.camera_from_world);
+    json["photos"].push_back(p);
+  }
+  return json;
+}
+
+void Session::Save(const std::string& path) const { WriteJsonFile(path, ToJson()); }
+
+std::string Session::PhotoPath(size_t i) const { return ResolvePath(directory, photos.at(i).file); }
+
+void Session::CheckPhotos() const {
+  for (size_t i = 0; i < photos.size(); ++i) {
+    const ImageSpec spec = ReadImageSpec(PhotoPath(i));
+    if (spec.width != camera.width || spec.height != camera.height) {
+      ThrowError(PhotoPath(i), "photo is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                                   " but the session's camera is " + std::to_string(camera.width) + "x" +
+                                   std::to_string(camera.height) + " (" + manifest_path + ": /photos/" +
+                                   std::to_string(i) + ")");
+    }
+    if (spec.channels != 1 && spec.channels < 3) {
+      ThrowError(PhotoPath(i), "expected 1 (grey) or 3+ (RGB) channels, got " + std::to_string(spec.channels));
+    }
+  }
+}
+
+}  // namespace ibrdf

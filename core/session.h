@@ -1,0 +1,82 @@
+// A measurement session: a folder with a JSON manifest (session.json) that names the photos, the
+// camera, the light, the sample and the radiometric settings. The format is documented in
+// docs/session-format.md; lengths are metres, angles radians unless a key says _deg.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/camera.h"
+#include "core/light.h"
+#include "core/radiometry.h"
+#include "core/rigid3.h"
+
+namespace ibrdf {
+
+// The camera's noise model, used to give each sample an uncertainty (shot and read noise, and the
+// quantization step of the stored file).
+struct CameraNoise {
+  double full_well_e = 0.0;   // electrons at the saturation level
+  double read_noise_e = 0.0;  // electrons, one sigma
+  int bits = 0;               // quantization of the stored values; 0 for floating-point files
+};
+
+struct RadiometrySpec {
+  Response response;             // file value -> linear signal
+  double black_level = 0.0;      // linear signal of a dark pixel, subtracted (normalized file units)
+  double saturation_level = 1.0; // file value at which a channel is clipped (normalized file units)
+  std::optional<CameraNoise> noise;
+};
+
+struct SampleSpec {
+  enum class Kind { kSphere, kCylinder, kMesh };
+  Kind kind = Kind::kSphere;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // sphere centre; cylinder axis midpoint
+  double radius = 0.0;                               // sphere and cylinder, metres
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   // cylinder axis, unit
+  double length = 0.0;                               // cylinder length along the axis, metres
+  std::string mesh_file;                             // mesh: path relative to the session folder
+};
+
+struct PhotoSpec {
+  std::string file;          // relative to the session folder
+  double exposure_s = 1.0;   // exposure time, seconds
+  double gain = 1.0;         // linear gain relative to the base ISO
+  std::optional<Rigid3d> camera_from_world;  // known pose, if any
+};
+
+struct Session {
+  std::string name;
+  std::string directory;      // folder holding the manifest; relative paths resolve against it
+  std::string manifest_path;  // the manifest file
+  Camera camera;
+  Light light;
+  SampleSpec sample;
+  RadiometrySpec radiometry;
+  std::vector<PhotoSpec> photos;
+
+  // Reads and validates a manifest (a session.json path, or a folder holding session.json). Unknown
+  // keys, missing fields, wrong types, missing photo files and impossible values are Errors naming the
+  // manifest and the field's JSON pointer.
+  static Session Load(const std::string& path);
+
+  // The manifest as JSON (round-trips through Load).
+  nlohmann::json ToJson() const;
+  // Writes the manifest to `path` atomically.
+  void Save(const std::string& path) const;
+
+  // Absolute or session-relative path of photo i.
+  std::string PhotoPath(size_t i) const;
+
+  // Opens every photo's header and checks its size against the camera; throws Error naming the photo.
+  void CheckPhotos() const;
+};
+
+// "sphere", "cylinder", "mesh".
+const char* SampleKindName(SampleSpec::Kind kind);
+
+}  // namespace ibrdf

@@ -1,0 +1,69 @@
+// Analytic sample shapes for the paper's sphere and cylinder measurements: exact ray intersection and
+// exact normals, no mesh (a scene models only what it needs).
+#pragma once
+
+#include <memory>
+
+#include <Eigen/Core>
+
+#include "core/session.h"
+
+namespace ibrdf {
+
+struct SurfaceHit {
+  double t = 0.0;                                    // ray parameter, metres along a unit direction
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // world frame
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, outward
+};
+
+class AnalyticSample {
+ public:
+  virtual ~AnalyticSample() = default;
+  // The nearest hit with t > 0 of the ray origin + t * direction (direction unit length) on the
+  // measured surface. False for a miss, for a ray that starts inside, and (cylinder) for rays that hit
+  // an end cap first: the caps are not measured.
+  virtual bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                         SurfaceHit* hit) const = 0;
+  // True if the point is inside the solid (a camera there sees no outer surface).
+  virtual bool Contains(const Eigen::Vector3d& point) const = 0;
+  // A bounding sphere: centre and radius (framing synthetic views).
+  virtual Eigen::Vector3d BoundingCenter() const = 0;
+  virtual double BoundingRadius() const = 0;
+
+  // A sphere or cylinder from a session's sample; throws Error for a mesh sample.
+  static std::unique_ptr<AnalyticSample> Create(const SampleSpec& spec);
+};
+
+class SphereSample : public AnalyticSample {
+ public:
+  SphereSample(const Eigen::Vector3d& center, double radius) : center_(center), radius_(radius) {}
+  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                 SurfaceHit* hit) const override;
+  bool Contains(const Eigen::Vector3d& point) const override;
+  Eigen::Vector3d BoundingCenter() const override { return center_; }
+  double BoundingRadius() const override { return radius_; }
+
+ private:
+  Eigen::Vector3d center_;
+  double radius_;
+};
+
+// A closed circular cylinder: the curved side is the sample, the end caps are unmeasured (black).
+class CylinderSample : public AnalyticSample {
+ public:
+  CylinderSample(const Eigen::Vector3d& center, const Eigen::Vector3d& axis, double radius, double length)
+      : center_(center), axis_(axis.normalized()), radius_(radius), half_length_(0.5 * length) {}
+  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                 SurfaceHit* hit) const override;
+  bool Contains(const Eigen::Vector3d& point) const override;
+  Eigen::Vector3d BoundingCenter() const override { return center_; }
+  double BoundingRadius() const override;
+
+ private:
+  Eigen::Vector3d center_;
+  Eigen::Vector3d axis_;
+  double radius_;
+  double half_length_;
+};
+
+}  // namespace ibrdf

@@ -1,0 +1,270 @@
+#include "derender/derenderer.h"
+
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+
+#include <nlohmann/json.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/brdf_coords.h"
+#include "core/error.h"
+#include "core/light.h"
+#include "derender/analytic_sample.h"
+
+namespace ibrdf {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+// Variance of a linear signal v (normalized units) from the camera noise model: shot noise
+// v / full_well, read noise (read / full_well)^2, and the file's quantization step through the slope
+// of the response.
+double SignalVariance(const RadiometrySpec& radiometry, double encoded, double linear) {
+  const CameraNoise& noise = *radiometry.noise;
+  double variance = std::max(linear, 0.0) / noise.full_well_e +
+                    (noise.read_noise_e / noise.full_well_e) * (noise.read_noise_e / noise.full_well_e);
+  if (noise.bits > 0) {
+    const double step = 1.0 / (std::ldexp(1.0, noise.bits) - 1.0);
+    const double slope = (radiometry.response.ToLinear(std::min(encoded + 0.5 * step, 1.0)) -
+                          radiometry.response.ToLinear(std::max(encoded - 0.5 * step, 0.0))) / step;
+    variance += (step * slope) * (step * slope) / 12.0;
+  }
+  return variance;
+}
+
+}  // namespace
+
+bool DerenderOptions::Check(std::string* why) const {
+  if (!(max_theta_i_deg > 0.0 && max_theta_i_deg <= 90.0) || !(max_theta_e_deg > 0.0 && max_theta_e_deg <= 90.0)) {
+    *why = "grazing limits must be in (0, 90] degrees";
+    return false;
+  }
+  if (!(min_signal >= 0.0)) {
+    *why = "min_signal must not be negative";
+    return false;
+  }
+  if (pixel_stride < 1) {
+    *why = "pixel_stride must be at least 1";
+    return false;
+  }
+  return true;
+}
+
+const std::vector<std::pair<std::string, std::string>>& RejectionReasons() {
+  static const std::vector<std::pair<std::string, std::string>> kReasons = {
+      {"off_sample", "the pixel's ray misses the sample (background, or a cylinder's end cap)"},
+      {"unlit", "the light is behind the surface at the hit point"},
+      {"grazing_exitance", "theta_e above max_theta_e_deg"},
+      {"grazing_incidence", "theta_i above max_theta_i_deg"},
+      {"non_finite", "a pixel value is NaN or infinite"},
+      {"saturated", "a channel reaches the saturation level"},
+      {"below_signal", "the darkest channel's linear signal is below min_signal"},
+  };
+  return kReasons;
+}
+
+std::string DerenderSummary::BriefReport() const {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), "derender: %llu samples from %llu photos (%llu pixels) in %.2f s; rejected: ",
+                static_cast<unsigned long long>(accepted), static_cast<unsigned long long>(photos),
+                static_cast<unsigned long long>(pixels_examined), total_s);
+  return buffer + FormatCounts(rejected);
+}
+
+std::vector<Eigen::Vector2f> PixelRays(const Camera& camera) {
+  std::vector<Eigen::Vector2f> rays(size_t(camera.width) * camera.height);
+  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      for (int x = 0; x < camera.width; ++x) {
+        rays[size_t(y) * camera.width + x] =
+            camera.CamPlaneFromImage(Eigen::Vector2d(x + 0.5, y + 0.5)).cast<float>();
+      }
+    }
+  });
+  return rays;
+}
+
+void DerenderPhoto(const Session& session, size_t photo_index, const Image& image,
+                   const std::vector<Eigen::Vector2f>& rays, const AnalyticSample& sample,
+                   const DerenderOptions& options, std::vector<BrdfSample>* samples,
+                   RejectionCounts* rejected) {
+  const PhotoSpec& photo = session.photos[photo_index];
+  const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
+  const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
+  const Eigen::Vector3d camera_center = world_from_camera.translation;
+  const RadiometrySpec& radiometry = session.radiometry;
+  const double radiance_scale = 1.0 / (photo.exposure_s * photo.gain);
+  const double cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
+  const double cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
+  const int stride = options.pixel_stride;
+  const bool grey = image.channels == 1;
+
+  // Counters per reason, in RejectionReasons() order.
+  enum { kOff, kUnlit, kGrazingE, kGrazingI, kNonFinite, kSaturated, kBelow, kNumReasons };
+  std::array<uint64_t, kNumReasons> counts{};
+
+  for (int y = 0; y < image.height; y += stride) {
+    for (int x = 0; x < image.width; x += stride) {
+      const Eigen::Vector2f& xy = rays[size_t(y) * image.width + x];
+      const Eigen::Vector3d direction =
+          (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+      SurfaceHit hit;
+      if (!sample.Intersect(camera_center, direction, &hit)) {
+        ++counts[kOff];
+        continue;
+      }
+      const Incidence incidence = IncidenceAt(session.light, hit.point, hit.normal);
+      if (!incidence.lit) {
+        ++counts[kUnlit];
+        continue;
+      }
+      const Eigen::Vector3d wo_world = -direction;
+      const double cos_e = wo_world.dot(hit.normal);
+      if (!(cos_e >= cos_max_e)) {
+        ++counts[kGrazingE];
+        continue;
+      }
+      if (!(incidence.cos_theta >= cos_max_i)) {
+        ++counts[kGrazingI];
+        continue;
+      }
+      // Pixel values: the saturation test on file values, then linearize and subtract the black level.
+      double encoded[3], linear[3];
+      bool finite = true, saturated = false;
+      for (int c = 0; c < 3; ++c) {
+        encoded[c] = image.at(x, y, grey ? 0 : c);
+        finite = finite && std::isfinite(encoded[c]);
+        saturated = saturated || encoded[c] >= radiometry.saturation_level;
+        linear[c] = radiometry.response.ToLinear(encoded[c]) - radiometry.black_level;
+      }
+      if (!finite) {
+        ++counts[kNonFinite];
+        continue;
+      }
+      if (saturated) {
+        ++counts[kSaturated];
+        continue;
+      }
+      if (std::min({linear[0], linear[1], linear[2]}) < options.min_signal) {
+        ++counts[kBelow];
+        continue;
+      }
+      const LocalFrame frame = LocalFrame::FromNormal(hit.normal);
+      const Eigen::Vector3d wi = frame.ToLocal(incidence.wi);
+      const Eigen::Vector3d wo = frame.ToLocal(wo_world);
+      const IsotropicAngles angles = ToIsotropic(wi, wo);
+      BrdfSample s;
+      for (int c = 0; c < 3; ++c) {
+        s.wi[c] = static_cast<float>(wi[c]);
+        s.wo[c] = static_cast<float>(wo[c]);
+        const double irradiance = incidence.irradiance[c];
+        s.brdf[c] = static_cast<float>(linear[c] * radiance_scale / irradiance);
+        s.sigma[c] = radiometry.noise
+                         ? static_cast<float>(std::sqrt(SignalVariance(radiometry, encoded[c], linear[c])) *
+                                              radiance_scale / irradiance)
+                         : 0.0f;
+      }
+      s.theta_i = static_cast<float>(angles.theta_i);
+      s.theta_e = static_cast<float>(angles.theta_e);
+      s.delta_phi = static_cast<float>(angles.delta_phi);
+      s.image = static_cast<uint32_t>(photo_index);
+      s.pixel[0] = static_cast<uint32_t>(x);
+      s.pixel[1] = static_cast<uint32_t>(y);
+      samples->push_back(s);
+    }
+  }
+  const auto& reasons = RejectionReasons();
+  for (int r = 0; r < kNumReasons; ++r) (*rejected)[reasons[r].first] += counts[r];
+}
+
+DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& options) {
+  Timer timer;
+  DerenderResult result;
+  std::string why;
+  if (!options.Check(&why)) ThrowError("derender options", why);
+  const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
+  // Everything that can be checked before decoding is checked first, so a bad session fails at once.
+  for (size_t i = 0; i < session.photos.size(); ++i) {
+    const PhotoSpec& photo = session.photos[i];
+    const std::string where = session.manifest_path + ": /photos/" + std::to_string(i);
+    if (!photo.camera_from_world) {
+      ThrowError(where, "photo " + photo.file + " has no camera_from_world pose (run `ibrdf align` first)");
+    }
+    if (sample->Contains(photo.camera_from_world->Inverse().translation)) {
+      ThrowError(where, "the camera centre is inside the sample");
+    }
+  }
+  session.CheckPhotos();
+
+  const std::vector<Eigen::Vector2f> rays = PixelRays(session.camera);
+  std::vector<std::vector<BrdfSample>> per_photo(session.photos.size());
+  std::vector<RejectionCounts> per_photo_rejected(session.photos.size());
+  std::vector<double> decode_s(session.photos.size(), 0.0);
+  ProgressBar progress("photos", session.photos.size());
+  tbb::parallel_for(size_t(0), session.photos.size(), [&](size_t i) {
+    Timer decode_timer;
+    const Image image = ReadImage(session.PhotoPath(i));
+    decode_s[i] = decode_timer.ElapsedSeconds();
+    DerenderPhoto(session, i, image, rays, *sample, options, &per_photo[i], &per_photo_rejected[i]);
+    progress.Add(1);
+  });
+  progress.Finish();
+
+  size_t total = 0;
+  for (const auto& samples : per_photo) total += samples.size();
+  result.samples.reserve(total);
+  for (size_t i = 0; i < per_photo.size(); ++i) {
+    result.samples.insert(result.samples.end(), per_photo[i].begin(), per_photo[i].end());
+    for (const auto& [reason, count] : per_photo_rejected[i]) result.summary.rejected[reason] += count;
+    result.summary.decode_s += decode_s[i];
+  }
+  const int stride = options.pixel_stride;
+  const uint64_t per_image = uint64_t((session.camera.width + stride - 1) / stride) *
+                             uint64_t((session.camera.height + stride - 1) / stride);
+  result.summary.photos = session.photos.size();
+  result.summary.pixels_examined = per_image * session.photos.size();
+  result.summary.accepted = result.samples.size();
+  result.summary.total_s = timer.ElapsedSeconds();
+  result.summary.success = true;
+  return result;
+}
+
+nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options,
+                               const DerenderSummary& summary) {
+  nlohmann::json rejected = nlohmann::json::object();
+  for (const auto& [reason, meaning] : RejectionReasons()) {
+    const auto it = summary.rejected.find(reason);
+    rejected[reason] = it == summary.rejected.end() ? 0 : it->second;
+  }
+  return {
+      {"format", "ibrdf-samples"},
+      {"version", 1},
+      {"session", std::filesystem::absolute(session.manifest_path).lexically_normal().string()},
+      {"session_name", session.name},
+      {"sample", SampleKindName(session.sample.kind)},
+      {"units",
+       {{"brdf", "1/sr"},
+        {"angles", "radians"},
+        {"directions", "unit vectors in the local frame, z = surface normal; wi towards the light, wo towards the camera"}}},
+      {"colour_space", "camera RGB, linear (the session's response inverted, black level subtracted)"},
+      {"uncertainty", session.radiometry.noise ? "sigma: one standard deviation from the session's camera noise model"
+                                               : "none: the session has no camera noise model; sigma is 0"},
+      {"counts",
+       {{"photos", summary.photos},
+        {"pixels_examined", summary.pixels_examined},
+        {"accepted", summary.accepted},
+        {"rejected", rejected}}},
+      {"options",
+       {{"max_theta_i_deg", options.max_theta_i_deg},
+        {"max_theta_e_deg", options.max_theta_e_deg},
+        {"min_signal", options.min_signal},
+        {"pixel_stride", options.pixel_stride}}},
+      {"timings_s", {{"total", summary.total_s}, {"decode_cpu", summary.decode_s}}},
+  };
+}
+
+}  // namespace ibrdf

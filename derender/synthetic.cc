@@ -1,0 +1,310 @@
+#include "derender/synthetic.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include <nlohmann/json.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/brdf_coords.h"
+#include "core/error.h"
+#include "core/file_util.h"
+#include "core/json_reader.h"
+#include "core/light.h"
+#include "core/logging.h"
+#include "core/radiometry.h"
+#include "derender/analytic_sample.h"
+
+namespace fs = std::filesystem;
+
+namespace ibrdf {
+namespace {
+constexpr double kDegree = M_PI / 180.0;
+
+// The session (camera, light, sample, poses) an options object describes, without photos on disk.
+Session BuildSession(const SynthOptions& options) {
+  Session session;
+  SampleSpec& sample = session.sample;
+  sample.kind = options.sample;
+  sample.center = options.origin;
+  sample.radius = options.sample_radius;
+  if (sample.kind == SampleSpec::Kind::kCylinder) {
+    sample.axis = Eigen::Vector3d::UnitZ();
+    sample.length = options.cylinder_length;
+  }
+  const double bounding_radius = AnalyticSample::Create(sample)->BoundingRadius();
+
+  session.light.kind = Light::Kind::kPoint;
+  session.light.position = options.origin + options.light_distance * Eigen::Vector3d::UnitX();
+  session.light.intensity = options.light_intensity;
+
+  const double half_angle = std::asin(std::min(1.0, bounding_radius / options.camera_distance));
+  const double focal = options.frame_fraction * 0.5 * std::min(options.width, options.height) / std::tan(half_angle);
+  session.camera = Camera::Create(CameraModelId::kOpenCV, options.width, options.height,
+                                  {focal, focal, 0.5 * options.width, 0.5 * options.height, options.k1,
+                                   options.k2, options.p1, options.p2},
+                                  "synth camera");
+
+  const CameraEffects& effects = options.effects;
+  session.radiometry.response.kind = effects.srgb ? Response::Kind::kSrgb : Response::Kind::kLinear;
+  session.radiometry.black_level = effects.black_level;
+  // Unclipped float files have no saturation level; the largest float stands for "none".
+  session.radiometry.saturation_level = effects.clip ? 1.0 : double(std::numeric_limits<float>::max());
+  if (effects.shot_noise || effects.read_noise || effects.bits > 0) {
+    CameraNoise noise;
+    noise.full_well_e = effects.full_well_e;
+    noise.read_noise_e = effects.read_noise ? effects.read_noise_e : 0.0;
+    noise.bits = effects.bits;
+    if (!effects.shot_noise) noise.full_well_e = 1e30;  // no shot noise: an infinitely deep well
+    session.radiometry.noise = noise;
+  }
+
+  const double elevation = options.camera_elevation_deg * kDegree;
+  for (int i = 0; i < options.num_photos; ++i) {
+    const double t = options.num_photos == 1 ? 0.0 : double(i) / (options.num_photos - 1);
+    const double azimuth = (options.arc_start_deg + t * (options.arc_end_deg - options.arc_start_deg)) * kDegree;
+    const Eigen::Vector3d direction(std::cos(elevation) * std::cos(azimuth),
+                                    std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+    PhotoSpec photo;
+    char name[32];
+    std::snprintf(name, sizeof(name), "photos/%03d.%s", i, effects.bits == 0 ? "exr" : "png");
+    photo.file = name;
+    photo.camera_from_world = LookAtCameraFromWorld(options.origin + options.camera_distance * direction,
+                                                    options.origin, Eigen::Vector3d::UnitZ());
+    session.photos.push_back(photo);
+  }
+  return session;
+}
+
+}  // namespace
+
+CameraEffects CameraEffects::None() {
+  CameraEffects effects;
+  effects.shot_noise = false;
+  effects.read_noise = false;
+  effects.bits = 0;
+  effects.srgb = false;
+  effects.black_level = 0.0;
+  effects.supersample = 1;
+  return effects;
+}
+
+bool CameraEffects::Check(std::string* why) const {
+  if (bits != 0 && (bits < 8 || bits > 16)) {
+    *why = "bits must be 0 (float) or 8 to 16";
+    return false;
+  }
+  if (!(full_well_e > 0.0) || !(read_noise_e >= 0.0)) {
+    *why = "full_well_e must be positive and read_noise_e non-negative";
+    return false;
+  }
+  if (!(black_level >= 0.0 && black_level < 0.5)) {
+    *why = "black_level must be in [0, 0.5)";
+    return false;
+  }
+  if (supersample < 1 || supersample > 16) {
+    *why = "supersample must be 1 to 16";
+    return false;
+  }
+  return true;
+}
+
+bool SynthOptions::Check(std::string* why) const {
+  if (sample == SampleSpec::Kind::kMesh) {
+    *why = "synth renders a sphere or a cylinder";
+    return false;
+  }
+  if (!(sample_radius > 0.0) || !(cylinder_length > 0.0)) {
+    *why = "sample sizes must be positive";
+    return false;
+  }
+  const double bounding = sample == SampleSpec::Kind::kCylinder ? std::hypot(sample_radius, 0.5 * cylinder_length)
+                                                                : sample_radius;
+  if (!(camera_distance > 1.5 * bounding) || !(light_distance > bounding)) {
+    *why = "the camera and the light must be well outside the sample";
+    return false;
+  }
+  if (num_photos < 1 || num_photos > 100000) {
+    *why = "num_photos must be 1 to 100000";
+    return false;
+  }
+  if (width < 8 || height < 8 || width > 20000 || height > 20000) {
+    *why = "image size must be 8 to 20000 pixels a side";
+    return false;
+  }
+  if (!(frame_fraction > 0.0 && frame_fraction <= 1.0) || !(exposure_target > 0.0 && exposure_target <= 1.0)) {
+    *why = "frame_fraction and exposure_target must be in (0, 1]";
+    return false;
+  }
+  if ((light_intensity.array() < 0.0).any() || !(light_intensity.maxCoeff() > 0.0)) {
+    *why = "light_intensity must be non-negative and not all zero";
+    return false;
+  }
+  return effects.Check(why);
+}
+
+Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material,
+                     int supersample, std::vector<uint8_t>* hit_mask) {
+  const Camera& camera = session.camera;
+  const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
+  const Rigid3d world_from_camera = session.photos[photo_index].camera_from_world->Inverse();
+  const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
+  const Eigen::Vector3d center = world_from_camera.translation;
+  Image image(camera.width, camera.height, 3);
+  if (hit_mask) hit_mask->assign(size_t(camera.width) * camera.height, 0);
+  const double weight = 1.0 / (supersample * supersample);
+  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      for (int x = 0; x < camera.width; ++x) {
+        Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
+        for (int sy = 0; sy < supersample; ++sy) {
+          for (int sx = 0; sx < supersample; ++sx) {
+            const Eigen::Vector2d pixel(x + (sx + 0.5) / supersample, y + (sy + 0.5) / supersample);
+            const Eigen::Vector2d xy = camera.CamPlaneFromImage(pixel);
+            const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+            SurfaceHit hit;
+            if (!sample->Intersect(center, direction, &hit)) continue;
+            if (hit_mask && sx == supersample / 2 && sy == supersample / 2) {
+              (*hit_mask)[size_t(y) * camera.width + x] = 1;
+            }
+            const Incidence incidence = IncidenceAt(session.light, hit.point, hit.normal);
+            if (!incidence.lit) continue;
+            const LocalFrame frame = LocalFrame::FromNormal(hit.normal);
+            const Eigen::Vector3d f = material.Eval(frame.ToLocal(incidence.wi), frame.ToLocal(-direction));
+            radiance += weight * f.cwiseProduct(incidence.irradiance);
+          }
+        }
+        for (int c = 0; c < 3; ++c) image.at(x, y, c) = static_cast<float>(radiance[c]);
+      }
+    }
+  });
+  return image;
+}
+
+std::string SynthSummary::BriefReport() const {
+  char buffer[160];
+  std::snprintf(buffer, sizeof(buffer), "synth: %d photos in %.2f s; %llu pixels clipped at saturation",
+                photos, total_s, static_cast<unsigned long long>(saturated_pixels));
+  return buffer;
+}
+
+SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel& material,
+                                   const std::string& material_name, const std::string& out_dir,
+                                   bool overwrite) {
+  Timer timer;
+  std::string why;
+  if (!options.Check(&why)) ThrowError("synth options", why);
+  SynthSummary summary;
+  Session session = BuildSession(options);
+  session.name = fs::path(out_dir).filename().string();
+  AtomicDirectory directory(out_dir, overwrite);
+  fs::create_directories(fs::path(directory.temporary_path()) / "photos");
+
+  const CameraEffects& effects = options.effects;
+  std::atomic<uint64_t> saturated{0};
+  ProgressBar progress("photos", session.photos.size());
+  // Photos one after another (each renders in parallel): each has its own random stream, seeded from
+  // the session seed and the photo index, so the output does not depend on the thread count.
+  for (size_t i = 0; i < session.photos.size(); ++i) {
+    std::vector<uint8_t> mask;
+    Image image = RenderRadiance(session, i, material, effects.supersample, &mask);
+    // Auto-exposure: the 99th percentile of the brightest channel over the sample's pixels.
+    std::vector<float> levels;
+    for (size_t p = 0; p < mask.size(); ++p) {
+      if (!mask[p]) continue;
+      const float* rgb = &image.pixels[p * 3];
+      const float level = std::max({rgb[0], rgb[1], rgb[2]});
+      if (level > 0.0f) levels.push_back(level);
+    }
+    double reference = 1.0;
+    if (!levels.empty()) {
+      const size_t k = static_cast<size_t>(0.99 * (levels.size() - 1));
+      std::nth_element(levels.begin(), levels.begin() + k, levels.end());
+      reference = levels[k];
+    }
+    PhotoSpec& photo = session.photos[i];
+    photo.exposure_s = options.exposure_target / reference;
+    photo.gain = 1.0;
+
+    std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ull + i);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    const double levels_max = effects.bits > 0 ? std::ldexp(1.0, effects.bits) - 1.0 : 0.0;
+    uint64_t clipped = 0;
+    for (size_t p = 0; p < image.pixels.size() / 3; ++p) {
+      bool pixel_clipped = false;
+      for (int c = 0; c < 3; ++c) {
+        double v = image.pixels[p * 3 + c] * photo.exposure_s * photo.gain;  // linear signal
+        if (effects.shot_noise && v > 0.0) {
+          const double electrons = v * effects.full_well_e;
+          const double noisy = electrons < 1000.0
+                                   ? double(std::poisson_distribution<long>(electrons)(rng))
+                                   : electrons + std::sqrt(electrons) * normal(rng);
+          v = noisy / effects.full_well_e;
+        }
+        if (effects.read_noise) v += effects.read_noise_e / effects.full_well_e * normal(rng);
+        v = std::max(0.0, v + effects.black_level);
+        if (effects.clip && v >= 1.0) {
+          v = 1.0;
+          pixel_clipped = true;
+        }
+        if (effects.srgb) v = LinearToSrgb(v);
+        if (effects.bits > 0) v = std::round(std::min(v, 1.0) * levels_max) / levels_max;
+        image.pixels[p * 3 + c] = static_cast<float>(v);
+      }
+      clipped += pixel_clipped;
+    }
+    saturated += clipped;
+    const PixelFormat format = effects.bits == 0   ? PixelFormat::kFloat
+                               : effects.bits <= 8 ? PixelFormat::kUint8
+                                                   : PixelFormat::kUint16;
+    WriteImage((fs::path(directory.temporary_path()) / photo.file).string(), image, format);
+    progress.Add(1);
+  }
+  progress.Finish();
+
+  session.Save((fs::path(directory.temporary_path()) / "session.json").string());
+  nlohmann::json truth = {
+      {"format", "ibrdf-truth"},
+      {"version", 1},
+      {"material_name", material_name},
+      {"material", material.ToJson()},
+      {"generator",
+       {{"sample", SampleKindName(options.sample)},
+        {"sample_radius", options.sample_radius},
+        {"cylinder_length", options.cylinder_length},
+        {"origin", ToJson(options.origin)},
+        {"light_distance", options.light_distance},
+        {"camera_distance", options.camera_distance},
+        {"camera_elevation_deg", options.camera_elevation_deg},
+        {"num_photos", options.num_photos},
+        {"arc_start_deg", options.arc_start_deg},
+        {"arc_end_deg", options.arc_end_deg},
+        {"width", options.width},
+        {"height", options.height},
+        {"exposure_target", options.exposure_target},
+        {"seed", options.seed},
+        {"effects",
+         {{"shot_noise", effects.shot_noise},
+          {"read_noise", effects.read_noise},
+          {"full_well_e", effects.full_well_e},
+          {"read_noise_e", effects.read_noise_e},
+          {"bits", effects.bits},
+          {"srgb", effects.srgb},
+          {"clip", effects.clip},
+          {"black_level", effects.black_level},
+          {"supersample", effects.supersample}}}}},
+  };
+  WriteJsonFile((fs::path(directory.temporary_path()) / "truth.json").string(), truth);
+  directory.Commit();
+  summary.photos = options.num_photos;
+  summary.saturated_pixels = saturated;
+  summary.total_s = timer.ElapsedSeconds();
+  summary.success = true;
+  return summary;
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,82 @@
+// Synthetic measurement sessions with known truth (COLMAP's scene/synthetic.h in spirit): a forward
+// renderer for the analytic sphere and cylinder under one point light, photographed from camera
+// positions on an arc from beside the light to opposite it (the paper's Figures 3 and 4), with the
+// camera effects of a real sensor that can each be switched off.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "core/brdf_model.h"
+#include "core/image_io.h"
+#include "core/session.h"
+
+namespace ibrdf {
+
+// What the sensor does to the ideal image. Defaults model a 12-bit camera with shot and read noise.
+struct CameraEffects {
+  bool shot_noise = true;        // Poisson photon noise on full_well_e electrons at saturation
+  bool read_noise = true;        // Gaussian read noise of read_noise_e electrons
+  double full_well_e = 20000.0;  // electrons at the saturation level
+  double read_noise_e = 4.0;     // electrons, one sigma
+  int bits = 12;                 // quantization: 8 to 16 (stored as 8- or 16-bit PNG); 0 = float EXR
+  bool srgb = false;             // encode with the sRGB curve before quantization
+  bool clip = true;              // clip at the saturation level (1.0)
+  double black_level = 0.0;      // offset added to the linear signal (normalized units)
+  int supersample = 1;           // n x n rays per pixel, averaged (1 = the pixel centre only)
+
+  // Every effect off: float EXR of the exact pixel-centre radiance (clipping stays on: a real sensor
+  // saturates, and the derenderer rejects what clipped).
+  static CameraEffects None();
+  bool Check(std::string* why) const;
+};
+
+struct SynthOptions {
+  SampleSpec::Kind sample = SampleSpec::Kind::kSphere;
+  double sample_radius = 0.04;     // metres (the paper's spheres were a few centimetres across)
+  double cylinder_length = 0.06;   // metres; the cylinder's axis is vertical (world z)
+  // Scene: the sample at `origin`, the light and cameras in the horizontal plane through it.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // move the whole scene (far-from-origin tests)
+  double light_distance = 1.2;     // metres from the sample centre, along world +x
+  Eigen::Vector3d light_intensity = Eigen::Vector3d(1.0, 1.0, 1.0);  // RGB
+  double camera_distance = 0.8;    // metres from the sample centre
+  double camera_elevation_deg = 0.0;
+  int num_photos = 20;
+  // Camera azimuths from the light direction, evenly spaced: from beside the light to opposite it.
+  double arc_start_deg = 8.0;
+  double arc_end_deg = 172.0;
+  // Camera: OPENCV model with the focal length chosen so the sample spans `frame_fraction` of the
+  // shorter image side.
+  int width = 800;
+  int height = 600;
+  double frame_fraction = 0.7;
+  double k1 = -0.08, k2 = 0.02, p1 = 0.0005, p2 = -0.0003;
+  // Auto-exposure: the 99th percentile of the sample's pixels (brightest channel) lands here.
+  double exposure_target = 0.8;
+  CameraEffects effects;
+  uint64_t seed = 1;
+
+  bool Check(std::string* why) const;
+};
+
+// Renders the ideal (noise-free, unclipped) radiance image of one photo; radiance is 0 off the sample.
+// `hit_mask` (optional) gets 1 where the pixel centre sees the sample.
+Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material,
+                     int supersample, std::vector<uint8_t>* hit_mask);
+
+// Writes a complete session folder: session.json, photos/, and truth.json with the material and the
+// generator options. The folder appears only when complete.
+struct SynthSummary {
+  bool success = false;
+  int photos = 0;
+  uint64_t saturated_pixels = 0;  // pixels with a clipped channel
+  double total_s = 0.0;
+  std::string BriefReport() const;
+};
+SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel& material,
+                                   const std::string& material_name, const std::string& out_dir,
+                                   bool overwrite);
+
+}  // namespace ibrdf
