@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <Eigen/LU>
+
 #include "core/error.h"
 
 namespace ibrdf {
@@ -142,7 +144,7 @@ Eigen::Vector2d Camera::CamPlaneFromImage(const Eigen::Vector2d& pixel) const {
     Eigen::Matrix2d jacobian;
     const Eigen::Vector2d residual = DistortWithJacobian(c, x, &jacobian) - distorted;
     if (residual.squaredNorm() < 1e-30) break;
-    const double det = jacobian.determinant();
+    const double det = jacobian(0, 0) * jacobian(1, 1) - jacobian(0, 1) * jacobian(1, 0);
     if (!(std::abs(det) > 1e-300)) break;
     const Eigen::Vector2d step(( jacobian(1, 1) * residual.x() - jacobian(0, 1) * residual.y()) / det,
                                (-jacobian(1, 0) * residual.x() + jacobian(0, 0) * residual.y()) / det);

@@ -207,8 +207,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   const CameraEffects& effects = options.effects;
   std::atomic<uint64_t> saturated{0};
   ProgressBar progress("photos", session.photos.size());
-  // Photos one after another (each renders in parallel): each has its own random stream, seeded from
-  // the session seed and the photo index, so the output does not depend on the thread count.
+  // Photos one after another; each renders and adds noise in parallel over rows.
   for (size_t i = 0; i < session.photos.size(); ++i) {
     std::vector<uint8_t> mask;
     Image image = RenderRadiance(session, i, material, effects.supersample, &mask);
@@ -230,33 +229,39 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
     photo.exposure_s = options.exposure_target / reference;
     photo.gain = 1.0;
 
-    std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ull + i);
-    std::normal_distribution<double> normal(0.0, 1.0);
     const double levels_max = effects.bits > 0 ? std::ldexp(1.0, effects.bits) - 1.0 : 0.0;
-    uint64_t clipped = 0;
-    for (size_t p = 0; p < image.pixels.size() / 3; ++p) {
-      bool pixel_clipped = false;
-      for (int c = 0; c < 3; ++c) {
-        double v = image.pixels[p * 3 + c] * photo.exposure_s * photo.gain;  // linear signal
-        if (effects.shot_noise && v > 0.0) {
-          const double electrons = v * effects.full_well_e;
-          const double noisy = electrons < 1000.0
-                                   ? double(std::poisson_distribution<long>(electrons)(rng))
-                                   : electrons + std::sqrt(electrons) * normal(rng);
-          v = noisy / effects.full_well_e;
+    std::atomic<uint64_t> clipped{0};
+    // One random stream per row, seeded from the session seed, the photo and the row: the output does
+    // not depend on the thread count.
+    tbb::parallel_for(0, image.height, [&](int y) {
+      std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ull + (uint64_t(i) << 32) + uint64_t(y));
+      std::normal_distribution<double> normal(0.0, 1.0);
+      uint64_t row_clipped = 0;
+      for (int x = 0; x < image.width; ++x) {
+        bool pixel_clipped = false;
+        for (int c = 0; c < 3; ++c) {
+          double v = image.at(x, y, c) * photo.exposure_s * photo.gain;  // linear signal
+          if (effects.shot_noise && v > 0.0) {
+            const double electrons = v * effects.full_well_e;
+            const double noisy = electrons < 1000.0
+                                     ? double(std::poisson_distribution<long>(electrons)(rng))
+                                     : electrons + std::sqrt(electrons) * normal(rng);
+            v = noisy / effects.full_well_e;
+          }
+          if (effects.read_noise) v += effects.read_noise_e / effects.full_well_e * normal(rng);
+          v = std::max(0.0, v + effects.black_level);
+          if (effects.clip && v >= 1.0) {
+            v = 1.0;
+            pixel_clipped = true;
+          }
+          if (effects.srgb) v = LinearToSrgb(v);
+          if (effects.bits > 0) v = std::round(std::min(v, 1.0) * levels_max) / levels_max;
+          image.at(x, y, c) = static_cast<float>(v);
         }
-        if (effects.read_noise) v += effects.read_noise_e / effects.full_well_e * normal(rng);
-        v = std::max(0.0, v + effects.black_level);
-        if (effects.clip && v >= 1.0) {
-          v = 1.0;
-          pixel_clipped = true;
-        }
-        if (effects.srgb) v = LinearToSrgb(v);
-        if (effects.bits > 0) v = std::round(std::min(v, 1.0) * levels_max) / levels_max;
-        image.pixels[p * 3 + c] = static_cast<float>(v);
+        row_clipped += pixel_clipped;
       }
-      clipped += pixel_clipped;
-    }
+      clipped += row_clipped;
+    });
     saturated += clipped;
     const PixelFormat format = effects.bits == 0   ? PixelFormat::kFloat
                                : effects.bits <= 8 ? PixelFormat::kUint8

@@ -36,7 +36,10 @@ struct CameraEffects {
 struct SynthOptions {
   SampleSpec::Kind sample = SampleSpec::Kind::kSphere;
   double sample_radius = 0.04;     // metres (the paper's spheres were a few centimetres across)
-  double cylinder_length = 0.06;   // metres; the cylinder's axis is vertical (world z)
+  // Metres; the axis is vertical (world z), perpendicular to the plane of the light and cameras, so
+  // every sample lies within about atan(length / 2 / camera_distance) of its incidence plane (the
+  // paper's Figure 4: a short measured strip of a cylinder).
+  double cylinder_length = 0.03;
   // Scene: the sample at `origin`, the light and cameras in the horizontal plane through it.
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // move the whole scene (far-from-origin tests)
   double light_distance = 1.2;     // metres from the sample centre, along world +x

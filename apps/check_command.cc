@@ -1,0 +1,43 @@
+// ibrdf check: consistency of measured samples (reciprocity, bilateral symmetry).
+#include <cstdio>
+
+#include "apps/commands.h"
+#include "core/json_reader.h"
+#include "core/logging.h"
+#include "core/sample_file.h"
+#include "reconstruct/consistency.h"
+
+namespace ibrdf {
+
+void AddCheckCommand(CLI::App& app) {
+  auto* command = app.add_subcommand(
+      "check",
+      "Check measured samples for reciprocity, f(ti, te, dphi) = f(te, ti, -dphi), and bilateral\n"
+      "symmetry, f(ti, te, dphi) = f(ti, te, -dphi), binned; writes the per-bin and overall figures as JSON.");
+  struct Args {
+    std::string samples, out;
+    ConsistencyOptions options;
+    bool overwrite = false;
+  };
+  auto args = std::make_shared<Args>();
+  command->add_option("samples", args->samples, "Sample file (.npy) from `ibrdf derender`")->required();
+  command->add_option("--out", args->out, "Report to write (.json)")->required();
+  command->add_option("--theta-bin-deg", args->options.theta_bin_deg, "Bin width in theta_i and theta_e")->capture_default_str();
+  command->add_option("--phi-bin-deg", args->options.phi_bin_deg, "Bin width in delta_phi (divides 360)")->capture_default_str();
+  command->add_option("--min-samples", args->options.min_samples_per_bin, "Samples a bin needs to be compared")->capture_default_str();
+  command->add_option("--max-theta-deg", args->options.max_theta_deg, "Compare bins up to this theta")->capture_default_str();
+  command->add_flag("--overwrite", args->overwrite, "Replace an existing report");
+  command->callback([args] {
+    StageLog stage("check");
+    RequireWritableOutput(args->out, args->overwrite, {args->samples});
+    const std::vector<BrdfSample> samples = ReadSamples(args->samples);
+    const ConsistencyReport report = CheckConsistency(samples, args->options);
+    WriteJsonFile(args->out, ToJson(report, args->options));
+    Log(1, report.BriefReport());
+    if (!report.reciprocity.valid()) Log(1, "warning: no bin pair had enough samples for a reciprocity figure");
+    if (!report.isotropy.valid()) Log(1, "warning: no bin pair had enough samples for an isotropy figure");
+    Log(1, "report written to " + args->out);
+  });
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,53 @@
+// ibrdf: image-based BRDF measurement of scanned objects. One tool, with subcommands like colmap's.
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+
+#include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
+
+#include "apps/commands.h"
+#include "core/error.h"
+#include "core/logging.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "ibrdf: image-based BRDF measurement (after Marschner et al. 1999).\n"
+      "Photograph a curved sample under one small light from many positions; every pixel is a BRDF sample."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "ibrdf 0.1.0");
+  int verbosity = 2;
+  int threads = 0;
+  app.add_flag_callback("-q,--quiet", [&] { verbosity = 1; }, "Stage lines and summaries only, no progress bars");
+  app.add_flag_callback("--silent", [&] { verbosity = 0; }, "Errors only");
+  app.add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+
+  ibrdf::AddSynthCommand(app);
+  ibrdf::AddDerenderCommand(app);
+  ibrdf::AddCheckCommand(app);
+  ibrdf::AddCompareCommand(app);
+
+  std::unique_ptr<tbb::global_control> thread_limit;
+  app.parse_complete_callback([&] {
+    ibrdf::SetVerbosity(verbosity);
+    if (threads > 0) {
+      thread_limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+    }
+  });
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const ibrdf::Error& e) {
+    std::cerr << "ibrdf: error: " << e.what() << std::endl;
+    return 1;
+  } catch (const ibrdf::InternalError& e) {
+    std::cerr << "ibrdf: bug: " << e.what() << " (please report it)" << std::endl;
+    return 70;
+  } catch (const std::exception& e) {
+    std::cerr << "ibrdf: error: " << e.what() << std::endl;
+    return 1;
+  }
+  return 0;
+}

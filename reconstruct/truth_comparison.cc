@@ -1,0 +1,122 @@
+#include "reconstruct/truth_comparison.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "core/json_reader.h"
+
+namespace ibrdf {
+namespace {
+
+struct Accumulator {
+  std::vector<double> abs_rel[3];
+  double sum_rel[3] = {0, 0, 0};
+
+  void Add(const Eigen::Vector3d& rel) {
+    for (int c = 0; c < 3; ++c) {
+      abs_rel[c].push_back(std::abs(rel[c]));
+      sum_rel[c] += rel[c];
+    }
+  }
+  ErrorStats Finish() {
+    ErrorStats stats;
+    stats.count = abs_rel[0].size();
+    if (stats.count == 0) return stats;
+    for (int c = 0; c < 3; ++c) {
+      std::vector<double>& v = abs_rel[c];
+      const size_t mid = v.size() / 2;
+      std::nth_element(v.begin(), v.begin() + mid, v.end());
+      stats.median[c] = v[mid];
+      const size_t k95 = static_cast<size_t>(0.95 * (v.size() - 1) + 0.5);
+      std::nth_element(v.begin(), v.begin() + k95, v.end());
+      stats.p95[c] = v[k95];
+      stats.bias[c] = sum_rel[c] / stats.count;
+    }
+    return stats;
+  }
+};
+
+nlohmann::json StatsJson(const ErrorStats& stats) {
+  auto rgb = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
+  return {{"count", stats.count}, {"median_rel_error", rgb(stats.median)}, {"p95_rel_error", rgb(stats.p95)},
+          {"mean_signed_rel_error", rgb(stats.bias)}};
+}
+
+}  // namespace
+
+TruthComparison CompareWithTruth(const std::vector<BrdfSample>& samples, const BrdfModel& truth,
+                                 const std::vector<double>& band_edges_deg) {
+  IBRDF_CHECK(band_edges_deg.size() >= 2);
+  TruthComparison comparison;
+  Accumulator overall;
+  std::vector<Accumulator> bands(band_edges_deg.size() - 1);
+  for (const BrdfSample& s : samples) {
+    const Eigen::Vector3d wi = Eigen::Vector3d(s.wi[0], s.wi[1], s.wi[2]).normalized();
+    const Eigen::Vector3d wo = Eigen::Vector3d(s.wo[0], s.wo[1], s.wo[2]).normalized();
+    const Eigen::Vector3d f_true = truth.Eval(wi, wo);
+    if (!((f_true.array() > 0.0).all())) {
+      ++comparison.skipped_zero_truth;
+      continue;
+    }
+    const Eigen::Vector3d f(s.brdf[0], s.brdf[1], s.brdf[2]);
+    const Eigen::Vector3d rel = (f - f_true).cwiseQuotient(f_true);
+    overall.Add(rel);
+    const double theta_deg = std::max(s.theta_i, s.theta_e) * 180.0 / M_PI;
+    for (size_t b = 0; b + 1 < band_edges_deg.size(); ++b) {
+      const bool last = b + 2 == band_edges_deg.size();
+      if (theta_deg >= band_edges_deg[b] && (theta_deg < band_edges_deg[b + 1] || (last && theta_deg <= band_edges_deg[b + 1]))) {
+        bands[b].Add(rel);
+        break;
+      }
+    }
+  }
+  comparison.overall = overall.Finish();
+  for (size_t b = 0; b < bands.size(); ++b) {
+    comparison.bands.push_back({band_edges_deg[b], band_edges_deg[b + 1], bands[b].Finish()});
+  }
+  comparison.success = true;
+  return comparison;
+}
+
+std::string TruthComparison::BriefReport() const {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "compare: %zu samples; median relative error R %.3f %%  G %.3f %%  B %.3f %%; p95 R %.2f %%  "
+                "G %.2f %%  B %.2f %%",
+                overall.count, 100 * overall.median[0], 100 * overall.median[1], 100 * overall.median[2],
+                100 * overall.p95[0], 100 * overall.p95[1], 100 * overall.p95[2]);
+  return buffer;
+}
+
+nlohmann::json ToJson(const TruthComparison& comparison) {
+  nlohmann::json bands = nlohmann::json::array();
+  for (const ThetaBand& band : comparison.bands) {
+    nlohmann::json b = StatsJson(band.stats);
+    b["theta_low_deg"] = band.low_deg;
+    b["theta_high_deg"] = band.high_deg;
+    bands.push_back(b);
+  }
+  return {{"format", "ibrdf-truth-comparison"},
+          {"version", 1},
+          {"relative_error", "(f_measured - f_true) / f_true per channel; bands by max(theta_i, theta_e)"},
+          {"overall", StatsJson(comparison.overall)},
+          {"skipped_zero_truth", comparison.skipped_zero_truth},
+          {"bands", bands}};
+}
+
+std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path) {
+  const nlohmann::json json = ReadJsonFile(truth_path);
+  JsonObject root(json, truth_path);
+  if (root.String("format") != "ibrdf-truth") ThrowError(root.Where("format"), "expected \"ibrdf-truth\"");
+  root.Integer("version");
+  root.String("material_name", "");
+  root.Raw("generator");
+  std::unique_ptr<BrdfModel> material = MaterialFromJson(root.Raw("material"), truth_path, "/material");
+  root.Finish();
+  return material;
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,46 @@
+// Measured samples against the true BRDF of a synthetic session: relative error per sample and per
+// colour channel, summarized overall and by theta band (bands of max(theta_i, theta_e), since error
+// grows towards grazing on either side).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/brdf_model.h"
+#include "core/sample_file.h"
+
+namespace ibrdf {
+
+struct ErrorStats {
+  size_t count = 0;
+  Eigen::Vector3d median = Eigen::Vector3d::Zero();  // of |f - f_true| / f_true, per channel
+  Eigen::Vector3d p95 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bias = Eigen::Vector3d::Zero();    // mean of (f - f_true) / f_true: a scale error shows here
+};
+
+struct ThetaBand {
+  double low_deg = 0.0, high_deg = 0.0;
+  ErrorStats stats;
+};
+
+struct TruthComparison {
+  bool success = false;
+  ErrorStats overall;
+  std::vector<ThetaBand> bands;
+  size_t skipped_zero_truth = 0;  // samples where the true BRDF is 0 (no relative error defined)
+  std::string BriefReport() const;
+};
+
+// Band edges in degrees; the default splits 0-20-40-60-70-80-90.
+TruthComparison CompareWithTruth(const std::vector<BrdfSample>& samples, const BrdfModel& truth,
+                                 const std::vector<double>& band_edges_deg = {0, 20, 40, 60, 70, 80, 90});
+
+nlohmann::json ToJson(const TruthComparison& comparison);
+
+// Reads the material of a synthetic session's truth.json.
+std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path);
+
+}  // namespace ibrdf

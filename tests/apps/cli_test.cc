@@ -1,0 +1,208 @@
+// The ibrdf tool as a user meets it: --help on every subcommand, the workflow end to end, and bad input
+// answered with a clear message naming the file and field, a non-zero exit, and nothing written.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <functional>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/image_io.h"
+#include "tests/test_util.h"
+
+namespace ibrdf {
+namespace {
+
+using testing::MaterialPath;
+using testing::ScratchDir;
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+RunResult Run(const std::string& arguments) {
+  const std::string command = std::string(IBRDF_BINARY) + " --silent " + arguments + " 2>&1";
+  RunResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  size_t n;
+  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, n);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+nlohmann::json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+void WriteJson(const std::string& path, const nlohmann::json& json) { std::ofstream(path) << json.dump(2); }
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    session_ = dir_ / "session";
+    const RunResult synth = Run("synth --out " + session_ + " --material " + MaterialPath("lambertian50") +
+                                " --photos 2 --width 96 --height 72");
+    ASSERT_EQ(synth.exit_code, 0) << synth.output;
+    manifest_ = session_ + "/session.json";
+  }
+  // Edits the manifest and returns its path.
+  std::string Edit(const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json json = ReadJson(manifest_);
+    edit(json);
+    WriteJson(manifest_, json);
+    return manifest_;
+  }
+  // A derender that must fail: non-zero exit, the message contains every `expected` piece, and no
+  // output appears.
+  void ExpectDerenderError(const std::vector<std::string>& expected) {
+    const std::string out = dir_ / "samples.npy";
+    const RunResult result = Run("derender " + session_ + " --out " + out);
+    EXPECT_NE(result.exit_code, 0);
+    for (const std::string& piece : expected) {
+      EXPECT_NE(result.output.find(piece), std::string::npos) << "missing \"" << piece << "\" in: " << result.output;
+    }
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_FALSE(fs::exists(out + ".json"));
+  }
+
+  ScratchDir dir_;
+  std::string session_, manifest_;
+};
+
+TEST(Cli, HelpOnEverySubcommand) {
+  const RunResult top = Run("--help");
+  EXPECT_EQ(top.exit_code, 0);
+  for (const std::string command : {"synth", "derender", "check", "compare"}) {
+    EXPECT_NE(top.output.find(command), std::string::npos) << command;
+    const RunResult help = Run(command + " --help");
+    EXPECT_EQ(help.exit_code, 0) << command;
+    EXPECT_NE(help.output.find("--out"), std::string::npos) << command << ": " << help.output;
+  }
+}
+
+TEST(Cli, NoSubcommandOrUnknownOptionFails) {
+  EXPECT_NE(Run("").exit_code, 0);
+  EXPECT_NE(Run("derender --no-such-option x").exit_code, 0);
+}
+
+TEST_F(CliTest, WorkflowEndToEnd) {
+  const std::string samples = dir_ / "samples.npy";
+  RunResult result = Run("derender " + session_ + " --out " + samples);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  ASSERT_TRUE(fs::exists(samples));
+  const nlohmann::json sidecar = ReadJson(samples + ".json");
+  EXPECT_GT(sidecar["counts"]["accepted"].get<int>(), 1000);
+  result = Run("check " + samples + " --out " + (dir_ / "check.json") + " --min-samples 10");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(ReadJson(dir_ / "check.json").contains("reciprocity"));
+  result = Run("compare " + samples + " --out " + (dir_ / "compare.json"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json compare = ReadJson(dir_ / "compare.json");
+  EXPECT_GT(compare["overall"]["count"].get<int>(), 1000);
+  EXPECT_LT(compare["overall"]["median_rel_error"][0].get<double>(), 0.05);
+}
+
+TEST_F(CliTest, UnknownKeyNamesTheField) {
+  Edit([](nlohmann::json& j) { j["light"]["intensty"] = {1, 1, 1}; });
+  ExpectDerenderError({manifest_, "/light/intensty", "unknown key"});
+}
+
+TEST_F(CliTest, UnknownRootKeyNamesTheField) {
+  Edit([](nlohmann::json& j) { j["photoz"] = 1; });
+  ExpectDerenderError({manifest_, "/photoz", "unknown key"});
+}
+
+TEST_F(CliTest, MissingPhotoNamesThePhoto) {
+  fs::remove(session_ + "/photos/001.png");
+  ExpectDerenderError({manifest_, "/photos/1/file", "001.png", "does not exist"});
+}
+
+TEST_F(CliTest, PhotoOfWrongSizeNamesThePhoto) {
+  WriteImage(session_ + "/photos/000.png", Image(50, 40, 3), PixelFormat::kUint16);
+  ExpectDerenderError({"000.png", "50x40", "96x72"});
+}
+
+TEST_F(CliTest, NegativeExposureNamesTheField) {
+  Edit([](nlohmann::json& j) { j["photos"][0]["exposure_s"] = -0.01; });
+  ExpectDerenderError({manifest_, "/photos/0/exposure_s", "positive"});
+}
+
+TEST_F(CliTest, WrongTypeNamesTheField) {
+  Edit([](nlohmann::json& j) { j["sample"]["radius"] = "four centimetres"; });
+  ExpectDerenderError({manifest_, "/sample/radius", "expected a number", "string"});
+}
+
+TEST_F(CliTest, NaNInTheManifestIsAnError) {
+  // JSON has no NaN literal; a manifest that spells one is not JSON, and the line is named.
+  std::string text;
+  {
+    std::ifstream in(manifest_);
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    text = buffer.str();
+  }
+  const size_t at = text.find("\"radius\": ");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, text.find(',', at) - at, "\"radius\": NaN");
+  std::ofstream(manifest_) << text;
+  ExpectDerenderError({manifest_ + ":", "invalid JSON"});
+}
+
+TEST_F(CliTest, WrongPathIsOneClearLine) {
+  const RunResult result = Run("derender " + (dir_ / "nowhere") + " --out " + (dir_ / "x.npy"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("nowhere"), std::string::npos);
+  EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << result.output;
+}
+
+TEST_F(CliTest, NeverOverwritesInputsOrExistingOutputs) {
+  // The manifest as the output: refused, and the manifest is untouched.
+  const std::string before = ReadJson(manifest_).dump();
+  RunResult result = Run("derender " + session_ + " --out " + manifest_ + " --overwrite");
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("input"), std::string::npos) << result.output;
+  EXPECT_EQ(ReadJson(manifest_).dump(), before);
+  // An existing output needs --overwrite.
+  const std::string samples = dir_ / "samples.npy";
+  ASSERT_EQ(Run("derender " + session_ + " --out " + samples).exit_code, 0);
+  result = Run("derender " + session_ + " --out " + samples);
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--overwrite"), std::string::npos) << result.output;
+  EXPECT_EQ(Run("derender " + session_ + " --out " + samples + " --overwrite").exit_code, 0);
+  // synth into an existing folder.
+  result = Run("synth --out " + session_ + " --material " + MaterialPath("lambertian50"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_TRUE(fs::exists(manifest_));
+}
+
+TEST_F(CliTest, CorruptSampleFileIsAnError) {
+  const std::string bad = dir_ / "bad.npy";
+  std::ofstream(bad) << "not a numpy file";
+  const RunResult result = Run("check " + bad + " --out " + (dir_ / "check.json"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("bad.npy"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(dir_ / "check.json"));
+}
+
+TEST_F(CliTest, CompareWithoutTruthSaysSo) {
+  const std::string samples = dir_ / "samples.npy";
+  ASSERT_EQ(Run("derender " + session_ + " --out " + samples).exit_code, 0);
+  fs::remove(session_ + "/truth.json");
+  const RunResult result = Run("compare " + samples);
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("truth.json"), std::string::npos) << result.output;
+}
+
+}  // namespace
+}  // namespace ibrdf

@@ -1,0 +1,1 @@
+// Tests of core/file_util.h (being written).

@@ -1,0 +1,1 @@
+// Tests of core/json_reader.h (being written).

@@ -1,0 +1,71 @@
+// Truth comparison: known relative errors come out as such, per channel and per theta band.
+#include "reconstruct/truth_comparison.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "core/brdf_coords.h"
+#include "core/error.h"
+
+namespace ibrdf {
+namespace {
+
+BrdfSample MakeSample(double theta_i, double theta_e, double delta_phi, const Eigen::Vector3d& f) {
+  Eigen::Vector3d wi, wo;
+  FromIsotropic({theta_i, theta_e, delta_phi}, &wi, &wo);
+  BrdfSample s{};
+  for (int c = 0; c < 3; ++c) {
+    s.wi[c] = float(wi[c]);
+    s.wo[c] = float(wo[c]);
+    s.brdf[c] = float(f[c]);
+  }
+  s.theta_i = float(theta_i);
+  s.theta_e = float(theta_e);
+  s.delta_phi = float(delta_phi);
+  return s;
+}
+
+TEST(TruthComparison, KnownScaleErrorsPerChannel) {
+  const LambertianBrdf truth(Eigen::Vector3d(0.2, 0.4, 0.6));
+  std::vector<BrdfSample> samples;
+  for (int i = 0; i < 100; ++i) {
+    const Eigen::Vector3d f = truth.albedo() / M_PI;
+    samples.push_back(MakeSample(0.01 * i, 0.5, 1.0, f.cwiseProduct(Eigen::Vector3d(1.01, 0.98, 1.0))));
+  }
+  const TruthComparison comparison = CompareWithTruth(samples, truth);
+  ASSERT_EQ(comparison.overall.count, 100u);
+  EXPECT_NEAR(comparison.overall.median[0], 0.01, 1e-6);
+  EXPECT_NEAR(comparison.overall.median[1], 0.02, 1e-6);
+  EXPECT_NEAR(comparison.overall.median[2], 0.0, 1e-6);
+  EXPECT_NEAR(comparison.overall.bias[1], -0.02, 1e-6);
+}
+
+TEST(TruthComparison, BandsByLargerTheta) {
+  const LambertianBrdf truth(Eigen::Vector3d::Constant(0.5));
+  const Eigen::Vector3d exact = truth.albedo() / M_PI;
+  std::vector<BrdfSample> samples = {
+      MakeSample(0.1, 0.1, 0.0, exact),                      // 0-20 band, exact
+      MakeSample(0.1, 75.0 * M_PI / 180.0, 0.0, 1.1 * exact),  // 70-80 band, 10 % high
+  };
+  const TruthComparison comparison = CompareWithTruth(samples, truth);
+  ASSERT_EQ(comparison.bands.size(), 6u);
+  EXPECT_EQ(comparison.bands[0].stats.count, 1u);
+  EXPECT_NEAR(comparison.bands[0].stats.median[0], 0.0, 1e-6);
+  EXPECT_EQ(comparison.bands[4].stats.count, 1u);
+  EXPECT_NEAR(comparison.bands[4].stats.median[0], 0.1, 1e-6);
+}
+
+TEST(TruthComparison, ZeroTruthIsSkippedNotDividedBy) {
+  const LafortuneBrdf truth(Eigen::Vector3d::Zero(), {{Eigen::Vector3d::Constant(-1), Eigen::Vector3d::Constant(1),
+                                                       Eigen::Vector3d::Constant(50)}});
+  // Far from the specular direction this lobe is exactly 0.
+  std::vector<BrdfSample> samples = {MakeSample(0.5, 0.5, 0.0, Eigen::Vector3d::Constant(0.1))};
+  const TruthComparison comparison = CompareWithTruth(samples, truth);
+  EXPECT_EQ(comparison.skipped_zero_truth, 1u);
+  EXPECT_EQ(comparison.overall.count, 0u);
+  EXPECT_TRUE(comparison.overall.median.allFinite());
+}
+
+}  // namespace
+}  // namespace ibrdf
