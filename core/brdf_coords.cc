@@ -15,7 +15,9 @@ LocalFrame LocalFrame::FromNormal(const Eigen::Vector3d& n) {
   return frame;
 }
 
-double PolarAngle(const Eigen::Vector3d& w) { return std::atan2(std::hypot(w.x(), w.y()), w.z()); }
+// sqrt(x^2 + y^2) rather than hypot: directions are unit length, so nothing overflows, and glibc's
+// correctly rounded hypot costs several times more.
+double PolarAngle(const Eigen::Vector3d& w) { return std::atan2(std::sqrt(w.x() * w.x() + w.y() * w.y()), w.z()); }
 
 double Azimuth(const Eigen::Vector3d& w) {
   if (w.x() == 0.0 && w.y() == 0.0) return 0.0;

@@ -27,7 +27,7 @@ struct RunResult {
   std::string output;  // stdout and stderr together
 };
 
-RunResult Run(const std::string& arguments) {
+RunResult RunIbrdf(const std::string& arguments) {
   const std::string command = std::string(IBRDF_BINARY) + " --silent " + arguments + " 2>&1";
   RunResult result;
   FILE* pipe = popen(command.c_str(), "r");
@@ -51,7 +51,7 @@ class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
     session_ = dir_ / "session";
-    const RunResult synth = Run("synth --out " + session_ + " --material " + MaterialPath("lambertian50") +
+    const RunResult synth = RunIbrdf("synth --out " + session_ + " --material " + MaterialPath("lambertian50") +
                                 " --photos 2 --width 96 --height 72");
     ASSERT_EQ(synth.exit_code, 0) << synth.output;
     manifest_ = session_ + "/session.json";
@@ -67,7 +67,7 @@ class CliTest : public ::testing::Test {
   // output appears.
   void ExpectDerenderError(const std::vector<std::string>& expected) {
     const std::string out = dir_ / "samples.npy";
-    const RunResult result = Run("derender " + session_ + " --out " + out);
+    const RunResult result = RunIbrdf("derender " + session_ + " --out " + out);
     EXPECT_NE(result.exit_code, 0);
     for (const std::string& piece : expected) {
       EXPECT_NE(result.output.find(piece), std::string::npos) << "missing \"" << piece << "\" in: " << result.output;
@@ -81,32 +81,32 @@ class CliTest : public ::testing::Test {
 };
 
 TEST(Cli, HelpOnEverySubcommand) {
-  const RunResult top = Run("--help");
+  const RunResult top = RunIbrdf("--help");
   EXPECT_EQ(top.exit_code, 0);
   for (const std::string command : {"synth", "derender", "check", "compare"}) {
     EXPECT_NE(top.output.find(command), std::string::npos) << command;
-    const RunResult help = Run(command + " --help");
+    const RunResult help = RunIbrdf(command + " --help");
     EXPECT_EQ(help.exit_code, 0) << command;
     EXPECT_NE(help.output.find("--out"), std::string::npos) << command << ": " << help.output;
   }
 }
 
 TEST(Cli, NoSubcommandOrUnknownOptionFails) {
-  EXPECT_NE(Run("").exit_code, 0);
-  EXPECT_NE(Run("derender --no-such-option x").exit_code, 0);
+  EXPECT_NE(RunIbrdf("").exit_code, 0);
+  EXPECT_NE(RunIbrdf("derender --no-such-option x").exit_code, 0);
 }
 
 TEST_F(CliTest, WorkflowEndToEnd) {
   const std::string samples = dir_ / "samples.npy";
-  RunResult result = Run("derender " + session_ + " --out " + samples);
+  RunResult result = RunIbrdf("derender " + session_ + " --out " + samples);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   ASSERT_TRUE(fs::exists(samples));
   const nlohmann::json sidecar = ReadJson(samples + ".json");
   EXPECT_GT(sidecar["counts"]["accepted"].get<int>(), 1000);
-  result = Run("check " + samples + " --out " + (dir_ / "check.json") + " --min-samples 10");
+  result = RunIbrdf("check " + samples + " --out " + (dir_ / "check.json") + " --min-samples 10");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_TRUE(ReadJson(dir_ / "check.json").contains("reciprocity"));
-  result = Run("compare " + samples + " --out " + (dir_ / "compare.json"));
+  result = RunIbrdf("compare " + samples + " --out " + (dir_ / "compare.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const nlohmann::json compare = ReadJson(dir_ / "compare.json");
   EXPECT_GT(compare["overall"]["count"].get<int>(), 1000);
@@ -160,7 +160,7 @@ TEST_F(CliTest, NaNInTheManifestIsAnError) {
 }
 
 TEST_F(CliTest, WrongPathIsOneClearLine) {
-  const RunResult result = Run("derender " + (dir_ / "nowhere") + " --out " + (dir_ / "x.npy"));
+  const RunResult result = RunIbrdf("derender " + (dir_ / "nowhere") + " --out " + (dir_ / "x.npy"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("nowhere"), std::string::npos);
   EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << result.output;
@@ -169,19 +169,19 @@ TEST_F(CliTest, WrongPathIsOneClearLine) {
 TEST_F(CliTest, NeverOverwritesInputsOrExistingOutputs) {
   // The manifest as the output: refused, and the manifest is untouched.
   const std::string before = ReadJson(manifest_).dump();
-  RunResult result = Run("derender " + session_ + " --out " + manifest_ + " --overwrite");
+  RunResult result = RunIbrdf("derender " + session_ + " --out " + manifest_ + " --overwrite");
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("input"), std::string::npos) << result.output;
   EXPECT_EQ(ReadJson(manifest_).dump(), before);
   // An existing output needs --overwrite.
   const std::string samples = dir_ / "samples.npy";
-  ASSERT_EQ(Run("derender " + session_ + " --out " + samples).exit_code, 0);
-  result = Run("derender " + session_ + " --out " + samples);
+  ASSERT_EQ(RunIbrdf("derender " + session_ + " --out " + samples).exit_code, 0);
+  result = RunIbrdf("derender " + session_ + " --out " + samples);
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--overwrite"), std::string::npos) << result.output;
-  EXPECT_EQ(Run("derender " + session_ + " --out " + samples + " --overwrite").exit_code, 0);
+  EXPECT_EQ(RunIbrdf("derender " + session_ + " --out " + samples + " --overwrite").exit_code, 0);
   // synth into an existing folder.
-  result = Run("synth --out " + session_ + " --material " + MaterialPath("lambertian50"));
+  result = RunIbrdf("synth --out " + session_ + " --material " + MaterialPath("lambertian50"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_TRUE(fs::exists(manifest_));
 }
@@ -189,7 +189,7 @@ TEST_F(CliTest, NeverOverwritesInputsOrExistingOutputs) {
 TEST_F(CliTest, CorruptSampleFileIsAnError) {
   const std::string bad = dir_ / "bad.npy";
   std::ofstream(bad) << "not a numpy file";
-  const RunResult result = Run("check " + bad + " --out " + (dir_ / "check.json"));
+  const RunResult result = RunIbrdf("check " + bad + " --out " + (dir_ / "check.json"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("bad.npy"), std::string::npos) << result.output;
   EXPECT_FALSE(fs::exists(dir_ / "check.json"));
@@ -197,9 +197,9 @@ TEST_F(CliTest, CorruptSampleFileIsAnError) {
 
 TEST_F(CliTest, CompareWithoutTruthSaysSo) {
   const std::string samples = dir_ / "samples.npy";
-  ASSERT_EQ(Run("derender " + session_ + " --out " + samples).exit_code, 0);
+  ASSERT_EQ(RunIbrdf("derender " + session_ + " --out " + samples).exit_code, 0);
   fs::remove(session_ + "/truth.json");
-  const RunResult result = Run("compare " + samples);
+  const RunResult result = RunIbrdf("compare " + samples);
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("truth.json"), std::string::npos) << result.output;
 }

@@ -1,1 +1,268 @@
-// Tests of core/sample_file.h (being written).
+// Tests of core/sample_file.h: BRDF sample files are NumPy .npy structured arrays that round-trip,
+// that NumPy itself loads (and writes) with the documented dtype, and whose damage is detected.
+#include "core/sample_file.h"
+
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+
+namespace fs = std::filesystem;
+
+namespace ibrdf {
+namespace {
+
+constexpr char kPython[] = "/usr/bin/python3";
+
+// Three rows with distinct, exactly representable values in every field.
+std::vector<BrdfSample> TestSamples() {
+  std::vector<BrdfSample> samples(3);
+  for (size_t r = 0; r < samples.size(); ++r) {
+    BrdfSample& s = samples[r];
+    const float base = static_cast<float>(r);
+    for (int k = 0; k < 3; ++k) {
+      s.wi[k] = base + 0.125f * k;
+      s.wo[k] = -base - 0.25f * k;
+      s.brdf[k] = 0.25f * (k + 1) + base;
+      s.sigma[k] = 0.0625f * (k + 1);
+    }
+    s.theta_i = 0.5f + base;
+    s.theta_e = 0.75f + base;
+    s.delta_phi = -0.5f - base;
+    s.image = static_cast<uint32_t>(7 * r + 1);
+    s.pixel[0] = static_cast<uint32_t>(640 + r);
+    s.pixel[1] = static_cast<uint32_t>(480 + 2 * r);
+  }
+  return samples;
+}
+
+std::string ReadBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void WriteBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+// Replaces `from` by `to` in the header of .npy 1.0 `bytes` and updates the header length field.
+std::string EditHeader(const std::string& bytes, const std::string& from, const std::string& to) {
+  const size_t header_length = static_cast<unsigned char>(bytes[8]) | (static_cast<unsigned char>(bytes[9]) << 8);
+  std::string header = bytes.substr(10, header_length);
+  const size_t at = header.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at == std::string::npos) return bytes;
+  header.replace(at, from.size(), to);
+  std::string edited = bytes.substr(0, 8);
+  edited.push_back(static_cast<char>(header.size() & 0xff));
+  edited.push_back(static_cast<char>(header.size() >> 8));
+  return edited + header + bytes.substr(10 + header_length);
+}
+
+// A fresh folder per test.
+class SampleFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = (fs::path(::testing::TempDir()) /
+            ("ibrdf_sample_file_test_" + std::to_string(::getpid()) + "_" + info->name()))
+               .string();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string Path(const std::string& name) const { return (fs::path(dir_) / name).string(); }
+
+  // Expects ReadSamples to throw an Error naming the file.
+  void ExpectReadError(const std::string& path) const {
+    try {
+      ReadSamples(path);
+      ADD_FAILURE() << "expected an Error reading " << path;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+
+  std::string dir_;
+};
+
+void ExpectSameSamples(const std::vector<BrdfSample>& a, const std::vector<BrdfSample>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(std::memcmp(&a[i], &b[i], sizeof(BrdfSample)), 0) << "row " << i;
+  }
+}
+
+TEST(BrdfSample, LayoutMatchesTheDtype) {
+  EXPECT_EQ(sizeof(BrdfSample), 72u);
+  EXPECT_EQ(offsetof(BrdfSample, theta_i), 24u);
+  EXPECT_EQ(offsetof(BrdfSample, brdf), 36u);
+  EXPECT_EQ(offsetof(BrdfSample, image), 60u);
+  EXPECT_EQ(offsetof(BrdfSample, pixel), 64u);
+}
+
+TEST(SidecarPath, AppendsJson) { EXPECT_EQ(SidecarPath("out/samples.npy"), "out/samples.npy.json"); }
+
+// Every byte of every row survives a write and a read.
+TEST_F(SampleFileTest, RoundTrip) {
+  const std::vector<BrdfSample> samples = TestSamples();
+  WriteSamples(Path("samples.npy"), samples);
+  ExpectSameSamples(ReadSamples(Path("samples.npy")), samples);
+}
+
+TEST_F(SampleFileTest, EmptyRoundTrip) {
+  WriteSamples(Path("empty.npy"), {});
+  EXPECT_TRUE(ReadSamples(Path("empty.npy")).empty());
+}
+
+// The .npy 1.0 layout: magic, version, little-endian header length, a header padded to a multiple of
+// 64 bytes and ending in a newline, holding our dtype and the row count, then exactly the rows.
+TEST_F(SampleFileTest, FileIsNpyVersion1) {
+  WriteSamples(Path("samples.npy"), TestSamples());
+  const std::string bytes = ReadBytes(Path("samples.npy"));
+  ASSERT_GT(bytes.size(), 10u);
+  EXPECT_EQ(bytes.substr(0, 6), std::string("\x93NUMPY"));
+  EXPECT_EQ(bytes[6], 1);
+  EXPECT_EQ(bytes[7], 0);
+  const size_t header_length = static_cast<unsigned char>(bytes[8]) | (static_cast<unsigned char>(bytes[9]) << 8);
+  EXPECT_EQ((10 + header_length) % 64, 0u);
+  ASSERT_EQ(bytes.size(), 10 + header_length + 3 * sizeof(BrdfSample));
+  const std::string header = bytes.substr(10, header_length);
+  EXPECT_EQ(header.back(), '\n');
+  EXPECT_NE(header.find(std::string("'descr': ") + BrdfSampleDtype()), std::string::npos) << header;
+  EXPECT_NE(header.find("'fortran_order': False"), std::string::npos) << header;
+  EXPECT_NE(header.find("'shape': (3,)"), std::string::npos) << header;
+  // Field order of the dtype as documented.
+  const std::string dtype = BrdfSampleDtype();
+  EXPECT_LT(dtype.find("'wi'"), dtype.find("'wo'"));
+  EXPECT_LT(dtype.find("'delta_phi'"), dtype.find("'brdf'"));
+  EXPECT_LT(dtype.find("'image'"), dtype.find("'pixel'"));
+}
+
+// Writing is atomic: only the final file remains.
+TEST_F(SampleFileTest, WriteLeavesNoTemporaryFile) {
+  WriteSamples(Path("samples.npy"), TestSamples());
+  WriteSamples(Path("samples.npy"), {});
+  size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    ++files;
+    EXPECT_EQ(entry.path().filename(), "samples.npy");
+  }
+  EXPECT_EQ(files, 1u);
+}
+
+// A file cut short (a crashed copy) does not hold the rows its header promises.
+TEST_F(SampleFileTest, TruncatedFileIsAnError) {
+  const std::string path = Path("samples.npy");
+  WriteSamples(path, TestSamples());
+  fs::resize_file(path, fs::file_size(path) - 10);
+  ExpectReadError(path);
+  fs::resize_file(path, 40);  // inside the header
+  ExpectReadError(path);
+  fs::resize_file(path, 4);  // inside the magic
+  ExpectReadError(path);
+}
+
+// A header claiming more, or fewer, rows than the data holds.
+TEST_F(SampleFileTest, HeaderLyingAboutRowCountIsAnError) {
+  const std::string path = Path("samples.npy");
+  WriteSamples(path, TestSamples());
+  const std::string bytes = ReadBytes(path);
+  for (const char* lie : {"'shape': (4,)", "'shape': (2,)", "'shape': (30,)"}) {
+    WriteBytes(path, EditHeader(bytes, "'shape': (3,)", lie));
+    ExpectReadError(path);
+  }
+  // The unedited bytes still read (the edit, not the rewrite, is what fails).
+  WriteBytes(path, EditHeader(bytes, "'shape': (3,)", "'shape': (3,)"));
+  EXPECT_EQ(ReadSamples(path).size(), 3u);
+}
+
+// Files that are not ours: another dtype, a 2-D shape, no .npy magic, no file at all.
+TEST_F(SampleFileTest, ForeignFilesAreErrors) {
+  const std::string path = Path("samples.npy");
+  WriteSamples(path, TestSamples());
+  const std::string bytes = ReadBytes(path);
+
+  WriteBytes(path, EditHeader(bytes, "('wi', '<f4'", "('wi', '>f4'"));  // big-endian
+  ExpectReadError(path);
+  WriteBytes(path, EditHeader(bytes, "'fortran_order': False", "'fortran_order': True"));
+  ExpectReadError(path);
+
+  WriteBytes(path, EditHeader(bytes, "'shape': (3,)", "'shape': (3, 1)"));
+  ExpectReadError(path);
+
+  WriteBytes(path, "just some text, not an array");
+  ExpectReadError(path);
+
+  ExpectReadError(Path("absent.npy"));
+}
+
+bool HaveNumpy() {
+  if (!fs::exists(kPython)) return false;
+  return std::system((std::string(kPython) + " -c 'import numpy' > /dev/null 2>&1").c_str()) == 0;
+}
+
+// Runs `script` with /usr/bin/python3, the file path as sys.argv[1]; true when it exits 0.
+bool RunPython(const std::string& script, const std::string& path) {
+  const std::string command = std::string(kPython) + " -c \"" + script + "\" '" + path + "'";
+  return std::system(command.c_str()) == 0;
+}
+
+// NumPy loads the file in one call with the right shape, dtype size and field values.
+TEST_F(SampleFileTest, NumpyLoadsTheFile) {
+  if (!HaveNumpy()) GTEST_SKIP() << kPython << " with numpy is not installed";
+  const std::string path = Path("samples.npy");
+  WriteSamples(path, TestSamples());
+  const std::string script =
+      "import sys, numpy\n"
+      "s = numpy.load(sys.argv[1])\n"
+      "assert s.shape == (3,), s.shape\n"
+      "assert s.dtype.itemsize == 72, s.dtype\n"
+      "assert s['brdf'].shape == (3, 3), s['brdf'].shape\n"
+      "assert s['brdf'][1, 2] == 1.75, s['brdf'][1]\n"
+      "assert s['wi'][2, 1] == 2.125, s['wi'][2]\n"
+      "assert s['delta_phi'][1] == -1.5, s['delta_phi']\n"
+      "assert s['image'][2] == 15, s['image']\n"
+      "assert list(s['pixel'][2]) == [642, 484], s['pixel']\n"
+      "assert s['sigma'][0, 2] == 0.1875, s['sigma'][0]\n";
+  EXPECT_TRUE(RunPython(script, path));
+}
+
+// ReadSamples reads a file that NumPy wrote with the same dtype.
+TEST_F(SampleFileTest, ReadsFileWrittenByNumpy) {
+  if (!HaveNumpy()) GTEST_SKIP() << kPython << " with numpy is not installed";
+  const std::string path = Path("from_numpy.npy");
+  const std::string script =
+      "import sys, numpy\n"
+      "dt = numpy.dtype([('wi', '<f4', (3,)), ('wo', '<f4', (3,)), ('theta_i', '<f4'), "
+      "('theta_e', '<f4'), ('delta_phi', '<f4'), ('brdf', '<f4', (3,)), ('sigma', '<f4', (3,)), "
+      "('image', '<u4'), ('pixel', '<u4', (2,))])\n"
+      "a = numpy.zeros(2, dtype=dt)\n"
+      "a['brdf'][1] = [0.25, 0.5, 0.75]\n"
+      "a['theta_e'][1] = 1.5\n"
+      "a['pixel'][1] = [3, 4]\n"
+      "a['image'][0] = 9\n"
+      "numpy.save(sys.argv[1], a)\n";
+  ASSERT_TRUE(RunPython(script, path));
+  const std::vector<BrdfSample> samples = ReadSamples(path);
+  ASSERT_EQ(samples.size(), 2u);
+  EXPECT_EQ(samples[1].brdf[0], 0.25f);
+  EXPECT_EQ(samples[1].brdf[2], 0.75f);
+  EXPECT_EQ(samples[1].theta_e, 1.5f);
+  EXPECT_EQ(samples[1].pixel[0], 3u);
+  EXPECT_EQ(samples[1].pixel[1], 4u);
+  EXPECT_EQ(samples[0].image, 9u);
+}
+
+}  // namespace
+}  // namespace ibrdf

@@ -59,8 +59,8 @@ TEST(TruthComparison, BandsByLargerTheta) {
 TEST(TruthComparison, ZeroTruthIsSkippedNotDividedBy) {
   const LafortuneBrdf truth(Eigen::Vector3d::Zero(), {{Eigen::Vector3d::Constant(-1), Eigen::Vector3d::Constant(1),
                                                        Eigen::Vector3d::Constant(50)}});
-  // Far from the specular direction this lobe is exactly 0.
-  std::vector<BrdfSample> samples = {MakeSample(0.5, 0.5, 0.0, Eigen::Vector3d::Constant(0.1))};
+  // In the retro-reflection direction at theta = 1 rad the lobe's base cos(2) is negative: f is exactly 0.
+  std::vector<BrdfSample> samples = {MakeSample(1.0, 1.0, 0.0, Eigen::Vector3d::Constant(0.1))};
   const TruthComparison comparison = CompareWithTruth(samples, truth);
   EXPECT_EQ(comparison.skipped_zero_truth, 1u);
   EXPECT_EQ(comparison.overall.count, 0u);
