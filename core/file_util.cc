@@ -71,7 +71,11 @@ void AtomicDirectory::Commit() {
     if (error) ThrowError(final_path_, "cannot move the old folder aside: " + error.message());
   }
   fs::rename(temporary_path_, final_path_, error);
-  if (error) ThrowError(final_path_, "cannot move the finished folder into place: " + error.message());
+  if (error) {
+    std::error_code ignored;
+    if (!old_path.empty()) fs::rename(old_path, final_path_, ignored);  // put the old folder back
+    ThrowError(final_path_, "cannot move the finished folder into place: " + error.message());
+  }
   committed_ = true;
   if (!old_path.empty()) fs::remove_all(old_path, error);
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "core/error.h"
@@ -64,6 +65,7 @@ JsonObject::JsonObject(const nlohmann::json& value, std::string file, std::strin
 bool JsonObject::Has(const std::string& key) const { return value_->contains(key); }
 
 std::string JsonObject::Where(const std::string& key) const {
+  if (key.empty()) return file_ + ": " + (pointer_.empty() ? "/" : pointer_);
   return file_ + ": " + pointer_ + "/" + key;
 }
 
@@ -89,6 +91,11 @@ double JsonObject::Number(const std::string& key) {
 int JsonObject::Integer(const std::string& key) {
   const nlohmann::json& v = Field(key);
   if (!v.is_number_integer()) TypeError(key, "an integer");
+  const bool out_of_range = v.is_number_unsigned()
+                                ? v.get<uint64_t>() > uint64_t(std::numeric_limits<int>::max())
+                                : (v.get<int64_t>() < std::numeric_limits<int>::min() ||
+                                   v.get<int64_t>() > std::numeric_limits<int>::max());
+  if (out_of_range) ThrowError(Where(key), "integer out of range, got " + v.dump());
   return v.get<int>();
 }
 
@@ -122,7 +129,8 @@ std::vector<double> JsonObject::Numbers(const std::string& key) {
 
 Eigen::Vector3d JsonObject::Vector3(const std::string& key) {
   const nlohmann::json& v = Field(key);
-  if (!v.is_array() || v.size() != 3) TypeError(key, "an array of 3 numbers");
+  if (!v.is_array()) TypeError(key, "an array of 3 numbers");
+  if (v.size() != 3) ThrowError(Where(key), "expected an array of 3 numbers, got " + std::to_string(v.size()));
   const std::vector<double> numbers = Numbers(key);
   return {numbers[0], numbers[1], numbers[2]};
 }
@@ -146,15 +154,19 @@ std::vector<JsonObject> JsonObject::Objects(const std::string& key) {
 const nlohmann::json& JsonObject::Raw(const std::string& key) { return Field(key); }
 
 double JsonObject::Number(const std::string& key, double fallback) {
+  read_.insert(key);  // an accepted key, listed in unknown-key messages even when absent
   return Has(key) ? Number(key) : fallback;
 }
 int JsonObject::Integer(const std::string& key, int fallback) {
+  read_.insert(key);  // an accepted key, listed in unknown-key messages even when absent
   return Has(key) ? Integer(key) : fallback;
 }
 bool JsonObject::Boolean(const std::string& key, bool fallback) {
+  read_.insert(key);  // an accepted key, listed in unknown-key messages even when absent
   return Has(key) ? Boolean(key) : fallback;
 }
 std::string JsonObject::String(const std::string& key, const std::string& fallback) {
+  read_.insert(key);  // an accepted key, listed in unknown-key messages even when absent
   return Has(key) ? String(key) : fallback;
 }
 

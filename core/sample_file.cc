@@ -3,6 +3,7 @@
 #include <cstring>
 #include <fstream>
 #include <regex>
+#include <stdexcept>
 
 #include "core/error.h"
 #include "core/file_util.h"
@@ -86,14 +87,19 @@ std::vector<BrdfSample> ReadSamples(const std::string& path) {
   if (!std::regex_search(header, match, std::regex("'shape': \\((\\d+),\\)"))) {
     ThrowError(path, "sample files are one-dimensional arrays; header: " + header);
   }
-  const size_t rows = std::stoull(match[1].str());
+  size_t rows = 0;
+  try {
+    rows = std::stoull(match[1].str());
+  } catch (const std::out_of_range&) {
+    ThrowError(path, "the header's row count " + match[1].str() + " is too large");
+  }
   const std::streampos data_start = in.tellg();
   in.seekg(0, std::ios::end);
   const size_t available = static_cast<size_t>(in.tellg() - data_start);
-  if (available != rows * sizeof(BrdfSample)) {
-    ThrowError(path, "the header says " + std::to_string(rows) + " rows (" +
-                         std::to_string(rows * sizeof(BrdfSample)) + " bytes) but the file holds " +
-                         std::to_string(available) + " bytes of data");
+  // Divide rather than multiply: a lying header's row count could overflow the product.
+  if (available % sizeof(BrdfSample) != 0 || available / sizeof(BrdfSample) != rows) {
+    ThrowError(path, "the header says " + std::to_string(rows) + " rows of " + std::to_string(sizeof(BrdfSample)) +
+                         " bytes but the file holds " + std::to_string(available) + " bytes of data");
   }
   in.seekg(data_start);
   std::vector<BrdfSample> samples(rows);

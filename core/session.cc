@@ -206,7 +206,7 @@ Session Session::Load(const std::string& path) {
                                           " (this ibrdf reads version " + std::to_string(kVersion) + ")");
   }
   session.name = root.String("name", fs::path(session.directory).filename().string());
-  root.String("description", "");
+  session.description = root.String("description", "");
   session.camera = ParseCamera(root.Object("camera"));
   session.light = ParseLight(root.Object("light"));
   session.sample = ParseSample(root.Object("sample"));
@@ -224,6 +224,7 @@ nlohmann::json Session::ToJson() const {
   json["format"] = kFormat;
   json["version"] = kVersion;
   json["name"] = name;
+  if (!description.empty()) json["description"] = description;
   json["camera"] = {{"model", CameraModelName(camera.model)},
                     {"width", camera.width},
                     {"height", camera.height},

@@ -51,6 +51,7 @@ struct PhotoSpec {
 
 struct Session {
   std::string name;
+  std::string description;    // free text, optional
   std::string directory;      // folder holding the manifest; relative paths resolve against it
   std::string manifest_path;  // the manifest file
   Camera camera;

@@ -2,9 +2,11 @@
 // constant) and the strict reading of material JSON.
 #include "core/brdf_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -16,6 +18,7 @@
 
 #include "core/brdf_coords.h"
 #include "core/error.h"
+#include "tests/scratch_dir.h"
 
 namespace ibrdf {
 namespace {
@@ -326,8 +329,8 @@ TEST(MaterialFromJson, ErrorsCarryThePointerPrefix) {
 
 // LoadMaterial reads a file; its errors name the file.
 TEST(LoadMaterial, ReadsFileAndNamesItInErrors) {
-  const std::string dir = ::testing::TempDir() + "/brdf_model_test_" + std::to_string(::getpid());
-  std::filesystem::create_directories(dir);
+  const testing::ScratchDir scratch;
+  const std::string dir = scratch.str();
   const std::string good = dir + "/bluepaint.json", bad = dir + "/bad.json";
   std::ofstream(good) << BluepaintJson().dump(2);
   json broken = BluepaintJson();

@@ -1,6 +1,7 @@
 // Tests of core/camera.h: the COLMAP camera models, their validation, projection and its inverse.
 #include "core/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "tests/scratch_dir.h"
 
 namespace fs = std::filesystem;
 
@@ -30,14 +31,9 @@ std::string ReadText(const std::string& path) {
 class FileUtilTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = (fs::path(::testing::TempDir()) /
-            ("ibrdf_file_util_test_" + std::to_string(::getpid()) + "_" + info->name()))
-               .string();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = scratch_.str();
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  testing::ScratchDir scratch_;
 
   std::string Path(const std::string& name) const { return (fs::path(dir_) / name).string(); }
 

@@ -1,6 +1,7 @@
 // Tests of core/rigid3.h: rigid transforms and the look-at camera pose.
 #include "core/rigid3.h"
 
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>

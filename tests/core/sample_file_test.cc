@@ -10,12 +10,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "tests/scratch_dir.h"
 
 namespace fs = std::filesystem;
 
@@ -73,14 +75,9 @@ std::string EditHeader(const std::string& bytes, const std::string& from, const 
 class SampleFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = (fs::path(::testing::TempDir()) /
-            ("ibrdf_sample_file_test_" + std::to_string(::getpid()) + "_" + info->name()))
-               .string();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = scratch_.str();
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  testing::ScratchDir scratch_;
   std::string Path(const std::string& name) const { return (fs::path(dir_) / name).string(); }
 
   // Expects ReadSamples to throw an Error naming the file.
@@ -90,6 +87,8 @@ class SampleFileTest : public ::testing::Test {
       ADD_FAILURE() << "expected an Error reading " << path;
     } catch (const Error& e) {
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "expected an ibrdf::Error reading " << path << ", got: " << e.what();
     }
   }
 
@@ -185,6 +184,18 @@ TEST_F(SampleFileTest, HeaderLyingAboutRowCountIsAnError) {
   // The unedited bytes still read (the edit, not the rewrite, is what fails).
   WriteBytes(path, EditHeader(bytes, "'shape': (3,)", "'shape': (3,)"));
   EXPECT_EQ(ReadSamples(path).size(), 3u);
+}
+
+// Row counts whose byte size overflows: (2^61 + 3) * 72 wraps modulo 2^64 to exactly the 216 bytes
+// present, and a 25-digit count does not fit 64 bits. Both must be an Error, not an allocation failure.
+TEST_F(SampleFileTest, HugeRowCountIsAnError) {
+  const std::string path = Path("samples.npy");
+  WriteSamples(path, TestSamples());
+  const std::string bytes = ReadBytes(path);
+  for (const char* lie : {"'shape': (2305843009213693955,)", "'shape': (9999999999999999999999999,)"}) {
+    WriteBytes(path, EditHeader(bytes, "'shape': (3,)", lie));
+    ExpectReadError(path);
+  }
 }
 
 // Files that are not ours: another dtype, a 2-D shape, no .npy magic, no file at all.

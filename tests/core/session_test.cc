@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "tests/scratch_dir.h"
 
 namespace fs = std::filesystem;
 
@@ -50,18 +51,14 @@ json ValidManifest() {
 class SessionTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = (fs::path(::testing::TempDir()) /
-            ("ibrdf_session_test_" + std::to_string(::getpid()) + "_" + info->name()))
-               .string();
-    fs::remove_all(dir_);
+    dir_ = scratch_.str();
     fs::create_directories(fs::path(dir_) / "photos");
     Image photo(kWidth, kHeight, 3);
     for (size_t i = 0; i < photo.pixels.size(); ++i) photo.pixels[i] = float(i % 7) / 7.0f;
     WriteImage(Path("photos/img0.png"), photo, PixelFormat::kUint8);
     WriteImage(Path("photos/img1.png"), photo, PixelFormat::kUint8);
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  testing::ScratchDir scratch_;
 
   std::string Path(const std::string& name) const { return (fs::path(dir_) / name).string(); }
   std::string ManifestPath() const { return Path("session.json"); }
