@@ -30,6 +30,13 @@ SynthOptions NoiseFree(SampleSpec::Kind kind = SampleSpec::Kind::kSphere) {
   return options;
 }
 
+// A noise-free session of a Lambertian sphere of albedo 0.5 with `photos` photos.
+Session LambertianSession(const ScratchDir& dir, int photos, SynthOptions options = NoiseFree()) {
+  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
+  options.num_photos = photos;
+  return Session::Load(MakeSession(dir / "s", options, material));
+}
+
 TEST(Derender, DefaultOptionsAreValid) {
   std::string why;
   EXPECT_TRUE(DerenderOptions().Check(&why)) << why;
@@ -184,10 +191,7 @@ TEST(Derender, SaturatedPixelsAreRejectedAndCounted) {
 
 TEST(Derender, StrideAndGrazingLimitsReduceSamples) {
   ScratchDir dir;
-  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
-  SynthOptions options = NoiseFree();
-  options.num_photos = 3;
-  const Session session = Session::Load(MakeSession(dir / "s", options, material));
+  const Session session = LambertianSession(dir, 3);
   const size_t all = DerenderAnalytic(session, DerenderOptions()).samples.size();
   DerenderOptions strided;
   strided.pixel_stride = 2;
@@ -205,10 +209,7 @@ TEST(Derender, StrideAndGrazingLimitsReduceSamples) {
 
 TEST(Derender, LightBehindEverySurfaceGivesNoSamples) {
   ScratchDir dir;
-  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
-  SynthOptions options = NoiseFree();
-  options.num_photos = 2;
-  Session session = Session::Load(MakeSession(dir / "s", options, material));
+  Session session = LambertianSession(dir, 2);
   // Put the light inside the sphere: it is behind every surface point.
   session.light.position = session.sample.center + Eigen::Vector3d(0.001, 0, 0);
   const DerenderResult result = DerenderAnalytic(session, DerenderOptions());
@@ -218,20 +219,14 @@ TEST(Derender, LightBehindEverySurfaceGivesNoSamples) {
 
 TEST(Derender, CameraInsideSampleIsAnError) {
   ScratchDir dir;
-  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
-  SynthOptions options = NoiseFree();
-  options.num_photos = 1;
-  Session session = Session::Load(MakeSession(dir / "s", options, material));
+  Session session = LambertianSession(dir, 1);
   session.sample.radius = 2.0;  // swallows the camera
   EXPECT_THROW(DerenderAnalytic(session, DerenderOptions()), Error);
 }
 
 TEST(Derender, PhotoWithoutPoseIsAnError) {
   ScratchDir dir;
-  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
-  SynthOptions options = NoiseFree();
-  options.num_photos = 1;
-  Session session = Session::Load(MakeSession(dir / "s", options, material));
+  Session session = LambertianSession(dir, 1);
   session.photos[0].camera_from_world.reset();
   try {
     DerenderAnalytic(session, DerenderOptions());
@@ -244,10 +239,7 @@ TEST(Derender, PhotoWithoutPoseIsAnError) {
 
 TEST(Derender, NonFinitePixelsAreRejectedNotPropagated) {
   ScratchDir dir;
-  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
-  SynthOptions options = NoiseFree();
-  options.num_photos = 1;
-  const Session session = Session::Load(MakeSession(dir / "s", options, material));
+  const Session session = LambertianSession(dir, 1);
   // Poison the centre of the photo with NaN.
   Image image = ReadImage(session.PhotoPath(0));
   for (int y = image.height / 2 - 5; y < image.height / 2 + 5; ++y) {
@@ -261,10 +253,7 @@ TEST(Derender, NonFinitePixelsAreRejectedNotPropagated) {
 
 TEST(Derender, SidecarHasUnitsCountsAndSession) {
   ScratchDir dir;
-  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
-  SynthOptions options = NoiseFree();
-  options.num_photos = 1;
-  const Session session = Session::Load(MakeSession(dir / "s", options, material));
+  const Session session = LambertianSession(dir, 1);
   const DerenderOptions derender_options;
   const DerenderResult result = DerenderAnalytic(session, derender_options);
   const nlohmann::json sidecar = DerenderSidecar(session, derender_options, result.summary);

@@ -1,6 +1,7 @@
 // The synthetic session generator: reproducible, loadable, and physically placed as in the paper.
 #include "derender/synthetic.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -95,6 +96,45 @@ TEST(Synth, AutoExposurePutsThe99thPercentileAtTheTarget) {
   std::sort(lit.begin(), lit.end());
   ASSERT_FALSE(lit.empty());
   EXPECT_NEAR(lit[size_t(0.99 * (lit.size() - 1))], options.exposure_target, 0.02);
+}
+
+// Supersampling averages n x n rays over the pixel: inside the disc it matches the centre ray of a
+// smooth (Lambertian) image closely, and pixels on the silhouette get partial coverage.
+TEST(Synth, SupersamplingAveragesOverThePixel) {
+  ScratchDir dir;
+  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
+  SynthOptions options;
+  options.effects = CameraEffects::None();
+  options.num_photos = 1;
+  options.width = 200;
+  options.height = 150;
+  const Session session = Session::Load(MakeSession(dir / "s", options, material));
+  std::vector<uint8_t> mask;
+  const Image centre = RenderRadiance(session, 0, material, 1, &mask);
+  const Image averaged = RenderRadiance(session, 0, material, 4, nullptr);
+  double peak = 0.0;
+  for (float v : centre.pixels) peak = std::max(peak, double(v));
+  int interior = 0, partial = 0;
+  std::vector<double> ratios;
+  for (int y = 1; y + 1 < centre.height; ++y) {
+    for (int x = 1; x + 1 < centre.width; ++x) {
+      const bool all_hit = mask[y * centre.width + x] && mask[y * centre.width + x - 1] &&
+                           mask[y * centre.width + x + 1] && mask[(y - 1) * centre.width + x] &&
+                           mask[(y + 1) * centre.width + x];
+      const double a = centre.at(x, y, 0), b = averaged.at(x, y, 0);
+      if (all_hit && a > 0.2 * peak) {
+        ++interior;
+        ratios.push_back(b / a);
+        // Second-order shading change across a (large) pixel: small, largest where the normal turns fast.
+        EXPECT_NEAR(b / a, 1.0, 0.02) << x << "," << y;
+      }
+      if (!mask[y * centre.width + x] && b > 0.0) ++partial;  // centre misses, some sub-rays hit
+    }
+  }
+  EXPECT_GT(interior, 1000);
+  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+  EXPECT_NEAR(ratios[ratios.size() / 2], 1.0, 0.001);
+  EXPECT_GT(partial, 10);
 }
 
 TEST(Synth, ExistingOutputIsNotReplacedWithoutOverwrite) {
