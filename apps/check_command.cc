@@ -9,6 +9,7 @@
 
 namespace ibrdf {
 
+namespace {
 void AddCheckCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "check",
@@ -39,5 +40,9 @@ void AddCheckCommand(CLI::App& app) {
     Log(1, "report written to " + args->out);
   });
 }
+
+}  // namespace
+
+IBRDF_REGISTER_COMMAND(60, AddCheckCommand);
 
 }  // namespace ibrdf

@@ -1,18 +1,32 @@
-// The subcommands of the ibrdf tool. Each Add*Command registers its options on the CLI11 app and sets
-// the callback that runs it; library code never sees argv.
+// The subcommands of the ibrdf tool. Each subcommand lives in its own apps/<name>_command.cc and
+// registers itself with IBRDF_REGISTER_COMMAND; main() adds them in `order`. Library code never sees
+// argv.
 #pragma once
+
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 namespace ibrdf {
 
-void AddSynthCommand(CLI::App& app);
-void AddDerenderCommand(CLI::App& app);
-void AddCheckCommand(CLI::App& app);
-void AddCompareCommand(CLI::App& app);
+using AddCommandFunction = void (*)(CLI::App& app);
+
+// Registers a subcommand at static-initialization time; `order` sets its place in --help (the
+// workflow's order: synth 10, scan 20, align 30, derender 40, reconstruct 50, check 60, report 70,
+// run 80, compare 90).
+struct CommandRegistrar {
+  CommandRegistrar(int order, AddCommandFunction add);
+};
+
+// The registered subcommands, sorted by order.
+std::vector<AddCommandFunction> RegisteredCommands();
 
 // Throws Error unless `output` may be written: it must not be one of the stage's inputs, and an
 // existing file is replaced only with --overwrite.
 void RequireWritableOutput(const std::string& output, bool overwrite, const std::vector<std::string>& inputs);
 
 }  // namespace ibrdf
+
+#define IBRDF_REGISTER_COMMAND(order, function) \
+  static const ::ibrdf::CommandRegistrar function##_registrar(order, &function)

@@ -47,6 +47,7 @@ void PrintTable(const TruthComparison& comparison) {
 
 }  // namespace
 
+namespace {
 void AddCompareCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "compare",
@@ -78,5 +79,9 @@ void AddCompareCommand(CLI::App& app) {
     Log(1, comparison.BriefReport());
   });
 }
+
+}  // namespace
+
+IBRDF_REGISTER_COMMAND(90, AddCompareCommand);
 
 }  // namespace ibrdf

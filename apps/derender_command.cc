@@ -8,6 +8,7 @@
 
 namespace ibrdf {
 
+namespace {
 void AddDerenderCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "derender",
@@ -43,5 +44,9 @@ void AddDerenderCommand(CLI::App& app) {
     Log(1, "samples written to " + args->out);
   });
 }
+
+}  // namespace
+
+IBRDF_REGISTER_COMMAND(40, AddDerenderCommand);
 
 }  // namespace ibrdf

@@ -22,10 +22,7 @@ int main(int argc, char** argv) {
   app.add_flag_callback("--silent", [&] { verbosity = 0; }, "Errors only");
   app.add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
 
-  ibrdf::AddSynthCommand(app);
-  ibrdf::AddDerenderCommand(app);
-  ibrdf::AddCheckCommand(app);
-  ibrdf::AddCompareCommand(app);
+  for (ibrdf::AddCommandFunction add : ibrdf::RegisteredCommands()) add(app);
 
   std::unique_ptr<tbb::global_control> thread_limit;
   app.parse_complete_callback([&] {

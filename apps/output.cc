@@ -1,10 +1,29 @@
+#include <algorithm>
 #include <filesystem>
+#include <utility>
 
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/file_util.h"
 
 namespace ibrdf {
+namespace {
+std::vector<std::pair<int, AddCommandFunction>>& Registry() {
+  static std::vector<std::pair<int, AddCommandFunction>> registry;
+  return registry;
+}
+}  // namespace
+
+CommandRegistrar::CommandRegistrar(int order, AddCommandFunction add) { Registry().emplace_back(order, add); }
+
+std::vector<AddCommandFunction> RegisteredCommands() {
+  std::vector<std::pair<int, AddCommandFunction>> sorted = Registry();
+  std::stable_sort(sorted.begin(), sorted.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<AddCommandFunction> out;
+  for (const auto& entry : sorted) out.push_back(entry.second);
+  return out;
+}
 
 void RequireWritableOutput(const std::string& output, bool overwrite, const std::vector<std::string>& inputs) {
   for (const std::string& input : inputs) {

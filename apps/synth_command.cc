@@ -9,6 +9,7 @@
 
 namespace ibrdf {
 
+namespace {
 void AddSynthCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "synth",
@@ -83,5 +84,9 @@ void AddSynthCommand(CLI::App& app) {
     Log(1, "session written to " + args->out + "/session.json (truth in " + args->out + "/truth.json)");
   });
 }
+
+}  // namespace
+
+IBRDF_REGISTER_COMMAND(10, AddSynthCommand);
 
 }  // namespace ibrdf
