@@ -20,8 +20,9 @@ void AddSynthCommand(CLI::App& app) {
     SynthOptions options;
     int bits = -1, supersample = -1;
     double black_level = -1, full_well = -1, read_noise = -1;
-    bool srgb = false, no_shot = false, no_read = false, no_clip = false, overwrite = false;
+    bool srgb = false, no_shot = false, no_read = false, no_clip = false, overwrite = false, targets = false;
     std::vector<double> origin, intensity;
+    size_t elevation_given = 0;
   };
   auto args = std::make_shared<Args>();
   SynthOptions& o = args->options;
@@ -34,7 +35,7 @@ void AddSynthCommand(CLI::App& app) {
   command->add_option("--arc-start-deg", o.arc_start_deg, "First camera azimuth from the light direction")->capture_default_str();
   command->add_option("--arc-end-deg", o.arc_end_deg, "Last camera azimuth from the light direction")->capture_default_str();
   command->add_option("--camera-distance", o.camera_distance, "Metres from the sample centre")->capture_default_str();
-  command->add_option("--camera-elevation-deg", o.camera_elevation_deg, "Camera elevation above the light's plane")->capture_default_str();
+  auto* elevation = command->add_option("--camera-elevation-deg", o.camera_elevation_deg, "Camera elevation above the light's plane")->capture_default_str();
   command->add_option("--light-distance", o.light_distance, "Metres from the sample centre")->capture_default_str();
   command->add_option("--light-intensity", args->intensity, "RGB intensity of the point light")->expected(3);
   command->add_option("--width", o.width, "Image width, pixels")->capture_default_str();
@@ -54,8 +55,13 @@ void AddSynthCommand(CLI::App& app) {
   command->add_option("--supersample", args->supersample, "n x n rays per pixel");
   command->add_option("--exposure-target", o.exposure_target, "Auto-exposure: 99th percentile lands here")->capture_default_str();
   command->add_option("--seed", o.seed, "Random seed (output is reproducible)")->capture_default_str();
+  command->add_flag("--targets", args->targets,
+                    "Put the sample on a platform with a ring of ArUco markers of known layout (for `ibrdf align`);\n"
+                    "cameras then look down from 45 degrees unless --camera-elevation-deg says otherwise");
+  command->add_option("--target-dictionary", o.target_dictionary, "ArUco dictionary of the markers")->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace an existing output folder");
-  command->callback([args] {
+  command->callback([args, elevation] {
+    args->elevation_given = elevation->count();
     SynthOptions options = args->options;
     options.sample = args->sample == "cylinder" ? SampleSpec::Kind::kCylinder : SampleSpec::Kind::kSphere;
     options.effects = args->effects == "none" ? CameraEffects::None() : CameraEffects();
@@ -71,6 +77,10 @@ void AddSynthCommand(CLI::App& app) {
     if (args->no_clip) {
       if (e.bits != 0) ThrowError("--no-clip", "unclipped values need float output (--bits 0)");
       e.clip = false;
+    }
+    if (args->targets) {
+      options.targets = true;
+      if (args->elevation_given == 0) options.camera_elevation_deg = 45.0;
     }
     if (!args->origin.empty()) options.origin = Eigen::Vector3d(args->origin[0], args->origin[1], args->origin[2]);
     if (!args->intensity.empty()) {

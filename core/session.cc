@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
@@ -174,6 +175,36 @@ PhotoSpec ParsePhoto(JsonObject object, const std::string& directory) {
   return photo;
 }
 
+TargetsSpec ParseTargets(JsonObject object) {
+  TargetsSpec targets;
+  targets.dictionary = object.String("dictionary");
+  std::set<int> seen;
+  for (JsonObject& marker : object.Objects("reference")) {
+    TargetSpec target;
+    target.id = marker.Integer("id");
+    if (target.id < 0) ThrowError(marker.Where("id"), "marker ids are non-negative");
+    if (!seen.insert(target.id).second) {
+      ThrowError(marker.Where("id"), "marker id " + std::to_string(target.id) + " is listed twice");
+    }
+    const nlohmann::json& corners = marker.Raw("corners");
+    if (!corners.is_array() || corners.size() != 4) {
+      ThrowError(marker.Where("corners"), "expected 4 corners [[x, y, z] x 4] (top-left, top-right, bottom-right, bottom-left)");
+    }
+    for (int k = 0; k < 4; ++k) {
+      const nlohmann::json& c = corners[k];
+      if (!c.is_array() || c.size() != 3 || !c[0].is_number() || !c[1].is_number() || !c[2].is_number()) {
+        ThrowError(marker.Where("corners") + "/" + std::to_string(k), "expected [x, y, z]");
+      }
+      target.corners[k] = Eigen::Vector3d(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
+      if (!target.corners[k].allFinite()) ThrowError(marker.Where("corners") + "/" + std::to_string(k), "expected finite numbers");
+    }
+    marker.Finish();
+    targets.reference.push_back(target);
+  }
+  object.Finish();
+  return targets;
+}
+
 nlohmann::json PoseToJson(const Rigid3d& pose) {
   const Eigen::Quaterniond& q = pose.rotation;
   return {{"rotation", {q.w(), q.x(), q.y(), q.z()}}, {"translation", ToJson(pose.translation)}};
@@ -211,6 +242,7 @@ Session Session::Load(const std::string& path) {
   session.light = ParseLight(root.Object("light"));
   session.sample = ParseSample(root.Object("sample"));
   if (root.Has("radiometry")) session.radiometry = ParseRadiometry(root.Object("radiometry"));
+  if (root.Has("targets")) session.targets = ParseTargets(root.Object("targets"));
   for (JsonObject& photo : root.Objects("photos")) {
     session.photos.push_back(ParsePhoto(photo, session.directory));
   }
@@ -260,6 +292,15 @@ nlohmann::json Session::ToJson() const {
     r["noise"] = {{"full_well_e", radiometry.noise->full_well_e},
                   {"read_noise_e", radiometry.noise->read_noise_e},
                   {"bits", radiometry.noise->bits}};
+  }
+  if (targets) {
+    nlohmann::json reference = nlohmann::json::array();
+    for (const TargetSpec& target : targets->reference) {
+      nlohmann::json corners = nlohmann::json::array();
+      for (const Eigen::Vector3d& c : target.corners) corners.push_back(ibrdf::ToJson(c));
+      reference.push_back({{"id", target.id}, {"corners", corners}});
+    }
+    json["targets"] = {{"dictionary", targets->dictionary}, {"reference", reference}};
   }
   json["photos"] = nlohmann::json::array();
   for (const PhotoSpec& photo : photos) {

@@ -3,6 +3,7 @@
 // docs/session-format.md; lengths are metres, angles radians unless a key says _deg.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,6 +43,19 @@ struct SampleSpec {
   std::string mesh_file;                             // mesh: path relative to the session folder
 };
 
+// Coded targets (ArUco markers) seen in the photos. Reference markers have a known layout: their four
+// corners in the world frame, in OpenCV's order (top-left, top-right, bottom-right, bottom-left of the
+// print). The world frame of an aligned session is the reference structure's.
+struct TargetSpec {
+  int id = -1;
+  std::array<Eigen::Vector3d, 4> corners;  // metres, world frame
+};
+
+struct TargetsSpec {
+  std::string dictionary;              // OpenCV predefined dictionary name, e.g. "DICT_4X4_50"
+  std::vector<TargetSpec> reference;   // markers with known layout
+};
+
 struct PhotoSpec {
   std::string file;          // relative to the session folder
   double exposure_s = 1.0;   // exposure time, seconds
@@ -59,6 +73,7 @@ struct Session {
   SampleSpec sample;
   RadiometrySpec radiometry;
   std::vector<PhotoSpec> photos;
+  std::optional<TargetsSpec> targets;
 
   // Reads and validates a manifest (a session.json path, or a folder holding session.json). Unknown
   // keys, missing fields, wrong types, missing photo files and impossible values are Errors naming the

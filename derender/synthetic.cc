@@ -17,6 +17,7 @@
 #include "core/light.h"
 #include "core/logging.h"
 #include "core/radiometry.h"
+#include "align/markers.h"
 #include "derender/analytic_sample.h"
 
 namespace fs = std::filesystem;
@@ -42,7 +43,8 @@ Session BuildSession(const SynthOptions& options) {
   session.light.position = options.origin + options.light_distance * Eigen::Vector3d::UnitX();
   session.light.intensity = options.light_intensity;
 
-  const double half_angle = std::asin(std::min(1.0, bounding_radius / options.camera_distance));
+  const double framed_radius = options.targets ? std::max(bounding_radius, options.platform_radius) : bounding_radius;
+  const double half_angle = std::asin(std::min(1.0, framed_radius / options.camera_distance));
   const double focal = options.frame_fraction * 0.5 * std::min(options.width, options.height) / std::tan(half_angle);
   session.camera = Camera::Create(CameraModelId::kOpenCV, options.width, options.height,
                                   {focal, focal, 0.5 * options.width, 0.5 * options.height, options.k1,
@@ -63,6 +65,13 @@ Session BuildSession(const SynthOptions& options) {
     session.radiometry.noise = noise;
   }
 
+  if (options.targets) {
+    TargetsSpec targets;
+    targets.dictionary = options.target_dictionary;
+    targets.reference = TargetLayout(options);
+    session.targets = targets;
+  }
+
   const double elevation = options.camera_elevation_deg * kDegree;
   for (int i = 0; i < options.num_photos; ++i) {
     const double t = options.num_photos == 1 ? 0.0 : double(i) / (options.num_photos - 1);
@@ -80,7 +89,121 @@ Session BuildSession(const SynthOptions& options) {
   return session;
 }
 
+// The platform plane's height: the sample rests on it.
+double PlatformHeight(const SynthOptions& options) {
+  const double below = options.sample == SampleSpec::Kind::kCylinder ? 0.5 * options.cylinder_length : options.sample_radius;
+  return options.origin.z() - below;
+}
+
+// The platform: dark, with the markers of TargetLayout printed on white cards.
+class PlatformTexture {
+ public:
+  explicit PlatformTexture(const SynthOptions& options)
+      : options_(options), dictionary_(options.target_dictionary, "synth --target-dictionary"),
+        layout_(TargetLayout(options)), height_(PlatformHeight(options)) {
+    for (const TargetSpec& target : layout_) modules_.push_back(dictionary_.Modules(target.id));
+  }
+  // The value in [black, white] at a point on the platform plane; < 0 off the platform.
+  double At(const Eigen::Vector3d& p) const {
+    const Eigen::Vector2d offset(p.x() - options_.origin.x(), p.y() - options_.origin.y());
+    if (offset.norm() > options_.platform_radius) return -1.0;
+    const int n = dictionary_.modules();
+    for (size_t m = 0; m < layout_.size(); ++m) {
+      // Marker axes from its corners: x along top-left -> top-right, y along top-left -> bottom-left.
+      const std::array<Eigen::Vector3d, 4>& c = layout_[m].corners;
+      const Eigen::Vector3d x_axis = c[1] - c[0], y_axis = c[3] - c[0];
+      const double u = (p - c[0]).dot(x_axis) / x_axis.squaredNorm();
+      const double v = (p - c[0]).dot(y_axis) / y_axis.squaredNorm();
+      const double margin = options_.card_margin;
+      if (u < -margin || u >= 1.0 + margin || v < -margin || v >= 1.0 + margin) continue;
+      if (u < 0.0 || u >= 1.0 || v < 0.0 || v >= 1.0) return options_.target_white;  // the card's border
+      const int col = std::min(n - 1, int(u * n)), row = std::min(n - 1, int(v * n));
+      return modules_[m][size_t(row) * n + col] ? options_.target_white : options_.target_black;
+    }
+    return options_.target_black;  // the dark platform
+  }
+  double height() const { return height_; }
+
+ private:
+  const SynthOptions& options_;
+  MarkerDictionary dictionary_;
+  std::vector<TargetSpec> layout_;
+  std::vector<std::vector<bool>> modules_;
+  double height_;
+};
+
+// Composites the platform into a photo's linear signal where the pixel centre misses the sample:
+// 4 x 4 rays per pixel, the platform's fraction of them averaged (sharp, anti-aliased marker edges).
+void CompositePlatform(const Session& session, size_t photo_index, const PlatformTexture& platform,
+                       const std::vector<uint8_t>& sample_mask, Image* signal) {
+  const Camera& camera = session.camera;
+  const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
+  const Rigid3d world_from_camera = session.photos[photo_index].camera_from_world->Inverse();
+  const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
+  const Eigen::Vector3d center = world_from_camera.translation;
+  // The platform's value along a ray through an image point; 0 where it shows nothing (or the sample
+  // is in front).
+  auto value_at = [&](const Eigen::Vector2d& pixel) {
+    const Eigen::Vector2d xy = camera.CamPlaneFromImage(pixel);
+    const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+    if (!(direction.z() < 0.0)) return 0.0;
+    const double t = (platform.height() - center.z()) / direction.z();
+    if (!(t > 0.0)) return 0.0;
+    SurfaceHit hit;
+    if (sample->Intersect(center, direction, &hit) && hit.t < t) return 0.0;
+    return std::max(0.0, platform.At(center + t * direction));
+  };
+  // Values at the pixel corners; a pixel whose four corners agree is uniform (one value), the others
+  // (edges) are averaged over 4 x 4 rays.
+  const int w = camera.width, h = camera.height;
+  std::vector<double> corners(size_t(w + 1) * (h + 1));
+  tbb::parallel_for(0, h + 1, [&](int y) {
+    for (int x = 0; x <= w; ++x) corners[size_t(y) * (w + 1) + x] = value_at(Eigen::Vector2d(x, y));
+  });
+  constexpr int kRays = 4;
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      if (sample_mask[size_t(y) * w + x]) continue;
+      const double c00 = corners[size_t(y) * (w + 1) + x], c10 = corners[size_t(y) * (w + 1) + x + 1];
+      const double c01 = corners[size_t(y + 1) * (w + 1) + x], c11 = corners[size_t(y + 1) * (w + 1) + x + 1];
+      double value = c00;
+      if (c00 != c10 || c00 != c01 || c00 != c11) {
+        double sum = 0.0;
+        for (int sy = 0; sy < kRays; ++sy) {
+          for (int sx = 0; sx < kRays; ++sx) {
+            sum += value_at(Eigen::Vector2d(x + (sx + 0.5) / kRays, y + (sy + 0.5) / kRays));
+          }
+        }
+        value = sum / (kRays * kRays);
+      }
+      if (value > 0.0) {
+        for (int c = 0; c < 3; ++c) signal->at(x, y, c) += static_cast<float>(value);
+      }
+    }
+  });
+}
+
 }  // namespace
+
+std::vector<TargetSpec> TargetLayout(const SynthOptions& options) {
+  std::vector<TargetSpec> layout;
+  if (!options.targets) return layout;
+  const double z = PlatformHeight(options);
+  const double half = 0.5 * options.target_size;
+  // Printed upright for a viewer above: x east, y south, so x cross y points down into the platform.
+  const Eigen::Vector3d x_axis = Eigen::Vector3d::UnitX(), y_axis = -Eigen::Vector3d::UnitY();
+  for (int k = 0; k < options.target_count; ++k) {
+    const double angle = 2.0 * M_PI * (k + 0.5) / options.target_count;
+    const Eigen::Vector3d center = Eigen::Vector3d(options.origin.x(), options.origin.y(), z) +
+                                   options.target_ring_radius * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
+    TargetSpec target;
+    target.id = k;
+    target.corners = {center - half * x_axis - half * y_axis, center + half * x_axis - half * y_axis,
+                      center + half * x_axis + half * y_axis, center - half * x_axis + half * y_axis};
+    layout.push_back(target);
+  }
+  return layout;
+}
 
 CameraEffects CameraEffects::None() {
   CameraEffects effects;
@@ -143,6 +266,16 @@ bool SynthOptions::Check(std::string* why) const {
   if ((light_intensity.array() < 0.0).any() || !(light_intensity.maxCoeff() > 0.0)) {
     *why = "light_intensity must be non-negative and not all zero";
     return false;
+  }
+  if (targets) {
+    if (target_count < 1 || !(target_size > 0.0) || !(platform_radius > target_ring_radius + target_size)) {
+      *why = "targets: need at least one marker, a positive size, and a platform wider than the ring";
+      return false;
+    }
+    if (!(target_white > target_black && target_black >= 0.0 && target_white <= 1.0)) {
+      *why = "targets: need 0 <= target_black < target_white <= 1";
+      return false;
+    }
   }
   return effects.Check(why);
 }
@@ -207,6 +340,8 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   const CameraEffects& effects = options.effects;
   std::atomic<uint64_t> saturated{0};
   ProgressBar progress("photos", session.photos.size());
+  std::unique_ptr<PlatformTexture> platform;
+  if (options.targets) platform = std::make_unique<PlatformTexture>(options);
   // Photos one after another; each renders and adds noise in parallel over rows.
   for (size_t i = 0; i < session.photos.size(); ++i) {
     std::vector<uint8_t> mask;
@@ -229,6 +364,9 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
     photo.exposure_s = options.exposure_target / reference;
     photo.gain = 1.0;
 
+    // Radiance to linear signal, then the platform (its values are already signal).
+    for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
+    if (platform) CompositePlatform(session, i, *platform, mask, &image);
     const double levels_max = effects.bits > 0 ? std::ldexp(1.0, effects.bits) - 1.0 : 0.0;
     std::atomic<uint64_t> clipped{0};
     // One random stream per row, seeded from the session seed, the photo and the row: the output does
@@ -240,7 +378,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
       for (int x = 0; x < image.width; ++x) {
         bool pixel_clipped = false;
         for (int c = 0; c < 3; ++c) {
-          double v = image.at(x, y, c) * photo.exposure_s * photo.gain;  // linear signal
+          double v = image.at(x, y, c);  // linear signal
           if (effects.shot_noise && v > 0.0) {
             const double electrons = v * effects.full_well_e;
             const double noisy = electrons < 1000.0
@@ -292,6 +430,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
         {"height", options.height},
         {"exposure_target", options.exposure_target},
         {"seed", options.seed},
+        {"targets", options.targets},
         {"effects",
          {{"shot_noise", effects.shot_noise},
           {"read_noise", effects.read_noise},

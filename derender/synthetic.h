@@ -61,6 +61,21 @@ struct SynthOptions {
   CameraEffects effects;
   uint64_t seed = 1;
 
+  // Coded targets (the align stage's input): a dark platform under the sample carrying a ring of ArUco
+  // markers of known layout, each printed on a white card, lit by the room's ambient light so that every
+  // photo can read them. The dark platform keeps the sphere's silhouette against black. The
+  // frame then holds the platform (target_frame_radius), and cameras should look down on it
+  // (camera_elevation_deg > 0).
+  bool targets = false;
+  std::string target_dictionary = "DICT_4X4_50";
+  int target_count = 12;            // markers on the ring, ids 0 .. target_count - 1
+  double target_size = 0.028;       // metres, printed side of a marker (border included)
+  double target_ring_radius = 0.1;  // metres, sample axis to marker centres
+  double platform_radius = 0.135;   // metres
+  double card_margin = 0.25;        // white card border around each marker, in marker sides
+  double target_white = 0.55;       // the cards' white as a fraction of full scale
+  double target_black = 0.02;       // printed black and the platform, the same way
+
   bool Check(std::string* why) const;
 };
 
@@ -68,6 +83,9 @@ struct SynthOptions {
 // `hit_mask` (optional) gets 1 where the pixel centre sees the sample.
 Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material,
                      int supersample, std::vector<uint8_t>* hit_mask);
+
+// The reference markers' corners of a target session (empty when options.targets is off).
+std::vector<TargetSpec> TargetLayout(const SynthOptions& options);
 
 // Writes a complete session folder: session.json, photos/, and truth.json with the material and the
 // generator options. The folder appears only when complete.

@@ -1,0 +1,414 @@
+#include "align/aligner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <tbb/parallel_for.h>
+
+#include "align/cost_functions/reprojection_error.h"
+#include "align/cost_functions/sphere_tangent_error.h"
+#include "align/markers.h"
+#include "core/error.h"
+#include "core/image_io.h"
+#include "core/json_reader.h"
+#include "core/logging.h"
+
+namespace ibrdf {
+namespace {
+
+// fx, fy, cx, cy, k1, k2, p1, p2 of any supported model.
+std::array<double, 8> OpenCvIntrinsics(const Camera& camera) {
+  std::array<double, 8> k = {camera.FocalX(), camera.FocalY(), camera.PrincipalX(), camera.PrincipalY(), 0, 0, 0, 0};
+  const std::vector<double>& p = camera.params;
+  switch (camera.model) {
+    case CameraModelId::kSimpleRadial: k[4] = p[3]; break;
+    case CameraModelId::kRadial: k[4] = p[3]; k[5] = p[4]; break;
+    case CameraModelId::kOpenCV: k[4] = p[4]; k[5] = p[5]; k[6] = p[6]; k[7] = p[7]; break;
+    default: break;
+  }
+  return k;
+}
+
+struct Observation {
+  int marker_id;
+  int corner;
+  Eigen::Vector2d pixel;
+};
+
+// Bilinear sample of the luminance at a continuous pixel position (centres at +0.5).
+double Luminance(const Image& image, double px, double py) {
+  const double x = px - 0.5, y = py - 0.5;
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= image.width || y0 + 1 >= image.height) return -1.0;
+  const double fx = x - x0, fy = y - y0;
+  auto lum = [&](int xi, int yi) {
+    if (image.channels < 3) return double(image.at(xi, yi, 0));
+    return 0.2126 * image.at(xi, yi, 0) + 0.7152 * image.at(xi, yi, 1) + 0.0722 * image.at(xi, yi, 2);
+  };
+  return (1 - fx) * (1 - fy) * lum(x0, y0) + fx * (1 - fy) * lum(x0 + 1, y0) + (1 - fx) * fy * lum(x0, y0 + 1) +
+         fx * fy * lum(x0 + 1, y0 + 1);
+}
+
+// Silhouette edge points of a sphere in one photo: along radial lines from the sphere's projected
+// centre, the sharpest drop from a lit limb to the dark background, located at sub-pixel precision
+// where the profile crosses the mid level. Edges against anything bright (the platform) or on the
+// unlit side (no contrast) are skipped.
+std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& camera, const Rigid3d& camera_from_world,
+                                              const Eigen::Vector3d& center, double radius, int lines, double band_px) {
+  std::vector<Eigen::Vector2d> points;
+  const Eigen::Vector3d c = camera_from_world * center;
+  if (!(c.z() > radius)) return points;
+  const Eigen::Vector2d center_px = camera.ImageFromCamera(c);
+  const double radius_px = camera.FocalX() * radius / std::sqrt(c.squaredNorm() - radius * radius);
+  const double step = 0.25;
+  for (int k = 0; k < lines; ++k) {
+    const double angle = 2.0 * M_PI * k / lines;
+    const Eigen::Vector2d direction(std::cos(angle), std::sin(angle));
+    // Search the band around the predicted silhouette, with room for the inside and outside levels.
+    const double s0 = radius_px - band_px - 3.0, s1 = radius_px + band_px + 3.0;
+    std::vector<double> profile;
+    for (double s = s0; s <= s1; s += step) profile.push_back(Luminance(image, center_px.x() + s * direction.x(), center_px.y() + s * direction.y()));
+    if (std::any_of(profile.begin(), profile.end(), [](double v) { return v < 0.0; })) continue;
+    // The sharpest drop over one pixel.
+    const int span = static_cast<int>(1.0 / step);
+    int best = -1;
+    double best_drop = 0.0;
+    for (size_t i = 0; i + span < profile.size(); ++i) {
+      const double drop = profile[i] - profile[i + span];
+      if (drop > best_drop) {
+        best_drop = drop;
+        best = static_cast<int>(i);
+      }
+    }
+    const int guard = static_cast<int>(2.0 / step);
+    if (best < guard || best + span + guard >= static_cast<int>(profile.size())) continue;
+    const double inside = profile[best - guard + span / 2];
+    const double outside = profile[best + span + guard];
+    if (!(inside > 0.03) || !(outside < 0.1 * inside)) continue;
+    // A rise before the edge means something brighter than the limb lies just beyond it (a white card
+    // behind the sphere): the drop found is that thing's edge, not the limb. Skip the line.
+    bool rises = false;
+    for (int i = 0; i + span <= best && !rises; ++i) rises = profile[i + span] - profile[i] > 0.25 * inside;
+    if (rises) continue;
+    // Sub-pixel: the crossing of the mid level between the two ends of the steepest drop (the limb
+    // pixel and the first background pixel); the level further inside may differ from the limb's.
+    const double mid = 0.5 * (profile[best] + profile[best + span]);
+    double edge = -1.0;
+    for (int i = best - guard; i < best + span + guard; ++i) {
+      if (profile[i] >= mid && profile[i + 1] < mid) {
+        edge = s0 + step * (i + (profile[i] - mid) / (profile[i] - profile[i + 1]));
+        break;
+      }
+    }
+    if (edge < 0.0) continue;
+    points.push_back(center_px + edge * direction);
+  }
+  return points;
+}
+
+}  // namespace
+
+bool AlignOptions::Check(std::string* why) const {
+  if (min_markers_per_image < 1 || !(max_image_rms_px > 0.0) || !(huber_px > 0.0) || silhouette_lines < 8) {
+    *why = "min_markers_per_image >= 1, max_image_rms_px > 0, huber_px > 0, silhouette_lines >= 8";
+    return false;
+  }
+  return true;
+}
+
+AlignResult AlignSession(const Session& session, const AlignOptions& options) {
+  Timer timer;
+  std::string why;
+  if (!options.Check(&why)) ThrowError("align options", why);
+  if (!session.targets || session.targets->reference.empty()) {
+    ThrowError(session.manifest_path + ": /targets", "align needs reference markers of known layout");
+  }
+  const MarkerDictionary dictionary(session.targets->dictionary, session.manifest_path + ": /targets/dictionary");
+  std::map<int, const TargetSpec*> reference;
+  for (const TargetSpec& target : session.targets->reference) {
+    if (target.id >= dictionary.size()) {
+      ThrowError(session.manifest_path + ": /targets/reference", "marker id " + std::to_string(target.id) +
+                                                                    " is not in " + dictionary.name());
+    }
+    reference[target.id] = &target;
+  }
+  session.CheckPhotos();
+  const Camera& camera = session.camera;
+  const std::array<double, 8> intrinsics = OpenCvIntrinsics(camera);
+  const cv::Mat camera_matrix = (cv::Mat_<double>(3, 3) << intrinsics[0], 0, intrinsics[2] - 0.5, 0, intrinsics[1],
+                                 intrinsics[3] - 0.5, 0, 0, 1);
+  const cv::Mat distortion = (cv::Mat_<double>(1, 4) << intrinsics[4], intrinsics[5], intrinsics[6], intrinsics[7]);
+
+  AlignResult result;
+  result.images.resize(session.photos.size());
+  std::vector<std::vector<Observation>> observations(session.photos.size());
+  std::vector<Image> images(session.photos.size());
+  ProgressBar progress("detect", session.photos.size());
+  tbb::parallel_for(size_t(0), session.photos.size(), [&](size_t i) {
+    ImageAlignment& alignment = result.images[i];
+    alignment.photo = i;
+    images[i] = ReadImage(session.PhotoPath(i));
+    // Linearize, so detection sees the same contrast whatever the file's response.
+    Image linear = images[i];
+    for (float& v : linear.pixels) {
+      v = static_cast<float>(std::max(0.0, session.radiometry.response.ToLinear(v) - session.radiometry.black_level));
+    }
+    images[i] = linear;
+    std::map<int, int> seen;
+    std::vector<MarkerDetection> detections = DetectMarkers(linear, dictionary);
+    RefineMarkerCorners(linear, camera, &detections);
+    for (const MarkerDetection& d : detections) ++seen[d.id];
+    for (const MarkerDetection& d : detections) {
+      if (!reference.count(d.id) || seen[d.id] > 1) {
+        ++alignment.ignored_markers;
+        continue;
+      }
+      ++alignment.markers;
+      for (int k = 0; k < 4; ++k) observations[i].push_back({d.id, k, d.corners[k]});
+    }
+    progress.Add(1);
+  });
+  progress.Finish();
+
+  // Per photo: PnP for a start, then Ceres with a robust loss on every corner.
+  std::map<int, std::pair<int, double>> marker_sums;  // id -> (observations, sum of squared residuals)
+  double all_squared = 0.0;
+  size_t all_count = 0;
+  for (size_t i = 0; i < session.photos.size(); ++i) {
+    ImageAlignment& alignment = result.images[i];
+    if (alignment.markers < options.min_markers_per_image) {
+      alignment.dropped_reason = "only " + std::to_string(alignment.markers) + " reference markers seen (need " +
+                                 std::to_string(options.min_markers_per_image) + ")";
+      continue;
+    }
+    std::vector<cv::Point3d> object;
+    std::vector<cv::Point2d> pixels;
+    for (const Observation& o : observations[i]) {
+      const Eigen::Vector3d& p = reference.at(o.marker_id)->corners[o.corner];
+      object.emplace_back(p.x(), p.y(), p.z());
+      pixels.emplace_back(o.pixel.x() - 0.5, o.pixel.y() - 0.5);  // OpenCV's pixel centres
+    }
+    cv::Mat rvec, tvec;
+    if (!cv::solvePnP(object, pixels, camera_matrix, distortion, rvec, tvec, false, cv::SOLVEPNP_SQPNP)) {
+      alignment.dropped_reason = "no pose from the markers (PnP failed)";
+      continue;
+    }
+    double rotation[3] = {rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)};
+    double translation[3] = {tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)};
+    std::vector<std::array<double, 3>> points;
+    for (const Observation& o : observations[i]) {
+      const Eigen::Vector3d& p = reference.at(o.marker_id)->corners[o.corner];
+      points.push_back({p.x(), p.y(), p.z()});
+    }
+    // Two solves: the second without corners beyond 3 robust sigmas (at least 0.5 px) of the first,
+    // which are corners of markers partly hidden (by the sample) or cut by the frame.
+    std::vector<bool> inlier(observations[i].size(), true);
+    ceres::Solver::Summary summary;
+    for (int solve = 0; solve < 2; ++solve) {
+      ceres::Problem problem;
+      for (size_t o = 0; o < observations[i].size(); ++o) {
+        if (!inlier[o]) continue;
+        problem.AddResidualBlock(ReprojectionError::Create(intrinsics, observations[i][o].pixel.x(), observations[i][o].pixel.y()),
+                                 new ceres::HuberLoss(options.huber_px), rotation, translation, points[o].data());
+        problem.SetParameterBlockConstant(points[o].data());  // the layout is known: gauge and scale fixed
+      }
+      ceres::Solver::Options solver_options;
+      solver_options.linear_solver_type = ceres::DENSE_QR;
+      solver_options.max_num_iterations = 100;
+      solver_options.function_tolerance = 1e-12;
+      solver_options.parameter_tolerance = 1e-12;
+      ceres::Solve(solver_options, &problem, &summary);
+      if (!summary.IsSolutionUsable() || solve == 1) break;
+      std::vector<double> norms;
+      for (size_t o = 0; o < observations[i].size(); ++o) {
+        double residual[2];
+        ReprojectionError(intrinsics, observations[i][o].pixel.x(), observations[i][o].pixel.y())(
+            rotation, translation, points[o].data(), residual);
+        norms.push_back(std::hypot(residual[0], residual[1]));
+      }
+      std::vector<double> sorted = norms;
+      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+      const double limit = std::max(0.5, 3.0 * 1.4826 * sorted[sorted.size() / 2]);
+      for (size_t o = 0; o < norms.size(); ++o) {
+        inlier[o] = norms[o] <= limit;
+        alignment.outlier_corners += !inlier[o];
+      }
+    }
+    if (!summary.IsSolutionUsable()) {
+      alignment.dropped_reason = "pose refinement failed: " + summary.message;
+      continue;
+    }
+    // Residuals, per photo and per marker.
+    double squared = 0.0;
+    size_t inliers = 0;
+    for (size_t o = 0; o < observations[i].size(); ++o) {
+      if (!inlier[o]) continue;
+      ++inliers;
+      double residual[2];
+      ReprojectionError(intrinsics, observations[i][o].pixel.x(), observations[i][o].pixel.y())(
+          rotation, translation, points[o].data(), residual);
+      const double r2 = residual[0] * residual[0] + residual[1] * residual[1];
+      squared += r2;
+      auto& sums = marker_sums[observations[i][o].marker_id];
+      ++sums.first;
+      sums.second += r2;
+    }
+    alignment.rms_px = std::sqrt(squared / inliers);
+    double matrix[9];
+    ceres::AngleAxisToRotationMatrix(rotation, matrix);  // column-major
+    Eigen::Matrix3d r;
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col) r(row, col) = matrix[col * 3 + row];
+    }
+    alignment.camera_from_world = Rigid3d(Eigen::Quaterniond(r), Eigen::Vector3d(translation[0], translation[1], translation[2]));
+    if (alignment.rms_px > options.max_image_rms_px) {
+      alignment.dropped_reason = "reprojection RMS " + std::to_string(alignment.rms_px) + " px above " +
+                                 std::to_string(options.max_image_rms_px);
+      continue;
+    }
+    alignment.used = true;
+    all_squared += squared;
+    all_count += inliers;
+  }
+  for (const auto& [id, sums] : marker_sums) {
+    result.markers.push_back({id, sums.first / 4, std::sqrt(sums.second / sums.first)});
+  }
+  result.rms_px = all_count ? std::sqrt(all_squared / all_count) : 0.0;
+
+  // The aligned session: used photos with their poses.
+  result.session = session;
+  result.session.photos.clear();
+  for (size_t i = 0; i < session.photos.size(); ++i) {
+    if (!result.images[i].used) continue;
+    PhotoSpec photo = session.photos[i];
+    photo.camera_from_world = result.images[i].camera_from_world;
+    result.session.photos.push_back(photo);
+  }
+  if (result.session.photos.empty()) ThrowError(session.manifest_path, "no photo could be aligned (see the reasons above)");
+
+  // The sphere from its silhouettes: rays through sub-pixel limb points are tangent to it. Three
+  // rounds, each extracting limb points in a band around the current estimate's silhouette (wide, then
+  // narrow) and fitting with a Cauchy loss, so edges of other things (a card behind the limb) do not
+  // pull the fit; the last round drops points beyond 3 RMS and refits.
+  if (options.fit_sphere && session.sample.kind == SampleSpec::Kind::kSphere) {
+    double center[3] = {session.sample.center.x(), session.sample.center.y(), session.sample.center.z()};
+    double radius = session.sample.radius;
+    SphereFit& fit = result.sphere;
+    const double bands_px[] = {0.15, 3.0, 1.5};  // the first as a fraction of the radius
+    for (int round = 0; round < 3; ++round) {
+      std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> rays;  // origin, direction
+      const Eigen::Vector3d current(center[0], center[1], center[2]);
+      for (size_t i = 0; i < session.photos.size(); ++i) {
+        if (!result.images[i].used) continue;
+        const Rigid3d& pose = result.images[i].camera_from_world;
+        const Rigid3d world_from_camera = pose.Inverse();
+        const Eigen::Vector3d c = pose * current;
+        const double radius_px = camera.FocalX() * radius / std::sqrt(std::max(c.squaredNorm() - radius * radius, 1e-12));
+        const double band = round == 0 ? bands_px[0] * radius_px : bands_px[round];
+        for (const Eigen::Vector2d& p : SilhouettePoints(images[i], camera, pose, current, radius, options.silhouette_lines, band)) {
+          const Eigen::Vector2d xy = camera.CamPlaneFromImage(p);
+          rays.emplace_back(world_from_camera.translation,
+                            world_from_camera.rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0).normalized());
+        }
+      }
+      if (rays.size() < 8) break;
+      std::vector<bool> keep(rays.size(), true);
+      for (int pass = 0; pass < (round == 2 ? 2 : 1); ++pass) {
+        ceres::Problem problem;
+        for (size_t k = 0; k < rays.size(); ++k) {
+          if (!keep[k]) continue;
+          problem.AddResidualBlock(SphereTangentError::Create(rays[k].first, rays[k].second),
+                                   new ceres::CauchyLoss(2e-4), center, &radius);
+        }
+        problem.SetParameterLowerBound(&radius, 0, 1e-6);
+        ceres::Solver::Options solver_options;
+        solver_options.linear_solver_type = ceres::DENSE_QR;
+        solver_options.max_num_iterations = 100;
+        solver_options.function_tolerance = 1e-15;
+        solver_options.parameter_tolerance = 1e-15;
+        ceres::Solver::Summary summary;
+        ceres::Solve(solver_options, &problem, &summary);
+        std::vector<double> residuals(rays.size());
+        double squared = 0.0;
+        int count = 0;
+        for (size_t k = 0; k < rays.size(); ++k) {
+          SphereTangentError(rays[k].first, rays[k].second)(center, &radius, &residuals[k]);
+          if (keep[k]) {
+            squared += residuals[k] * residuals[k];
+            ++count;
+          }
+        }
+        fit.rms_m = std::sqrt(squared / std::max(count, 1));
+        fit.silhouette_points = count;
+        fit.rejected_points = static_cast<int>(rays.size()) - count;
+        if (pass == 0 && round == 2) {
+          for (size_t k = 0; k < rays.size(); ++k) keep[k] = std::abs(residuals[k]) <= 3.0 * fit.rms_m;
+        }
+      }
+    }
+    if (fit.silhouette_points >= 8) {
+      fit.fitted = true;
+      fit.center = Eigen::Vector3d(center[0], center[1], center[2]);
+      fit.radius = radius;
+      result.session.sample.center = fit.center;
+      result.session.sample.radius = fit.radius;
+    }
+  }
+  result.total_s = timer.ElapsedSeconds();
+  result.success = true;
+  return result;
+}
+
+std::string AlignResult::BriefReport() const {
+  int used = 0;
+  for (const ImageAlignment& image : images) used += image.used;
+  char buffer[320];
+  std::snprintf(buffer, sizeof(buffer), "align: %d of %zu photos posed, corner RMS %.3f px, %zu markers; ", used,
+                images.size(), rms_px, markers.size());
+  std::string report = buffer;
+  if (sphere.fitted) {
+    std::snprintf(buffer, sizeof(buffer), "sphere centre (%.5f, %.5f, %.5f) m, radius %.5f m from %d silhouette points (RMS %.3f mm, %d rejected)",
+                  sphere.center.x(), sphere.center.y(), sphere.center.z(), sphere.radius, sphere.silhouette_points,
+                  1e3 * sphere.rms_m, sphere.rejected_points);
+    report += buffer;
+  } else {
+    report += "sample pose as given";
+  }
+  return report;
+}
+
+nlohmann::json ToJson(const AlignResult& result) {
+  nlohmann::json images = nlohmann::json::array();
+  for (const ImageAlignment& image : result.images) {
+    nlohmann::json entry = {{"photo", image.photo},
+                            {"used", image.used},
+                            {"markers", image.markers},
+                            {"ignored_markers", image.ignored_markers},
+                            {"outlier_corners", image.outlier_corners},
+                            {"rms_px", image.rms_px}};
+    if (!image.used) entry["dropped"] = image.dropped_reason;
+    images.push_back(entry);
+  }
+  nlohmann::json markers = nlohmann::json::array();
+  for (const MarkerResidual& marker : result.markers) {
+    markers.push_back({{"id", marker.id}, {"observations", marker.observations}, {"rms_px", marker.rms_px}});
+  }
+  nlohmann::json json = {{"format", "ibrdf-alignment"}, {"version", 1}, {"rms_px", result.rms_px},
+                         {"images", images},          {"markers", markers}, {"total_s", result.total_s}};
+  if (result.sphere.fitted) {
+    json["sphere"] = {{"center", ToJson(result.sphere.center)},
+                      {"radius", result.sphere.radius},
+                      {"silhouette_points", result.sphere.silhouette_points},
+                      {"rejected_points", result.sphere.rejected_points},
+                      {"rms_m", result.sphere.rms_m}};
+  }
+  return json;
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,189 @@
+#include "align/markers.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <opencv2/aruco.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/camera.h"
+#include "core/error.h"
+
+namespace ibrdf {
+namespace {
+
+struct NamedDictionary {
+  const char* name;
+  int id;
+  int bits;
+  int size;
+};
+
+constexpr NamedDictionary kDictionaries[] = {
+    {"DICT_4X4_50", cv::aruco::DICT_4X4_50, 4, 50},       {"DICT_4X4_100", cv::aruco::DICT_4X4_100, 4, 100},
+    {"DICT_4X4_250", cv::aruco::DICT_4X4_250, 4, 250},    {"DICT_4X4_1000", cv::aruco::DICT_4X4_1000, 4, 1000},
+    {"DICT_5X5_50", cv::aruco::DICT_5X5_50, 5, 50},       {"DICT_5X5_100", cv::aruco::DICT_5X5_100, 5, 100},
+    {"DICT_5X5_250", cv::aruco::DICT_5X5_250, 5, 250},    {"DICT_5X5_1000", cv::aruco::DICT_5X5_1000, 5, 1000},
+    {"DICT_6X6_50", cv::aruco::DICT_6X6_50, 6, 50},       {"DICT_6X6_100", cv::aruco::DICT_6X6_100, 6, 100},
+    {"DICT_6X6_250", cv::aruco::DICT_6X6_250, 6, 250},    {"DICT_6X6_1000", cv::aruco::DICT_6X6_1000, 6, 1000},
+};
+
+// Bilinear luminance at a continuous pixel position (centres at +0.5); NaN outside.
+double Sample(const Image& image, const Eigen::Vector2d& p) {
+  const double x = p.x() - 0.5, y = p.y() - 0.5;
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= image.width || y0 + 1 >= image.height) return NAN;
+  const double fx = x - x0, fy = y - y0;
+  auto lum = [&](int xi, int yi) {
+    if (image.channels < 3) return double(image.at(xi, yi, 0));
+    return 0.2126 * image.at(xi, yi, 0) + 0.7152 * image.at(xi, yi, 1) + 0.0722 * image.at(xi, yi, 2);
+  };
+  return (1 - fx) * (1 - fy) * lum(x0, y0) + fx * (1 - fy) * lum(x0 + 1, y0) + (1 - fx) * fy * lum(x0, y0 + 1) +
+         fx * fy * lum(x0 + 1, y0 + 1);
+}
+
+}  // namespace
+
+void RefineMarkerCorners(const Image& image, const Camera& camera, std::vector<MarkerDetection>* detections) {
+  // Two passes: the second measures the edges from the first pass's corners.
+  for (int pass = 0; pass < 2; ++pass)
+  for (MarkerDetection& d : *detections) {
+    // Side k runs from corner k to corner k + 1; the marker's inside is to the side's right in image
+    // coordinates (y down), since corners go clockwise on screen.
+    std::array<Eigen::Vector3d, 4> lines;  // a x + b y + c = 0 in the undistorted image plane
+    bool ok = true;
+    for (int k = 0; k < 4 && ok; ++k) {
+      const Eigen::Vector2d a = d.corners[k], b = d.corners[(k + 1) % 4];
+      const double length = (b - a).norm();
+      const Eigen::Vector2d along = (b - a) / length;
+      const Eigen::Vector2d inward(-along.y(), along.x());
+      std::vector<Eigen::Vector2d> edge_points;
+      const int samples = std::max(6, static_cast<int>(length));
+      for (int j = 0; j < samples; ++j) {
+        const double t = 0.15 + 0.7 * (j + 0.5) / samples;  // stay clear of the corners
+        const Eigen::Vector2d base = a + t * (b - a);
+        // Profile across the edge, from 3 px outside (white card) to 3 px inside (black border).
+        const double step = 0.1, reach = 3.0;
+        std::vector<double> profile;
+        for (double s = -reach; s <= reach + 1e-9; s += step) profile.push_back(Sample(image, base + s * inward));
+        if (std::any_of(profile.begin(), profile.end(), [](double v) { return !std::isfinite(v); })) continue;
+        const double outside = profile.front(), inside = profile.back();
+        if (!(outside > inside + 0.05)) continue;  // no clear white-to-black step
+        const double mid = 0.5 * (outside + inside);
+        // The crossing nearest the detected edge (s = 0).
+        double best = NAN;
+        for (size_t i = 0; i + 1 < profile.size(); ++i) {
+          if ((profile[i] - mid) * (profile[i + 1] - mid) <= 0.0 && profile[i] != profile[i + 1]) {
+            const double s = -reach + step * (i + (profile[i] - mid) / (profile[i] - profile[i + 1]));
+            if (!std::isfinite(best) || std::abs(s) < std::abs(best)) best = s;
+          }
+        }
+        if (!std::isfinite(best)) continue;
+        edge_points.push_back(camera.CamPlaneFromImage(base + best * inward));
+      }
+      if (edge_points.size() < 4) {
+        ok = false;
+        break;
+      }
+      // Total least squares line through the edge points.
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      for (const auto& p : edge_points) mean += p;
+      mean /= edge_points.size();
+      Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+      for (const auto& p : edge_points) scatter += (p - mean) * (p - mean).transpose();
+      // The normal is the eigenvector of the smaller eigenvalue (closed form for 2x2).
+      const double tr = scatter.trace(), det = scatter.determinant();
+      const double small = 0.5 * tr - std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
+      Eigen::Vector2d normal(scatter(0, 1), small - scatter(0, 0));
+      if (normal.norm() < 1e-300) normal = Eigen::Vector2d(small - scatter(1, 1), scatter(1, 0));
+      if (!(normal.norm() > 0.0)) {
+        ok = false;
+        break;
+      }
+      normal.normalize();
+      lines[k] = Eigen::Vector3d(normal.x(), normal.y(), -normal.dot(mean));
+    }
+    if (!ok) continue;
+    for (int k = 0; k < 4; ++k) {
+      // Corner k lies on side k - 1 and side k.
+      const Eigen::Vector3d corner = lines[(k + 3) % 4].cross(lines[k]);
+      if (!(std::abs(corner.z()) > 1e-12)) continue;
+      const Eigen::Vector2d xy = corner.head<2>() / corner.z();
+      const Eigen::Vector2d d_xy = camera.Distort(xy);
+      const Eigen::Vector2d pixel(camera.FocalX() * d_xy.x() + camera.PrincipalX(),
+                                  camera.FocalY() * d_xy.y() + camera.PrincipalY());
+      if ((pixel - d.corners[k]).norm() < 2.0) d.corners[k] = pixel;  // a large jump means a bad fit
+    }
+  }
+}
+
+MarkerDictionary::MarkerDictionary(const std::string& name, const std::string& where) : name_(name) {
+  for (const NamedDictionary& d : kDictionaries) {
+    if (name == d.name) {
+      id_ = d.id;
+      bits_ = d.bits;
+      size_ = d.size;
+      return;
+    }
+  }
+  ThrowError(where, "unknown ArUco dictionary \"" + name + "\" (expected e.g. DICT_4X4_50, DICT_5X5_100, DICT_6X6_250)");
+}
+
+std::vector<bool> MarkerDictionary::Modules(int id) const {
+  IBRDF_CHECK(id >= 0 && id < size_) << "marker id " << id << " outside " << name_;
+  const cv::Ptr<cv::aruco::Dictionary> dictionary = cv::aruco::getPredefinedDictionary(id_);
+  cv::Mat image;
+  cv::aruco::drawMarker(dictionary, id, modules(), image, 1);
+  std::vector<bool> cells(size_t(modules()) * modules());
+  for (int r = 0; r < modules(); ++r) {
+    for (int c = 0; c < modules(); ++c) cells[size_t(r) * modules() + c] = image.at<uint8_t>(r, c) > 127;
+  }
+  return cells;
+}
+
+std::vector<MarkerDetection> DetectMarkers(const Image& image, const MarkerDictionary& dictionary,
+                                           const MarkerDetectionOptions& options) {
+  cv::Mat grey(image.height, image.width, CV_8UC1);
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      double v = 0.0;
+      if (image.channels >= 3) {
+        v = 0.2126 * image.at(x, y, 0) + 0.7152 * image.at(x, y, 1) + 0.0722 * image.at(x, y, 2);
+      } else {
+        v = image.at(x, y, 0);
+      }
+      if (!std::isfinite(v)) v = 0.0;
+      grey.at<uint8_t>(y, x) = static_cast<uint8_t>(std::lround(255.0 * std::pow(std::clamp(v, 0.0, 1.0), 1.0 / 2.2)));
+    }
+  }
+  cv::Ptr<cv::aruco::DetectorParameters> parameters = cv::aruco::DetectorParameters::create();
+  if (options.subpixel) {
+    parameters->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
+    parameters->cornerRefinementWinSize = 3;
+    parameters->cornerRefinementMaxIterations = 100;
+    parameters->cornerRefinementMinAccuracy = 0.001;
+  }
+  std::vector<std::vector<cv::Point2f>> corners;
+  std::vector<int> ids;
+  cv::aruco::detectMarkers(grey, cv::aruco::getPredefinedDictionary(
+                                     cv::aruco::PREDEFINED_DICTIONARY_NAME(dictionary.id_for_opencv())),
+                           corners, ids, parameters);
+  std::vector<MarkerDetection> detections;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    MarkerDetection detection;
+    detection.id = ids[i];
+    double shortest = 1e30;
+    for (int k = 0; k < 4; ++k) {
+      // OpenCV puts pixel centres at integers; ibrdf (COLMAP) at +0.5.
+      detection.corners[k] = Eigen::Vector2d(corners[i][k].x + 0.5, corners[i][k].y + 0.5);
+    }
+    for (int k = 0; k < 4; ++k) shortest = std::min(shortest, (detection.corners[k] - detection.corners[(k + 1) % 4]).norm());
+    if (shortest >= options.min_side_px) detections.push_back(detection);
+  }
+  return detections;
+}
+
+}  // namespace ibrdf
