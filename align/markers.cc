@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <opencv2/aruco.hpp>
@@ -72,15 +73,16 @@ void RefineMarkerCorners(const Image& image, const Camera& camera, std::vector<M
         if (std::any_of(profile.begin(), profile.end(), [](double v) { return !std::isfinite(v); })) continue;
         const double outside = profile.front(), inside = profile.back();
         if (!(outside > inside + 0.05)) continue;  // no clear white-to-black step
-        const double mid = 0.5 * (outside + inside);
-        // The crossing nearest the detected edge (s = 0).
-        double best = NAN;
+        // The edge by area: the white fraction of the profile, integrated, is the distance from the
+        // outer end to the edge. Exact for a box-filtered step (what a sensor records), where a
+        // mid-level crossing of interpolated samples is biased by up to a tenth of a pixel.
+        double area = 0.0;
         for (size_t i = 0; i + 1 < profile.size(); ++i) {
-          if ((profile[i] - mid) * (profile[i + 1] - mid) <= 0.0 && profile[i] != profile[i + 1]) {
-            const double s = -reach + step * (i + (profile[i] - mid) / (profile[i] - profile[i + 1]));
-            if (!std::isfinite(best) || std::abs(s) < std::abs(best)) best = s;
-          }
+          const double f0 = (profile[i] - inside) / (outside - inside), f1 = (profile[i + 1] - inside) / (outside - inside);
+          area += 0.5 * (f0 + f1) * step;
         }
+        const double best = area - reach;
+        if (std::abs(best) > 2.0) continue;  // the detected edge was further off than the refinement reaches
         if (!std::isfinite(best)) continue;
         edge_points.push_back(camera.CamPlaneFromImage(base + best * inward));
       }
@@ -94,12 +96,11 @@ void RefineMarkerCorners(const Image& image, const Camera& camera, std::vector<M
       mean /= edge_points.size();
       Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
       for (const auto& p : edge_points) scatter += (p - mean) * (p - mean).transpose();
-      // The normal is the eigenvector of the smaller eigenvalue (closed form for 2x2).
-      const double tr = scatter.trace(), det = scatter.determinant();
-      const double small = 0.5 * tr - std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
-      Eigen::Vector2d normal(scatter(0, 1), small - scatter(0, 0));
-      if (normal.norm() < 1e-300) normal = Eigen::Vector2d(small - scatter(1, 1), scatter(1, 0));
-      if (!(normal.norm() > 0.0)) {
+      // The normal is the eigenvector of the smaller eigenvalue (Eigen's solver: the closed form is
+      // ill-conditioned for sides along an image axis).
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
+      Eigen::Vector2d normal = eigen.eigenvectors().col(0);
+      if (eigen.info() != Eigen::Success || !(normal.norm() > 0.0)) {
         ok = false;
         break;
       }

@@ -83,7 +83,7 @@ class CliTest : public ::testing::Test {
 TEST(Cli, HelpOnEverySubcommand) {
   const RunResult top = RunIbrdf("--help");
   EXPECT_EQ(top.exit_code, 0);
-  for (const std::string command : {"synth", "derender", "check", "compare"}) {
+  for (const std::string command : {"synth", "align", "derender", "check", "compare"}) {
     EXPECT_NE(top.output.find(command), std::string::npos) << command;
     const RunResult help = RunIbrdf(command + " --help");
     EXPECT_EQ(help.exit_code, 0) << command;
@@ -184,6 +184,32 @@ TEST_F(CliTest, NeverOverwritesInputsOrExistingOutputs) {
   result = RunIbrdf("synth --out " + session_ + " --material " + MaterialPath("lambertian50"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_TRUE(fs::exists(manifest_));
+}
+
+TEST(Cli, AlignWritesAnAlignedSessionThatDerenders) {
+  ScratchDir dir;
+  const std::string session = dir / "targets";
+  RunResult result = RunIbrdf("synth --out " + session + " --material " + MaterialPath("lambertian50") +
+                              " --targets --photos 3");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  result = RunIbrdf("align " + session + " --out " + (dir / "aligned"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json report = ReadJson(dir / "aligned/alignment.json");
+  EXPECT_EQ(report["images"].size(), 3u);
+  EXPECT_LT(report["rms_px"].get<double>(), 0.5);
+  result = RunIbrdf("derender " + (dir / "aligned") + " --out " + (dir / "samples.npy"));
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  // Aligning into the input folder is refused.
+  result = RunIbrdf("align " + session + " --out " + session + " --overwrite");
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_TRUE(fs::exists(session + "/session.json"));
+}
+
+TEST_F(CliTest, AlignWithoutTargetsNamesTheMissingBlock) {
+  const RunResult result = RunIbrdf("align " + session_ + " --out " + (dir_ / "aligned"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("/targets"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(dir_ / "aligned"));
 }
 
 TEST_F(CliTest, CorruptSampleFileIsAnError) {

@@ -1,0 +1,53 @@
+// The align stage's Ceres cost functions: analytic values and autodiff derivatives checked against
+// numeric differentiation with ceres::GradientChecker.
+#include <ceres/gradient_checker.h>
+#include <gtest/gtest.h>
+
+#include "align/cost_functions/reprojection_error.h"
+#include "align/cost_functions/sphere_tangent_error.h"
+
+namespace ibrdf {
+namespace {
+
+TEST(ReprojectionError, ZeroAtTheTrueProjectionAndGradientsCheck) {
+  const std::array<double, 8> intrinsics = {1200, 1210, 400, 300, -0.08, 0.02, 5e-4, -3e-4};
+  double rotation[3] = {0.1, -0.2, 0.05};
+  double translation[3] = {0.01, -0.02, 0.8};
+  double point[3] = {0.03, -0.01, 0.02};
+  // The observation where the point projects: the residual must vanish there.
+  double residual[2];
+  ReprojectionError(intrinsics, 0.0, 0.0)(rotation, translation, point, residual);
+  const double u = residual[0], v = residual[1];
+  ReprojectionError(intrinsics, u, v)(rotation, translation, point, residual);
+  EXPECT_NEAR(residual[0], 0.0, 1e-12);
+  EXPECT_NEAR(residual[1], 0.0, 1e-12);
+
+  std::unique_ptr<ceres::CostFunction> cost(ReprojectionError::Create(intrinsics, u + 0.3, v - 0.2));
+  ceres::NumericDiffOptions numeric;
+  ceres::GradientChecker checker(cost.get(), static_cast<const std::vector<const ceres::Manifold*>*>(nullptr), numeric);
+  ceres::GradientChecker::ProbeResults results;
+  std::vector<double*> parameters = {rotation, translation, point};
+  EXPECT_TRUE(checker.Probe(parameters.data(), 1e-6, &results)) << results.error_log;
+}
+
+TEST(SphereTangentError, DistanceMinusRadiusAndGradientsCheck) {
+  const Eigen::Vector3d origin(0, 0, -1), direction(0, 0, 1);
+  double center[3] = {0.3, 0.4, 0.0};
+  double radius = 0.5;
+  double residual;
+  SphereTangentError(origin, direction)(center, &radius, &residual);
+  EXPECT_NEAR(residual, 0.0, 1e-12);  // the ray passes at distance 0.5 from the centre
+  radius = 0.4;
+  SphereTangentError(origin, direction)(center, &radius, &residual);
+  EXPECT_NEAR(residual, 0.1, 1e-12);
+
+  std::unique_ptr<ceres::CostFunction> cost(SphereTangentError::Create(origin, Eigen::Vector3d(0.1, 0.05, 1.0)));
+  ceres::NumericDiffOptions numeric;
+  ceres::GradientChecker checker(cost.get(), static_cast<const std::vector<const ceres::Manifold*>*>(nullptr), numeric);
+  ceres::GradientChecker::ProbeResults results;
+  std::vector<double*> parameters = {center, &radius};
+  EXPECT_TRUE(checker.Probe(parameters.data(), 1e-6, &results)) << results.error_log;
+}
+
+}  // namespace
+}  // namespace ibrdf
