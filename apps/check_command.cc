@@ -1,11 +1,14 @@
 // ibrdf check: consistency of measured samples (reciprocity, bilateral symmetry).
 #include <cstdio>
 
+#include <nlohmann/json.hpp>
+
 #include "apps/commands.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
 #include "core/sample_file.h"
 #include "reconstruct/consistency.h"
+#include "reconstruct/prediction_check.h"
 
 namespace ibrdf {
 
@@ -18,6 +21,8 @@ void AddCheckCommand(CLI::App& app) {
   struct Args {
     std::string samples, out;
     ConsistencyOptions options;
+    PredictionCheckOptions prediction;
+    bool regression = false;
     bool overwrite = false;
   };
   auto args = std::make_shared<Args>();
@@ -27,13 +32,23 @@ void AddCheckCommand(CLI::App& app) {
   command->add_option("--phi-bin-deg", args->options.phi_bin_deg, "Bin width in delta_phi (divides 360)")->capture_default_str();
   command->add_option("--min-samples", args->options.min_samples_per_bin, "Samples a bin needs to be compared")->capture_default_str();
   command->add_option("--max-theta-deg", args->options.max_theta_deg, "Compare bins up to this theta")->capture_default_str();
+  command->add_flag("--regression", args->regression,
+                    "Also the local-regression checks: reciprocity near the incidence plane, bilateral symmetry\n"
+                    "(unfolded fit) and held-out photos (fit without a photo, predict it)");
+  command->add_option("--held-out", args->prediction.held_out_photos, "Photos to hold out with --regression")->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace an existing report");
   command->callback([args] {
     StageLog stage("check");
     RequireWritableOutput(args->out, args->overwrite, {args->samples});
     const std::vector<BrdfSample> samples = ReadSamples(args->samples);
     const ConsistencyReport report = CheckConsistency(samples, args->options);
-    WriteJsonFile(args->out, ToJson(report, args->options));
+    nlohmann::json json = ToJson(report, args->options);
+    if (args->regression) {
+      const PredictionReport prediction = CheckWithRegression(samples, args->prediction);
+      json["regression"] = ToJson(prediction, args->prediction);
+      Log(1, prediction.BriefReport());
+    }
+    WriteJsonFile(args->out, json);
     Log(1, report.BriefReport());
     if (!report.reciprocity.valid()) Log(1, "warning: no bin pair had enough samples for a reciprocity figure");
     if (!report.isotropy.valid()) Log(1, "warning: no bin pair had enough samples for an isotropy figure");

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/image_io.h"
+#include "tests/run_ibrdf.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -20,25 +21,10 @@ namespace {
 
 using testing::MaterialPath;
 using testing::ScratchDir;
+using testing::RunIbrdf;
+using testing::RunResult;
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-RunResult RunIbrdf(const std::string& arguments) {
-  const std::string command = std::string(IBRDF_BINARY) + " --silent " + arguments + " 2>&1";
-  RunResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
 
 nlohmann::json ReadJson(const std::string& path) {
   std::ifstream in(path);

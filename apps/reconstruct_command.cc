@@ -1,0 +1,149 @@
+// ibrdf reconstruct: samples to a smooth isotropic BRDF (local polynomial regression), tabulated to
+// the MERL format and .npy, with Lafortune and GGX fits and a JSON summary.
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/commands.h"
+#include "core/error.h"
+#include "core/file_util.h"
+#include "core/json_reader.h"
+#include "core/logging.h"
+#include "core/sample_file.h"
+#include "reconstruct/local_regression.h"
+#include "reconstruct/merl_table.h"
+#include "reconstruct/model_fit.h"
+#include "reconstruct/npy_array.h"
+#include "reconstruct/reconstruction_error.h"
+#include "reconstruct/truth_comparison.h"
+
+namespace fs = std::filesystem;
+
+namespace ibrdf {
+namespace {
+
+void WriteText(const std::string& path, const std::string& text) {
+  AtomicFile file(path);
+  {
+    std::ofstream out(file.temporary_path());
+    out << text;
+    if (!out) ThrowError(path, "write failed");
+  }
+  file.Commit();
+}
+
+void AddReconstructCommand(CLI::App& app) {
+  auto* command = app.add_subcommand(
+      "reconstruct",
+      "Reconstruct a smooth isotropic BRDF from samples by local polynomial regression (elliptical kernel\n"
+      "in half/difference coordinates, folded by reciprocity and bilateral symmetry); writes into DIR:\n"
+      "brdf.binary (MERL 90x90x180), brdf.npy (90,90,180,3; -1 unmeasured), effective_samples.npy,\n"
+      "lafortune.json and ggx.json (material files), ggx.pbrt and ggx.xml (pbrt-v4, Mitsuba 3) and\n"
+      "summary.json (timings, reliability counts, fit errors; error against the truth with --truth).");
+  struct Args {
+    std::string samples, out, truth;
+    LocalRegressionOptions regression;
+    TabulateOptions tabulate;
+    ModelFitOptions fit;
+    bool no_fold = false, no_fits = false, linear_values = false, overwrite = false;
+  };
+  auto args = std::make_shared<Args>();
+  command->add_option("samples", args->samples, "Sample file (.npy) from `ibrdf derender`")->required();
+  command->add_option("--out", args->out, "Output folder (created; replaced only with --overwrite)")->required();
+  command->add_option("--degree", args->regression.degree, "Local polynomial degree: 0, 1 or 2")->capture_default_str();
+  command->add_option("--radius-h-deg", args->regression.radius_h_deg, "Kernel radius along the sheets (theta_h)")->capture_default_str();
+  command->add_option("--radius-d-deg", args->regression.radius_d_deg, "Kernel radius across the sheets (theta_d)")->capture_default_str();
+  command->add_flag("--no-fold", args->no_fold, "Do not assume reciprocity and bilateral symmetry");
+  command->add_flag("--linear-values", args->linear_values, "Fit f rather than log f");
+  command->add_option("--max-theta-deg", args->tabulate.max_theta_deg, "Tabulate cells up to this theta_i, theta_e")->capture_default_str();
+  command->add_option("--min-effective-samples", args->tabulate.min_effective_samples, "Cells with fewer are written as unmeasured (-1)")->capture_default_str();
+  command->add_option("--lobes", args->fit.lafortune_lobes, "Lafortune lobes (1 to 3)")->capture_default_str();
+  command->add_option("--fit-samples", args->fit.max_samples, "Samples used by the model fits")->capture_default_str();
+  command->add_flag("--no-fits", args->no_fits, "Skip the Lafortune and GGX fits");
+  command->add_option("--truth", args->truth, "truth.json (or a material file) to score the reconstruction against");
+  command->add_flag("--overwrite", args->overwrite, "Replace an existing output folder");
+  command->callback([args] {
+    StageLog stage("reconstruct");
+    RequireWritableOutput(args->out, args->overwrite, {args->samples});
+    if (args->no_fold) args->regression.fold_reciprocity = args->regression.fold_bilateral = false;
+    if (args->linear_values) args->regression.log_space = false;
+    std::string why;
+    if (!args->regression.Check(&why)) ThrowError("--degree/--radius", why);
+    if (!args->tabulate.Check(&why)) ThrowError("--max-theta-deg", why);
+    if (!args->fit.Check(&why)) ThrowError("--lobes/--fit-samples", why);
+    std::unique_ptr<BrdfModel> truth;
+    if (!args->truth.empty()) {
+      const nlohmann::json json = ReadJsonFile(args->truth);
+      truth = json.contains("material") ? LoadTruthMaterial(args->truth) : LoadMaterial(args->truth);
+    }
+    Timer total;
+    const std::vector<BrdfSample> samples = ReadSamples(args->samples);
+    if (samples.empty()) ThrowError(args->samples, "holds no samples");
+    nlohmann::json summary = {{"format", "ibrdf-reconstruction"}, {"version", 1}, {"samples_file", args->samples},
+                              {"samples", samples.size()}};
+    AtomicDirectory dir(args->out, args->overwrite);
+    const std::string tmp = dir.temporary_path();
+    nlohmann::json timings;
+
+    Timer timer;
+    const LocalRegression regression(samples, args->regression);
+    timings["build_s"] = timer.ElapsedSeconds();
+    TabulateSummary tabulated;
+    std::vector<float> ess;
+    const MerlTable table = TabulateMerl(regression, args->tabulate, &tabulated, &ess);
+    timings["tabulate_s"] = tabulated.seconds;
+    Log(1, "regression: " + std::to_string(regression.size()) + " samples, " + tabulated.reliability.Brief());
+    Log(1, tabulated.BriefReport());
+    timer.Restart();
+    WriteMerl(tmp + "/brdf.binary", table);
+    WriteNpyArray(tmp + "/brdf.npy", MerlToArray(table), {90, 90, 180, 3});
+    WriteNpyArray(tmp + "/effective_samples.npy", ess, {90, 90, 180});
+    timings["write_s"] = timer.ElapsedSeconds();
+    const LocalRegressionOptions& r = args->regression;
+    summary["regression"] = {{"degree", r.degree},
+                             {"radius_h_deg", r.radius_h_deg},
+                             {"radius_d_deg", r.radius_d_deg},
+                             {"fold_reciprocity", r.fold_reciprocity},
+                             {"fold_bilateral", r.fold_bilateral},
+                             {"log_space", r.log_space},
+                             {"samples_used", regression.size()},
+                             {"samples_skipped", regression.skipped_samples()},
+                             {"reliability", ToJson(tabulated.reliability)}};
+    summary["table"] = {{"cells_measured", tabulated.cells_measured},
+                        {"cells_beyond_theta_limit", tabulated.cells_below_horizon},
+                        {"cells_unsupported", tabulated.cells_unsupported},
+                        {"max_theta_deg", args->tabulate.max_theta_deg}};
+    if (truth) {
+      const ReconstructionError error = CompareTableWithTruth(table, *truth, 80.0);
+      summary["error_against_truth"] = ToJson(error);
+      summary["error_against_truth"]["truth"] = args->truth;
+      Log(1, "against the truth (theta <= 80): " + error.Brief());
+    }
+    if (!args->no_fits) {
+      timer.Restart();
+      const ModelFitResult lafortune = FitLafortune(samples, args->fit);
+      Log(1, lafortune.BriefReport());
+      WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, "lafortune-fit"));
+      const ModelFitResult ggx = FitGgx(samples, args->fit);
+      Log(1, ggx.BriefReport());
+      WriteJsonFile(tmp + "/ggx.json", FitMaterialJson(ggx, "ggx-fit"));
+      WriteText(tmp + "/ggx.pbrt", PbrtV4Material(*ggx.brdf, "ggx_fit"));
+      WriteText(tmp + "/ggx.xml", Mitsuba3Material(*ggx.brdf, "ggx_fit"));
+      timings["fits_s"] = timer.ElapsedSeconds();
+      summary["fits"] = {{"lafortune", {{"rel_rms_vs_samples", lafortune.rel_rms}, {"samples", lafortune.samples_used}, {"seconds", lafortune.seconds}}},
+                         {"ggx", {{"rel_rms_vs_samples", ggx.rel_rms}, {"samples", ggx.samples_used}, {"seconds", ggx.seconds}}}};
+    }
+    timings["total_s"] = total.ElapsedSeconds();
+    summary["timings_s"] = timings;
+    WriteJsonFile(tmp + "/summary.json", summary);
+    dir.Commit();
+    Log(1, "reconstruction written to " + args->out);
+  });
+}
+
+}  // namespace
+
+IBRDF_REGISTER_COMMAND(50, AddReconstructCommand);
+
+}  // namespace ibrdf

@@ -1,0 +1,470 @@
+#include "reconstruct/local_regression.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <random>
+
+#include <Eigen/Cholesky>
+#include <nanoflann.hpp>
+#include <nlohmann/json.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/error.h"
+
+namespace ibrdf {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+constexpr int kMaxCoefficients = 10;
+constexpr int kCoefficients[3] = {1, 4, 10};
+
+// The point cloud as nanoflann wants it: scaled canonical coordinates, 3 floats a point.
+struct Cloud {
+  std::vector<float> xyz;
+  size_t kdtree_get_point_count() const { return xyz.size() / 3; }
+  float kdtree_get_pt(size_t index, size_t dim) const { return xyz[3 * index + dim]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, uint32_t>;
+
+// One mirror image of the domain: signs applied to (u, v); w never changes sign.
+struct Mirror {
+  float su, sv;
+};
+
+// Accumulates the weighted normal equations of a degree-2 fit directly from the kd-tree's radius search
+// (no neighbour list is stored). Degree 1 and 0 use leading blocks of the same matrices, because the
+// basis is nested: 1, x, y, z, x^2, y^2, z^2, xy, xz, yz.
+struct NormalEquations {
+  const float* xyz = nullptr;
+  const float* values = nullptr;
+  int64_t exclude = -1;
+  float query[3] = {0, 0, 0};
+  Mirror mirror{1, 1};
+  float radius = 1.0f;  // of the support in scaled units (the growth factor)
+  float radius_squared = 1.0f;
+
+  double a[kMaxCoefficients][kMaxCoefficients] = {};
+  double a2[kMaxCoefficients][kMaxCoefficients] = {};  // with squared weights: the estimate's variance
+  double b[kMaxCoefficients][3] = {};
+  double sum_w = 0.0, sum_w2 = 0.0;
+  float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};  // range of the neighbours' values
+  uint32_t count = 0;
+
+  // nanoflann's result-set interface.
+  float worstDist() const { return radius_squared; }
+  size_t size() const { return count; }
+  bool full() const { return true; }
+  bool addPoint(float distance_squared, uint32_t index) {
+    if (distance_squared >= radius_squared || static_cast<int64_t>(index) == exclude) return true;
+    const double r = std::sqrt(double(distance_squared)) / radius;
+    const double t = 1.0 - r * r * r;
+    const double w = t * t * t;
+    if (!(w > 0.0)) return true;
+    const float* p = xyz + 3 * size_t(index);
+    const double dx = mirror.su * (p[0] - query[0]) / radius;
+    const double dy = mirror.sv * (p[1] - query[1]) / radius;
+    const double dz = (p[2] - query[2]) / radius;
+    const double basis[kMaxCoefficients] = {1.0, dx, dy, dz, dx * dx, dy * dy, dz * dz, dx * dy, dx * dz, dy * dz};
+    const float* f = values + 3 * size_t(index);
+    for (int c = 0; c < 3; ++c) {
+      low[c] = count == 0 ? f[c] : std::min(low[c], f[c]);
+      high[c] = count == 0 ? f[c] : std::max(high[c], f[c]);
+    }
+    for (int i = 0; i < kMaxCoefficients; ++i) {
+      const double wb = w * basis[i];
+      const double w2b = w * wb;
+      for (int j = i; j < kMaxCoefficients; ++j) {
+        a[i][j] += wb * basis[j];
+        a2[i][j] += w2b * basis[j];
+      }
+      b[i][0] += wb * f[0];
+      b[i][1] += wb * f[1];
+      b[i][2] += wb * f[2];
+    }
+    sum_w += w;
+    sum_w2 += w * w;
+    ++count;
+    return true;
+  }
+  void Reset() {
+    for (auto& row : a) std::fill(std::begin(row), std::end(row), 0.0);
+    for (auto& row : a2) std::fill(std::begin(row), std::end(row), 0.0);
+    for (auto& row : b) std::fill(std::begin(row), std::end(row), 0.0);
+    sum_w = sum_w2 = 0.0;
+    count = 0;
+  }
+};
+
+}  // namespace
+
+struct LocalRegression::Impl {
+  Cloud cloud;
+  std::vector<float> values;  // 3 a point (log f in log space)
+  std::unique_ptr<Tree> tree;
+  std::vector<Mirror> mirrors;  // the identity first
+  bool fold_reciprocity = false, fold_bilateral = false;
+  double scale_h = 1.0, scale_d = 1.0;  // 1 / radius, per coordinate
+
+  // Maps (u, v) into the canonical part of the domain.
+  void Fold(double* u, double* v) const {
+    if (fold_reciprocity && fold_bilateral) {
+      *u = std::abs(*u);
+      *v = std::abs(*v);
+    } else if (fold_reciprocity) {
+      if (*v < 0.0 || (*v == 0.0 && *u < 0.0)) {
+        *u = -*u;
+        *v = -*v;
+      }
+    } else if (fold_bilateral) {
+      *v = std::abs(*v);
+    }
+  }
+  // Squared distance (scaled units) from a mirrored query to the canonical region.
+  double DistanceToCanonicalSquared(float x, float y) const {
+    double d2 = 0.0;
+    if (fold_reciprocity && fold_bilateral) {
+      d2 += x < 0 ? double(x) * x : 0.0;
+      d2 += y < 0 ? double(y) * y : 0.0;
+    } else if (fold_reciprocity || fold_bilateral) {
+      d2 += y < 0 ? double(y) * y : 0.0;
+    }
+    return d2;
+  }
+};
+
+bool LocalRegressionOptions::Check(std::string* why) const {
+  if (degree < 0 || degree > 2) {
+    *why = "degree must be 0, 1 or 2";
+    return false;
+  }
+  if (!(radius_h_deg > 0.0 && radius_h_deg <= 90.0) || !(radius_d_deg > 0.0 && radius_d_deg <= 90.0)) {
+    *why = "kernel radii must be in (0, 90] degrees";
+    return false;
+  }
+  if (!(min_rcond >= 0.0 && min_rcond < 1.0) || !(min_samples_per_coefficient >= 1.0)) {
+    *why = "min_rcond must be in [0, 1) and min_samples_per_coefficient at least 1";
+    return false;
+  }
+  if (!(range_margin >= 0.0)) {
+    *why = "range_margin must be non-negative";
+    return false;
+  }
+  if (min_neighbors < 1 || !(max_growth >= 1.0)) {
+    *why = "min_neighbors must be at least 1 and max_growth at least 1";
+    return false;
+  }
+  if (log_space && !(log_floor > 0.0)) {
+    *why = "log_floor must be positive";
+    return false;
+  }
+  return true;
+}
+
+void ReliabilityCounts::Add(const Estimate& e) {
+  ++evaluations;
+  switch (e.status) {
+    case EstimateStatus::kFull: ++full; break;
+    case EstimateStatus::kReducedDegree: ++reduced_degree; break;
+    case EstimateStatus::kGrown: ++grown; break;
+    case EstimateStatus::kUnsupported: ++unsupported; break;
+  }
+  clamped += e.clamped;
+  mean_effective_samples += (e.effective_samples - mean_effective_samples) / double(evaluations);
+}
+
+void ReliabilityCounts::Merge(const ReliabilityCounts& other) {
+  const uint64_t total = evaluations + other.evaluations;
+  if (total > 0) {
+    mean_effective_samples =
+        (mean_effective_samples * evaluations + other.mean_effective_samples * other.evaluations) / total;
+  }
+  evaluations = total;
+  full += other.full;
+  reduced_degree += other.reduced_degree;
+  grown += other.grown;
+  unsupported += other.unsupported;
+  clamped += other.clamped;
+}
+
+std::string ReliabilityCounts::Brief() const {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "%llu evaluations: %llu full, %llu reduced degree, %llu grown support, %llu unsupported, %llu "
+                "clamped; mean effective samples %.1f",
+                (unsigned long long)evaluations, (unsigned long long)full, (unsigned long long)reduced_degree,
+                (unsigned long long)grown, (unsigned long long)unsupported, (unsigned long long)clamped,
+                mean_effective_samples);
+  return buffer;
+}
+
+nlohmann::json ToJson(const ReliabilityCounts& counts) {
+  return {{"evaluations", counts.evaluations},   {"full", counts.full},
+          {"reduced_degree", counts.reduced_degree}, {"grown_support", counts.grown},
+          {"unsupported", counts.unsupported},   {"clamped_negative", counts.clamped},
+          {"mean_effective_samples", counts.mean_effective_samples}};
+}
+
+Eigen::Vector3d RegressionCoordinates(const HalfDiffAngles& angles) {
+  return {angles.theta_h * std::cos(angles.phi_d), angles.theta_h * std::sin(angles.phi_d), angles.theta_d};
+}
+
+Eigen::Vector3d RegressionCoordinates(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) {
+  HalfDiffAngles angles;
+  ToHalfDiff(wi, wo, &angles);
+  return RegressionCoordinates(angles);
+}
+
+LocalRegression::LocalRegression(const std::vector<BrdfSample>& samples, const LocalRegressionOptions& options)
+    : impl_(std::make_unique<Impl>()), options_(options) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("local regression options", why);
+  Impl& impl = *impl_;
+  impl.fold_reciprocity = options.fold_reciprocity;
+  impl.fold_bilateral = options.fold_bilateral;
+  impl.scale_h = 1.0 / (options.radius_h_deg * kDegree);
+  impl.scale_d = 1.0 / (options.radius_d_deg * kDegree);
+  impl.mirrors.push_back({1, 1});
+  if (impl.fold_reciprocity) impl.mirrors.push_back({-1, -1});
+  if (impl.fold_bilateral) impl.mirrors.push_back({1, -1});
+  if (impl.fold_reciprocity && impl.fold_bilateral) impl.mirrors.push_back({-1, 1});
+
+  const size_t n = samples.size();
+  std::vector<float> xyz(3 * n), values(3 * n);
+  std::vector<uint8_t> valid(n, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const BrdfSample& s = samples[i];
+      const Eigen::Vector3d wi(s.wi[0], s.wi[1], s.wi[2]), wo(s.wo[0], s.wo[1], s.wo[2]);
+      const Eigen::Vector3f f(s.brdf[0], s.brdf[1], s.brdf[2]);
+      if (!wi.allFinite() || !wo.allFinite() || !f.allFinite() || !(wi.norm() > 0.5) || !(wo.norm() > 0.5)) continue;
+      HalfDiffAngles angles;
+      if (!ToHalfDiff(wi.normalized(), wo.normalized(), &angles)) continue;
+      Eigen::Vector3d uvw = RegressionCoordinates(angles);
+      impl.Fold(&uvw[0], &uvw[1]);
+      xyz[3 * i + 0] = static_cast<float>(uvw[0] * impl.scale_h);
+      xyz[3 * i + 1] = static_cast<float>(uvw[1] * impl.scale_h);
+      xyz[3 * i + 2] = static_cast<float>(uvw[2] * impl.scale_d);
+      for (int c = 0; c < 3; ++c) {
+        values[3 * i + c] = options.log_space ? std::log(std::max<float>(f[c], float(options.log_floor))) : f[c];
+      }
+      valid[i] = 1;
+    }
+  });
+  size_t kept = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!valid[i]) continue;
+    for (int k = 0; k < 3; ++k) {
+      xyz[3 * kept + k] = xyz[3 * i + k];
+      values[3 * kept + k] = values[3 * i + k];
+    }
+    ++kept;
+  }
+  skipped_ = n - kept;
+  xyz.resize(3 * kept);
+  values.resize(3 * kept);
+  xyz.shrink_to_fit();
+  values.shrink_to_fit();
+  impl.cloud.xyz = std::move(xyz);
+  impl.values = std::move(values);
+  impl.tree = std::make_unique<Tree>(3, impl.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(24));
+  if (kept > 0) impl.tree->buildIndex();
+}
+
+LocalRegression::~LocalRegression() = default;
+
+size_t LocalRegression::size() const { return impl_->values.size() / 3; }
+
+Estimate LocalRegression::Evaluate(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const {
+  return EvaluateAt(RegressionCoordinates(wi, wo));
+}
+
+Estimate LocalRegression::Evaluate(const HalfDiffAngles& angles) const {
+  return EvaluateAt(RegressionCoordinates(angles));
+}
+
+Estimate LocalRegression::EvaluateAt(const Eigen::Vector3d& uvw_in, int64_t exclude) const {
+  const Impl& impl = *impl_;
+  Estimate estimate;
+  if (size() == 0 || !uvw_in.allFinite()) return estimate;
+  double u = uvw_in[0], v = uvw_in[1];
+  impl.Fold(&u, &v);
+  const float x = static_cast<float>(u * impl.scale_h);
+  const float y = static_cast<float>(v * impl.scale_h);
+  const float z = static_cast<float>(uvw_in[2] * impl.scale_d);
+
+  NormalEquations eq;
+  eq.xyz = impl.cloud.xyz.data();
+  eq.values = impl.values.data();
+  eq.exclude = exclude;
+  const nanoflann::SearchParams params(32, 0.0f, false);
+  float growth = 1.0f;
+  for (;;) {
+    eq.Reset();
+    eq.radius = growth;
+    eq.radius_squared = growth * growth;
+    for (const Mirror& m : impl.mirrors) {
+      const float qx = m.su * x, qy = m.sv * y;
+      if (impl.DistanceToCanonicalSquared(qx, qy) >= double(growth) * growth) continue;
+      eq.query[0] = qx;
+      eq.query[1] = qy;
+      eq.query[2] = z;
+      eq.mirror = m;
+      impl.tree->findNeighbors(eq, eq.query, params);
+    }
+    if (int(eq.count) >= options_.min_neighbors && eq.sum_w > 0.0) break;
+    if (growth >= options_.max_growth) break;
+    growth = std::min<float>(growth * 1.5f, float(options_.max_growth));
+  }
+  if (!(eq.sum_w > 0.0)) return estimate;  // unsupported: value 0, degree -1
+
+  estimate.neighbors = eq.count;
+  estimate.growth = growth;
+  estimate.effective_samples = static_cast<float>(eq.sum_w * eq.sum_w / eq.sum_w2);
+  for (int degree = options_.degree; degree >= 0; --degree) {
+    const int m = kCoefficients[degree];
+    Eigen::Vector3d value;
+    double rcond = 1.0;
+    double fit_samples = eq.sum_w * eq.sum_w / eq.sum_w2;
+    if (degree == 0) {
+      value = Eigen::Vector3d(eq.b[0][0], eq.b[0][1], eq.b[0][2]) / eq.sum_w;
+    } else {
+      if (estimate.effective_samples < options_.min_samples_per_coefficient * m) continue;
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a(m, m);
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a2(m, m);
+      Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxCoefficients, 3> b(m, 3);
+      for (int i = 0; i < m; ++i) {
+        for (int j = i; j < m; ++j) {
+          a(i, j) = a(j, i) = eq.a[i][j];
+          a2(i, j) = a2(j, i) = eq.a2[i][j];
+        }
+        for (int c = 0; c < 3; ++c) b(i, c) = eq.b[i][c];
+      }
+      const Eigen::LDLT<decltype(a)> ldlt(a);
+      if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) continue;
+      rcond = ldlt.rcond();
+      if (!(rcond > options_.min_rcond)) continue;
+      // The estimate is sum_i l_i f_i; its variance relative to one sample's is sum l_i^2 =
+      // g' A2 g with g = A^-1 e1. An extrapolation along a poorly sampled direction (one sheet, a domain
+      // edge) has huge weights l_i: too few effective samples, so a lower degree is used.
+      Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCoefficients, 1> e1 =
+          Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCoefficients, 1>::Zero(m);
+      e1[0] = 1.0;
+      const auto g = ldlt.solve(e1).eval();
+      const double variance = g.dot(a2 * g);
+      if (!(variance > 0.0) || 1.0 / variance < options_.min_fit_samples) continue;
+      fit_samples = 1.0 / variance;
+      const auto coefficients = ldlt.solve(b).eval();
+      value = coefficients.row(0).transpose();
+      // An estimate far outside the range of the values it was fitted to is an extrapolation along a
+      // poorly sampled direction (one sheet, a domain edge): use a lower degree instead.
+      bool in_range = true;
+      for (int c = 0; c < 3; ++c) {
+        const double margin = options_.range_margin * (double(eq.high[c]) - eq.low[c]);
+        in_range = in_range && value[c] >= eq.low[c] - margin && value[c] <= eq.high[c] + margin;
+      }
+      if (!in_range) continue;
+    }
+    if (options_.log_space) value = value.array().exp();
+    if (!value.allFinite()) continue;
+    estimate.value = value;
+    estimate.rcond = static_cast<float>(rcond);
+    estimate.effective_samples = static_cast<float>(fit_samples);
+    estimate.degree = static_cast<int8_t>(degree);
+    break;
+  }
+  if (estimate.degree < 0) return Estimate();  // cannot happen: degree 0 is always finite here
+  if (options_.clamp_negative && (estimate.value.array() < 0.0).any()) {
+    estimate.value = estimate.value.cwiseMax(0.0);
+    estimate.clamped = true;
+  }
+  if (growth > 1.0f) {
+    estimate.status = EstimateStatus::kGrown;
+  } else if (estimate.degree < options_.degree) {
+    estimate.status = EstimateStatus::kReducedDegree;
+  } else {
+    estimate.status = EstimateStatus::kFull;
+  }
+  return estimate;
+}
+
+std::vector<Estimate> LocalRegression::EvaluateMany(const std::vector<Eigen::Vector3d>& uvw,
+                                                    ReliabilityCounts* counts) const {
+  std::vector<Estimate> estimates(uvw.size());
+  std::mutex mutex;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, uvw.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+    ReliabilityCounts local;
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      estimates[i] = EvaluateAt(uvw[i]);
+      local.Add(estimates[i]);
+    }
+    if (counts) {
+      std::lock_guard<std::mutex> lock(mutex);
+      counts->Merge(local);
+    }
+  });
+  return estimates;
+}
+
+double LocalRegression::LeaveOneOutRelativeRms(size_t count, uint64_t seed) const {
+  const size_t n = size();
+  if (n == 0) return 0.0;
+  count = std::min(count, n);
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<size_t> pick(0, n - 1);
+  std::vector<size_t> indices(count);
+  for (size_t& index : indices) index = pick(rng);
+  std::vector<double> sums(count, 0.0);
+  const Impl& impl = *impl_;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 64), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t k = range.begin(); k != range.end(); ++k) {
+      const size_t i = indices[k];
+      const float* p = &impl.cloud.xyz[3 * i];
+      const Eigen::Vector3d uvw(p[0] / impl.scale_h, p[1] / impl.scale_h, p[2] / impl.scale_d);
+      const Estimate e = EvaluateAt(uvw, static_cast<int64_t>(i));
+      double sum = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        const double f = options_.log_space ? std::exp(impl.values[3 * i + c]) : impl.values[3 * i + c];
+        const double rel = (e.value[c] - f) / std::max(std::abs(f), 1e-4);
+        sum += rel * rel;
+      }
+      sums[k] = sum;
+    }
+  });
+  double total = 0.0;
+  for (double s : sums) total += s;
+  return std::sqrt(total / (3.0 * count));
+}
+
+LocalRegressionOptions SelectBandwidth(const std::vector<BrdfSample>& samples, const LocalRegressionOptions& base,
+                                       const std::vector<double>& radius_h_deg,
+                                       const std::vector<double>& radius_d_deg, size_t loo_samples,
+                                       std::vector<Eigen::Vector3d>* scores) {
+  IBRDF_CHECK(!radius_h_deg.empty() && !radius_d_deg.empty());
+  LocalRegressionOptions best = base;
+  double best_score = std::numeric_limits<double>::infinity();
+  for (double rh : radius_h_deg) {
+    for (double rd : radius_d_deg) {
+      LocalRegressionOptions options = base;
+      options.radius_h_deg = rh;
+      options.radius_d_deg = rd;
+      const LocalRegression regression(samples, options);
+      const double score = regression.LeaveOneOutRelativeRms(loo_samples);
+      if (scores) scores->emplace_back(rh, rd, score);
+      if (score < best_score) {
+        best_score = score;
+        best = options;
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,147 @@
+// Local polynomial regression of scattered BRDF samples into a smooth isotropic BRDF (the paper's
+// section 3.3: an elliptical kernel long enough to bridge the sheets of samples that each photo
+// contributes, short along them).
+//
+// Coordinates. Each sample's pair of directions is converted to Rusinkiewicz's half/difference angles
+// (core/brdf_coords.h, as the MERL reader computes them) and then to
+//   u = theta_h cos(phi_d),  v = theta_h sin(phi_d),  w = theta_d.
+// A photo of a convex sample under one distant light sees (nearly) one angle between wi and wo, and
+// theta_d is half that angle, so each photo's samples form a slab of nearly constant w: the kernel is
+// long in w (across the sheets) and short in (u, v) (along them), an axis-aligned ellipsoid. (u, v) is
+// the half vector in polar form about d's azimuth, which stays smooth at theta_h = 0 where phi_d is
+// undefined, so the normal-incidence peak is not a coordinate singularity.
+//
+// Symmetries. Reciprocity (wi <-> wo) maps phi_d to phi_d + pi, i.e. (u, v) -> (-u, -v); bilateral
+// symmetry (delta_phi -> -delta_phi) maps phi_d to -phi_d, i.e. v -> -v. With folding on, samples are
+// mapped into the canonical part of the domain and every evaluation also gathers the mirrored images of
+// its neighbourhood, so there is no artificial boundary at the fold. Folding can be switched off to
+// check the symmetries instead of assuming them (reconstruct/prediction_check.h).
+//
+// Each evaluation fits a polynomial of degree 0, 1 or 2 in the bandwidth-scaled offsets with tricube
+// weights (1 - r^3)^3 (as locfit) and returns its constant term, with a reliability: the neighbour
+// count, the effective sample count (sum w)^2 / sum w^2, the reciprocal condition of the normal
+// matrix, the degree actually used and whether the support had to grow. It never returns NaN.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/brdf_coords.h"
+#include "core/sample_file.h"
+
+namespace ibrdf {
+
+struct LocalRegressionOptions {
+  int degree = 2;                 // 0 local constant, 1 local linear, 2 local quadratic
+  double radius_h_deg = 2.5;      // kernel radius along the sheets, in u and v (degrees of theta_h)
+  double radius_d_deg = 9.0;      // kernel radius across the sheets, in w = theta_d (degrees)
+  bool fold_reciprocity = true;   // assume f(wi, wo) = f(wo, wi) and pool both halves
+  bool fold_bilateral = true;     // assume f(delta_phi) = f(-delta_phi) and pool both halves
+  // Fit log f instead of f (a Phong/Lafortune lobe is close to exp of a quadratic); samples <= 0 are
+  // clamped to `log_floor` first. On by default: 0.84 % against 1.63 % RMS on noise-free bluepaint.
+  bool log_space = true;
+  double log_floor = 1e-6;        // 1/sr
+  // A degree is used only if the normal matrix's reciprocal condition (LDLT estimate) is above this and
+  // the effective sample count is at least `min_samples_per_coefficient` times the coefficient count;
+  // otherwise the next lower degree is tried.
+  double min_rcond = 1e-10;
+  double min_samples_per_coefficient = 1.5;
+  // A degree is also rejected when its estimate leaves the range [min, max] of the neighbours' values
+  // widened by this fraction of the range on each side (an extrapolation).
+  double range_margin = 1.0;
+  // A degree is used only if its estimate has at least this many effective samples, 1 / sum l_i^2 for
+  // the estimate sum l_i f_i (the noise of one sample is reduced by this factor in variance).
+  double min_fit_samples = 3.0;
+  // Where the kernel holds fewer than `min_neighbors` samples, the support grows to reach the
+  // `min_neighbors` nearest ones (at most `max_growth` times the radii; beyond that the point is
+  // reported as unsupported, value 0).
+  int min_neighbors = 12;
+  double max_growth = 4.0;
+  // Clamp negative estimates (extrapolated slopes) to 0; they are counted.
+  bool clamp_negative = true;
+
+  bool Check(std::string* why) const;
+};
+
+// Why an estimate is less than a full-degree fit inside the kernel.
+enum class EstimateStatus : uint8_t {
+  kFull = 0,           // the requested degree with the given radii
+  kReducedDegree = 1,  // an ill-conditioned design: a lower degree was used
+  kGrown = 2,          // too few samples in the kernel: the support grew (maybe the degree dropped too)
+  kUnsupported = 3,    // no sample within max_growth times the radii: value 0
+};
+
+struct Estimate {
+  Eigen::Vector3d value = Eigen::Vector3d::Zero();  // RGB BRDF, 1/sr; always finite
+  // 1 / sum l_i^2 for the estimate sum l_i f_i: how many samples' worth of noise averaging the fit
+  // achieves ((sum w)^2 / sum w^2 for a local constant).
+  float effective_samples = 0.0f;
+  float rcond = 0.0f;              // reciprocal condition estimate of the normal matrix used
+  float growth = 1.0f;             // factor applied to the radii (1 = as given)
+  uint32_t neighbors = 0;          // samples with non-zero weight (mirrored images included)
+  int8_t degree = -1;              // degree used; -1 when unsupported
+  EstimateStatus status = EstimateStatus::kUnsupported;
+  bool clamped = false;            // a negative estimate was clamped to 0
+};
+
+// Counts of evaluations by status, for summaries ("how many evaluations fell back").
+struct ReliabilityCounts {
+  uint64_t evaluations = 0, full = 0, reduced_degree = 0, grown = 0, unsupported = 0, clamped = 0;
+  double mean_effective_samples = 0.0;
+  void Add(const Estimate& e);
+  void Merge(const ReliabilityCounts& other);
+  std::string Brief() const;
+};
+nlohmann::json ToJson(const ReliabilityCounts& counts);
+
+// The regression coordinates (u, v, w) of a direction pair, in radians (see the header comment).
+Eigen::Vector3d RegressionCoordinates(const HalfDiffAngles& angles);
+Eigen::Vector3d RegressionCoordinates(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo);
+
+class LocalRegression {
+ public:
+  // Converts and folds the samples and builds the kd-tree (TBB-parallel conversion). Samples with a
+  // non-finite value or direction are skipped and counted.
+  LocalRegression(const std::vector<BrdfSample>& samples, const LocalRegressionOptions& options);
+  ~LocalRegression();
+  LocalRegression(const LocalRegression&) = delete;
+  LocalRegression& operator=(const LocalRegression&) = delete;
+
+  // The estimate for one pair of local directions (towards the light, towards the camera).
+  Estimate Evaluate(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const;
+  Estimate Evaluate(const HalfDiffAngles& angles) const;
+  // At regression coordinates (u, v, w); `exclude` is a sample index left out of the fit (for
+  // leave-one-out), or -1.
+  Estimate EvaluateAt(const Eigen::Vector3d& uvw, int64_t exclude = -1) const;
+  // Many points, TBB-parallel; `counts` (optional) gets their reliability counts.
+  std::vector<Estimate> EvaluateMany(const std::vector<Eigen::Vector3d>& uvw, ReliabilityCounts* counts) const;
+
+  // Leave-one-out cross-validation score at `count` samples chosen with a fixed seed: the root mean
+  // square of (f_loo - f) / max(f, floor) over samples and channels.
+  double LeaveOneOutRelativeRms(size_t count, uint64_t seed = 1) const;
+
+  size_t size() const;
+  uint64_t skipped_samples() const { return skipped_; }
+  const LocalRegressionOptions& options() const { return options_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  LocalRegressionOptions options_;
+  uint64_t skipped_ = 0;
+};
+
+// Bandwidth selection by leave-one-out cross-validation: each candidate pair of radii is scored with
+// LeaveOneOutRelativeRms on `loo_samples` samples; the best options are returned and every score is
+// appended to `scores` (radius_h_deg, radius_d_deg, score) when given.
+LocalRegressionOptions SelectBandwidth(const std::vector<BrdfSample>& samples, const LocalRegressionOptions& base,
+                                       const std::vector<double>& radius_h_deg,
+                                       const std::vector<double>& radius_d_deg, size_t loo_samples,
+                                       std::vector<Eigen::Vector3d>* scores = nullptr);
+
+}  // namespace ibrdf

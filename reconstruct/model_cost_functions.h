@@ -1,0 +1,69 @@
+// Ceres residuals of the analytic BRDF models (core/brdf_model.h) against one measured sample, weighted
+// by the sample's uncertainty: r = (f_model(wi, wo) - f_measured) / sigma. Templated for automatic
+// differentiation; tests check them with ceres::GradientChecker.
+#pragma once
+
+#include <cmath>
+
+#include <Eigen/Core>
+
+namespace ibrdf {
+
+// One colour channel of an N-lobe Lafortune model (Lafortune et al. 1997), parameters in one block:
+// [diffuse, Cxy_1, Cz_1, n_1, ..., Cxy_N, Cz_N, n_N]; f = diffuse/pi + sum max(0, Cxy xy + Cz z)^n.
+template <int kLobes>
+struct LafortuneResidual {
+  static constexpr int kParameters = 1 + 3 * kLobes;
+  LafortuneResidual(const Eigen::Vector3d& wi_in, const Eigen::Vector3d& wo_in, double value_in, double sigma)
+      : xy(wi_in.x() * wo_in.x() + wi_in.y() * wo_in.y()), z(wi_in.z() * wo_in.z()), value(value_in),
+        inv_sigma(1.0 / sigma) {}
+
+  template <class T>
+  bool operator()(const T* p, T* residual) const {
+    T f = p[0] / T(M_PI);
+    for (int k = 0; k < kLobes; ++k) {
+      const T base = p[1 + 3 * k] * xy + p[2 + 3 * k] * z;
+      if (base > T(0.0)) f += pow(base, p[3 + 3 * k]);
+    }
+    residual[0] = (f - value) * inv_sigma;
+    return true;
+  }
+
+  double xy, z, value, inv_sigma;
+};
+
+// GGX microfacet model as GgxBrdf evaluates it, all three channels: parameters [diffuse_albedo r g b],
+// [specular_f0 r g b], [alpha].
+struct GgxResidual {
+  GgxResidual(const Eigen::Vector3d& wi_in, const Eigen::Vector3d& wo_in, const Eigen::Vector3d& value_in,
+              const Eigen::Vector3d& sigma)
+      : wi(wi_in), wo(wo_in), value(value_in), inv_sigma(sigma.cwiseInverse()) {}
+
+  template <class T>
+  bool operator()(const T* diffuse, const T* f0, const T* alpha, T* residual) const {
+    const Eigen::Vector3d sum = wi + wo;
+    const Eigen::Vector3d h = sum.normalized();
+    const T a2 = alpha[0] * alpha[0];
+    const double cos_h = h.z();
+    const T denominator = T(cos_h * cos_h) * (a2 - T(1.0)) + T(1.0);
+    const T d = a2 / (T(M_PI) * denominator * denominator);
+    const T g = G1(a2, wi.z()) * G1(a2, wo.z());
+    const double schlick = std::pow(1.0 - std::max(0.0, wi.dot(h)), 5.0);
+    const T specular = d * g / T(4.0 * wi.z() * wo.z());
+    for (int c = 0; c < 3; ++c) {
+      const T fresnel = f0[c] + (T(1.0) - f0[c]) * T(schlick);
+      const T f = diffuse[c] / T(M_PI) + fresnel * specular;
+      residual[c] = (f - value[c]) * inv_sigma[c];
+    }
+    return true;
+  }
+
+  template <class T>
+  static T G1(const T& a2, double cos_theta) {
+    return T(2.0 * cos_theta) / (T(cos_theta) + sqrt(a2 + (T(1.0) - a2) * T(cos_theta * cos_theta)));
+  }
+
+  Eigen::Vector3d wi, wo, value, inv_sigma;
+};
+
+}  // namespace ibrdf

@@ -1,0 +1,232 @@
+#include "reconstruct/prediction_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <random>
+
+#include <nlohmann/json.hpp>
+
+#include "core/brdf_coords.h"
+#include "core/error.h"
+#include "core/logging.h"
+
+namespace ibrdf {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+Eigen::Vector3d Coordinates(double theta_i, double theta_e, double delta_phi) {
+  Eigen::Vector3d wi, wo;
+  FromIsotropic({theta_i, theta_e, delta_phi}, &wi, &wo);
+  return RegressionCoordinates(wi, wo);
+}
+
+double Percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const size_t k = static_cast<size_t>(q * (values.size() - 1) + 0.5);
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[k];
+}
+
+// Compares the regression at point pairs (a[i], b[i]); pairs where either estimate is not a full fit
+// with enough samples are left out.
+PairFigure ComparePairs(const LocalRegression& regression, const std::vector<Eigen::Vector3d>& a,
+                        const std::vector<Eigen::Vector3d>& b, float min_effective_samples) {
+  const std::vector<Estimate> ea = regression.EvaluateMany(a, nullptr);
+  const std::vector<Estimate> eb = regression.EvaluateMany(b, nullptr);
+  PairFigure figure;
+  std::vector<double> errors;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const Estimate& x = ea[i];
+    const Estimate& y = eb[i];
+    if (x.status != EstimateStatus::kFull || y.status != EstimateStatus::kFull) continue;
+    if (x.effective_samples < min_effective_samples || y.effective_samples < min_effective_samples) continue;
+    Eigen::Vector3d rel;
+    for (int c = 0; c < 3; ++c) {
+      const double mean = 0.5 * (x.value[c] + y.value[c]);
+      rel[c] = mean > 0.0 ? std::abs(x.value[c] - y.value[c]) / mean : 0.0;
+    }
+    figure.mean_rel_error += rel;
+    errors.push_back(rel.mean());
+  }
+  figure.pairs = errors.size();
+  if (figure.pairs > 0) {
+    figure.mean_rel_error /= double(figure.pairs);
+    figure.mean = figure.mean_rel_error.mean();
+    figure.median = Percentile(errors, 0.5);
+    figure.p95 = Percentile(errors, 0.95);
+  }
+  return figure;
+}
+
+nlohmann::json Rgb(const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); }
+
+nlohmann::json FigureJson(const PairFigure& figure) {
+  return {{"valid", figure.valid()},       {"pairs", figure.pairs},   {"mean_rel_error", figure.mean},
+          {"per_channel_rel_error", Rgb(figure.mean_rel_error)}, {"median_rel_error", figure.median},
+          {"p95_rel_error", figure.p95}};
+}
+
+}  // namespace
+
+bool PredictionCheckOptions::Check(std::string* why) const {
+  if (!regression.Check(why)) return false;
+  if (held_out_photos < 0 || max_predicted_samples < 1) {
+    *why = "held_out_photos must be non-negative and max_predicted_samples positive";
+    return false;
+  }
+  if (!(max_theta_deg > 0.0 && max_theta_deg <= 90.0) || !(near_plane_deg >= 0.0 && near_plane_deg < 90.0) ||
+      !(step_deg > 0.0)) {
+    *why = "max_theta_deg in (0, 90], near_plane_deg in [0, 90), step_deg positive";
+    return false;
+  }
+  return true;
+}
+
+PredictionReport CheckWithRegression(const std::vector<BrdfSample>& samples, const PredictionCheckOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("check options", why);
+  Timer timer;
+  PredictionReport report;
+
+  // Symmetries: an unfolded regression, so nothing is assumed.
+  {
+    LocalRegressionOptions unfolded = options.regression;
+    unfolded.fold_reciprocity = false;
+    unfolded.fold_bilateral = false;
+    const LocalRegression regression(samples, unfolded);
+    const double step = options.step_deg * kDegree, limit = options.max_theta_deg * kDegree + 1e-9;
+    std::vector<Eigen::Vector3d> a, b;
+    // Reciprocity: fixed incidence t0 against fixed exitance t0, near the plane on both sides.
+    std::vector<double> phis;
+    for (double d = 0.0; d <= options.near_plane_deg + 1e-9; d += options.step_deg) {
+      for (double phi : {d, -d, 180.0 - d, -(180.0 - d)}) {
+        if (std::find(phis.begin(), phis.end(), phi) == phis.end() && phi > -180.0) phis.push_back(phi);
+      }
+    }
+    for (double t0 = step; t0 <= limit; t0 += step) {
+      for (double t = step; t <= limit; t += step) {
+        if (std::abs(t - t0) < 1e-9) continue;
+        for (double phi_deg : phis) {
+          a.push_back(Coordinates(t0, t, phi_deg * kDegree));
+          b.push_back(Coordinates(t, t0, -phi_deg * kDegree));
+        }
+      }
+    }
+    report.reciprocity = ComparePairs(regression, a, b, options.min_effective_samples);
+    a.clear();
+    b.clear();
+    for (double ti = step; ti <= limit; ti += step) {
+      for (double te = step; te <= limit; te += step) {
+        for (double phi = options.step_deg; phi < 180.0 - 1e-9; phi += 2.0 * options.step_deg) {
+          a.push_back(Coordinates(ti, te, phi * kDegree));
+          b.push_back(Coordinates(ti, te, -phi * kDegree));
+        }
+      }
+    }
+    report.bilateral = ComparePairs(regression, a, b, options.min_effective_samples);
+  }
+
+  // Held-out photos, evenly spaced over the images present.
+  std::map<uint32_t, size_t> per_image;
+  for (const BrdfSample& s : samples) ++per_image[s.image];
+  std::vector<uint32_t> images;
+  for (const auto& [image, count] : per_image) images.push_back(image);
+  const int held = std::min<int>(options.held_out_photos, images.size() > 1 ? int(images.size()) : 0);
+  double sum_squares[3] = {0, 0, 0};
+  size_t total = 0;
+  for (int h = 0; h < held; ++h) {
+    const uint32_t image = images[(2 * h + 1) * images.size() / (2 * held)];
+    std::vector<BrdfSample> fit, predict;
+    for (const BrdfSample& s : samples) (s.image == image ? predict : fit).push_back(s);
+    const double max_theta = options.max_theta_deg * kDegree;
+    predict.erase(std::remove_if(predict.begin(), predict.end(),
+                                 [&](const BrdfSample& s) { return s.theta_i > max_theta || s.theta_e > max_theta; }),
+                  predict.end());
+    if (predict.size() > options.max_predicted_samples) {
+      std::mt19937_64 rng(image + 1);
+      std::shuffle(predict.begin(), predict.end(), rng);
+      predict.resize(options.max_predicted_samples);
+    }
+    const LocalRegression regression(fit, options.regression);
+    std::vector<Eigen::Vector3d> points;
+    for (const BrdfSample& s : predict) {
+      points.push_back(RegressionCoordinates(Eigen::Vector3d(s.wi[0], s.wi[1], s.wi[2]).normalized(),
+                                             Eigen::Vector3d(s.wo[0], s.wo[1], s.wo[2]).normalized()));
+    }
+    HeldOutPhoto photo;
+    photo.image = image;
+    const std::vector<Estimate> estimates = regression.EvaluateMany(points, &photo.reliability);
+    std::vector<double> abs_rel[3];
+    size_t within = 0, with_sigma = 0;
+    for (size_t i = 0; i < predict.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        const double f = predict[i].brdf[c];
+        const double rel = (estimates[i].value[c] - f) / std::max(std::abs(f), 1e-6);
+        photo.rms_rel_error[c] += rel * rel;
+        sum_squares[c] += rel * rel;
+        abs_rel[c].push_back(std::abs(rel));
+        if (predict[i].sigma[c] > 0.0f) {
+          ++with_sigma;
+          within += std::abs(estimates[i].value[c] - f) <= 2.0 * predict[i].sigma[c];
+        }
+      }
+    }
+    photo.predicted = predict.size();
+    total += predict.size();
+    for (int c = 0; c < 3; ++c) {
+      photo.rms_rel_error[c] = predict.empty() ? 0.0 : std::sqrt(photo.rms_rel_error[c] / predict.size());
+      photo.median_rel_error[c] = Percentile(abs_rel[c], 0.5);
+    }
+    if (with_sigma > 0) photo.within_2_sigma = double(within) / with_sigma;
+    report.held_out.push_back(photo);
+  }
+  for (int c = 0; c < 3; ++c) report.held_out_rms[c] = total ? std::sqrt(sum_squares[c] / total) : 0.0;
+  report.seconds = timer.ElapsedSeconds();
+  report.success = true;
+  return report;
+}
+
+std::string PredictionReport::BriefReport() const {
+  char buffer[320];
+  std::snprintf(buffer, sizeof(buffer),
+                "regression check: reciprocity near the incidence plane %.2f %% over %zu pairs; bilateral %.2f %% "
+                "over %zu pairs; %zu held-out photos, RMS prediction error R G B %.2f %.2f %.2f %%",
+                100.0 * reciprocity.mean, reciprocity.pairs, 100.0 * bilateral.mean, bilateral.pairs,
+                held_out.size(), 100.0 * held_out_rms[0], 100.0 * held_out_rms[1], 100.0 * held_out_rms[2]);
+  return buffer;
+}
+
+nlohmann::json ToJson(const PredictionReport& report, const PredictionCheckOptions& options) {
+  nlohmann::json photos = nlohmann::json::array();
+  for (const HeldOutPhoto& p : report.held_out) {
+    photos.push_back({{"image", p.image},
+                      {"predicted_samples", p.predicted},
+                      {"rms_rel_error", Rgb(p.rms_rel_error)},
+                      {"median_rel_error", Rgb(p.median_rel_error)},
+                      {"within_2_sigma", p.within_2_sigma},
+                      {"reliability", ToJson(p.reliability)}});
+  }
+  const LocalRegressionOptions& r = options.regression;
+  return {{"method",
+           "local regression (unfolded) compared at point pairs; held-out photos predicted by a fit "
+           "without them"},
+          {"options",
+           {{"degree", r.degree},
+            {"radius_h_deg", r.radius_h_deg},
+            {"radius_d_deg", r.radius_d_deg},
+            {"held_out_photos", options.held_out_photos},
+            {"max_theta_deg", options.max_theta_deg},
+            {"near_plane_deg", options.near_plane_deg},
+            {"step_deg", options.step_deg},
+            {"min_effective_samples", options.min_effective_samples}}},
+          {"reciprocity_near_incidence_plane", FigureJson(report.reciprocity)},
+          {"bilateral_symmetry", FigureJson(report.bilateral)},
+          {"held_out_photos", photos},
+          {"held_out_rms_rel_error", Rgb(report.held_out_rms)},
+          {"seconds", report.seconds}};
+}
+
+}  // namespace ibrdf

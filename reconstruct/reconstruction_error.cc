@@ -1,0 +1,113 @@
+#include "reconstruct/reconstruction_error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+namespace ibrdf {
+namespace {
+
+struct Cell {
+  HalfDiffAngles angles;
+  Eigen::Vector3d wi, wo;
+  size_t flat;
+};
+
+// Cell centres with both directions within the theta limit.
+std::vector<Cell> Cells(double max_theta_deg, int stride) {
+  const double cos_limit = std::cos(max_theta_deg * M_PI / 180.0);
+  std::vector<Cell> cells;
+  for (int i = 0; i < kMerlThetaH; i += stride) {
+    for (int j = 0; j < kMerlThetaD; j += stride) {
+      for (int k = 0; k < kMerlPhiD; k += stride) {
+        Cell cell;
+        cell.angles = MerlCellCentre(i, j, k);
+        FromHalfDiff(cell.angles, &cell.wi, &cell.wo);
+        if (!(cell.wi.z() >= cos_limit && cell.wo.z() >= cos_limit)) continue;
+        cell.flat = MerlFlatIndex(i, j, k);
+        cells.push_back(cell);
+      }
+    }
+  }
+  return cells;
+}
+
+class Accumulator {
+ public:
+  void Add(const Eigen::Vector3d& f, const Eigen::Vector3d& truth) {
+    if (!(truth.array() > 0.0).all()) return;
+    const Eigen::Vector3d rel = (f - truth).cwiseQuotient(truth);
+    sum_ += rel.cwiseAbs2();
+    for (int c = 0; c < 3; ++c) abs_[c].push_back(std::abs(rel[c]));
+    ++error_.points;
+  }
+  void Outside() { ++error_.outside; }
+  ReconstructionError Finish() {
+    if (error_.points > 0) {
+      error_.rel_rms = (sum_ / double(error_.points)).cwiseSqrt();
+      error_.rel_rms_all = std::sqrt(sum_.sum() / (3.0 * error_.points));
+      for (int c = 0; c < 3; ++c) {
+        auto mid = abs_[c].begin() + abs_[c].size() / 2;
+        std::nth_element(abs_[c].begin(), mid, abs_[c].end());
+        error_.median[c] = *mid;
+      }
+    }
+    return error_;
+  }
+
+ private:
+  ReconstructionError error_;
+  Eigen::Vector3d sum_ = Eigen::Vector3d::Zero();
+  std::vector<double> abs_[3];
+};
+
+}  // namespace
+
+std::string ReconstructionError::Brief() const {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "relative RMS error R G B %.2f %.2f %.2f %% (all %.2f %%) over %zu cells (coverage %.1f %%)",
+                100 * rel_rms[0], 100 * rel_rms[1], 100 * rel_rms[2], 100 * rel_rms_all, points, 100 * coverage());
+  return buffer;
+}
+
+ReconstructionError CompareRegressionWithTruth(const LocalRegression& regression, const BrdfModel& truth,
+                                               double max_theta_deg, int stride) {
+  const std::vector<Cell> cells = Cells(max_theta_deg, std::max(1, stride));
+  std::vector<Eigen::Vector3d> points;
+  for (const Cell& cell : cells) points.push_back(RegressionCoordinates(cell.angles));
+  const std::vector<Estimate> estimates = regression.EvaluateMany(points, nullptr);
+  Accumulator accumulator;
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const Estimate& e = estimates[i];
+    if (e.status == EstimateStatus::kGrown || e.status == EstimateStatus::kUnsupported) {
+      accumulator.Outside();
+      continue;
+    }
+    accumulator.Add(e.value, truth.Eval(cells[i].wi, cells[i].wo));
+  }
+  return accumulator.Finish();
+}
+
+ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfModel& truth, double max_theta_deg) {
+  Accumulator accumulator;
+  for (const Cell& cell : Cells(max_theta_deg, 1)) {
+    if (!table.Measured(cell.flat)) {
+      accumulator.Outside();
+      continue;
+    }
+    accumulator.Add(table.Cell(cell.flat), truth.Eval(cell.wi, cell.wo));
+  }
+  return accumulator.Finish();
+}
+
+nlohmann::json ToJson(const ReconstructionError& error) {
+  auto rgb = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
+  return {{"cells_scored", error.points},     {"cells_outside", error.outside},
+          {"coverage", error.coverage()},     {"rel_rms_error", rgb(error.rel_rms)},
+          {"rel_rms_error_all", error.rel_rms_all}, {"median_abs_rel_error", rgb(error.median)}};
+}
+
+}  // namespace ibrdf

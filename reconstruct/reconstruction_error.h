@@ -1,0 +1,36 @@
+// A reconstructed BRDF against a known true BRDF (synthetic sessions): relative RMS error over the MERL
+// cell centres of the measured domain, theta_i and theta_e up to a limit (80 degrees, the derenderer's
+// grazing limit) and with samples within the kernel (estimates that had to grow their support, i.e.
+// configurations the session never photographed, are counted but not scored).
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/brdf_model.h"
+#include "reconstruct/local_regression.h"
+#include "reconstruct/merl_table.h"
+
+namespace ibrdf {
+
+struct ReconstructionError {
+  size_t points = 0;         // cells scored
+  size_t outside = 0;        // cells within the theta limit left out (no samples within the kernel)
+  Eigen::Vector3d rel_rms = Eigen::Vector3d::Zero();  // per channel, of (f - f_true) / f_true
+  double rel_rms_all = 0.0;  // over channels
+  Eigen::Vector3d median = Eigen::Vector3d::Zero();   // of |f - f_true| / f_true
+  double coverage() const { return points + outside ? double(points) / double(points + outside) : 0.0; }
+  std::string Brief() const;
+};
+
+// Evaluates the regression at every `stride`-th cell centre (in each index) with theta up to the limit.
+ReconstructionError CompareRegressionWithTruth(const LocalRegression& regression, const BrdfModel& truth,
+                                               double max_theta_deg = 80.0, int stride = 1);
+// The same over a tabulated MERL table (unmeasured cells count as outside).
+ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfModel& truth, double max_theta_deg = 80.0);
+
+nlohmann::json ToJson(const ReconstructionError& error);
+
+}  // namespace ibrdf

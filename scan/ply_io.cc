@@ -1,0 +1,479 @@
+#include "scan/ply_io.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include "core/error.h"
+#include "core/file_util.h"
+
+namespace ibrdf {
+namespace {
+
+enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
+
+bool ParseType(const std::string& name, PlyType* type) {
+  static const std::pair<const char*, PlyType> kTypes[] = {
+      {"char", PlyType::kInt8},     {"int8", PlyType::kInt8},       {"uchar", PlyType::kUint8},
+      {"uint8", PlyType::kUint8},   {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
+      {"ushort", PlyType::kUint16}, {"uint16", PlyType::kUint16},   {"int", PlyType::kInt32},
+      {"int32", PlyType::kInt32},   {"uint", PlyType::kUint32},     {"uint32", PlyType::kUint32},
+      {"float", PlyType::kFloat32}, {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
+      {"float64", PlyType::kFloat64}};
+  for (const auto& [type_name, value] : kTypes) {
+    if (name == type_name) {
+      *type = value;
+      return true;
+    }
+  }
+  return false;
+}
+
+int TypeSize(PlyType type) {
+  switch (type) {
+    case PlyType::kInt8:
+    case PlyType::kUint8: return 1;
+    case PlyType::kInt16:
+    case PlyType::kUint16: return 2;
+    case PlyType::kInt32:
+    case PlyType::kUint32:
+    case PlyType::kFloat32: return 4;
+    case PlyType::kFloat64: return 8;
+  }
+  return 0;
+}
+
+bool IsInteger(PlyType type) { return type != PlyType::kFloat32 && type != PlyType::kFloat64; }
+
+struct Property {
+  std::string name;
+  bool is_list = false;
+  PlyType count_type = PlyType::kUint8;  // lists only
+  PlyType type = PlyType::kFloat32;
+};
+
+struct Element {
+  std::string name;
+  uint64_t count = 0;
+  std::vector<Property> properties;
+  int header_line = 0;
+};
+
+enum class Format { kAscii, kBinaryLittle, kBinaryBig };
+
+struct Header {
+  Format format = Format::kAscii;
+  std::vector<Element> elements;
+  int num_cols = -1, num_rows = -1;  // obj_info of Cyberware range images
+  size_t body_offset = 0;
+};
+
+std::string ReadWholeFile(const std::string& path) {
+  RequireFile(path, "scan file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) ThrowError(path, "cannot open for reading");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+std::vector<std::string> Split(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> words;
+  std::string word;
+  while (in >> word) words.push_back(word);
+  return words;
+}
+
+bool ParseCount(const std::string& text, uint64_t* value) {
+  if (text.empty() || text[0] == '-') return false;
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+  if (errno != 0 || *end != '\0') return false;
+  *value = v;
+  return true;
+}
+
+Header ParseHeader(const std::string& data, const std::string& path) {
+  if (data.empty()) ThrowError(path, "empty file (expected a PLY header starting with 'ply')");
+  Header header;
+  size_t pos = 0;
+  int line_number = 0;
+  bool saw_format = false, saw_end = false;
+  auto where = [&](int line) { return path + ": header line " + std::to_string(line); };
+  while (pos < data.size()) {
+    const size_t end = data.find('\n', pos);
+    if (end == std::string::npos) break;
+    std::string line = data.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line_number == 1) {
+      if (line != "ply") ThrowError(path, "not a PLY file (the first line is not 'ply')");
+      continue;
+    }
+    const std::vector<std::string> words = Split(line);
+    if (words.empty()) continue;
+    const std::string& keyword = words[0];
+    if (keyword == "format") {
+      if (words.size() != 3 || words[2] != "1.0") ThrowError(where(line_number), "expected 'format <type> 1.0'");
+      if (words[1] == "ascii") {
+        header.format = Format::kAscii;
+      } else if (words[1] == "binary_little_endian") {
+        header.format = Format::kBinaryLittle;
+      } else if (words[1] == "binary_big_endian") {
+        header.format = Format::kBinaryBig;
+      } else {
+        ThrowError(where(line_number), "unknown format '" + words[1] + "'");
+      }
+      saw_format = true;
+    } else if (keyword == "comment") {
+      continue;
+    } else if (keyword == "obj_info") {
+      if (words.size() >= 3 && (words[1] == "num_cols" || words[1] == "num_rows")) {
+        uint64_t v = 0;
+        if (!ParseCount(words[2], &v) || v > 1000000) ThrowError(where(line_number), "bad " + words[1]);
+        (words[1] == "num_cols" ? header.num_cols : header.num_rows) = static_cast<int>(v);
+      }
+    } else if (keyword == "element") {
+      Element element;
+      if (words.size() != 3 || !ParseCount(words[2], &element.count)) {
+        ThrowError(where(line_number), "expected 'element <name> <count>'");
+      }
+      element.name = words[1];
+      element.header_line = line_number;
+      header.elements.push_back(element);
+    } else if (keyword == "property") {
+      if (header.elements.empty()) ThrowError(where(line_number), "property before any element");
+      Property property;
+      if (words.size() == 5 && words[1] == "list") {
+        property.is_list = true;
+        if (!ParseType(words[2], &property.count_type) || !IsInteger(property.count_type)) {
+          ThrowError(where(line_number), "list count type '" + words[2] + "' is not an integer type");
+        }
+        if (!ParseType(words[3], &property.type)) ThrowError(where(line_number), "unknown type '" + words[3] + "'");
+        property.name = words[4];
+      } else if (words.size() == 3) {
+        if (!ParseType(words[1], &property.type)) ThrowError(where(line_number), "unknown type '" + words[1] + "'");
+        property.name = words[2];
+      } else {
+        ThrowError(where(line_number), "expected 'property <type> <name>' or 'property list <type> <type> <name>'");
+      }
+      header.elements.back().properties.push_back(property);
+    } else if (keyword == "end_header") {
+      saw_end = true;
+      break;
+    } else {
+      ThrowError(where(line_number), "unknown header line '" + keyword + "'");
+    }
+  }
+  if (!saw_end) ThrowError(path, "the header has no end_header line (truncated file?)");
+  if (!saw_format) ThrowError(path, "the header has no format line");
+  header.body_offset = pos;
+  return header;
+}
+
+// Reads the values of one element instance, whichever the format.
+class BodyReader {
+ public:
+  BodyReader(const std::string& data, const Header& header, const std::string& path)
+      : data_(data), format_(header.format), pos_(header.body_offset), path_(path) {}
+
+  // Starts an instance (ASCII: one line). Returns false at the end of the data.
+  bool BeginInstance() {
+    if (format_ != Format::kAscii) return pos_ < data_.size();
+    // Skip blank lines.
+    while (pos_ < data_.size()) {
+      size_t end = data_.find('\n', pos_);
+      if (end == std::string::npos) end = data_.size();
+      line_begin_ = pos_;
+      line_end_ = end;
+      pos_ = std::min(end + 1, data_.size());
+      cursor_ = line_begin_;
+      SkipSpaces();
+      if (cursor_ < line_end_) return true;
+    }
+    return false;
+  }
+
+  // True if the current ASCII line has unread values.
+  bool LineHasMore() {
+    SkipSpaces();
+    return cursor_ < line_end_;
+  }
+
+  bool Read(PlyType type, double* value) {
+    if (format_ == Format::kAscii) return ReadAscii(type, value);
+    const int size = TypeSize(type);
+    if (pos_ + size > data_.size()) return false;
+    unsigned char bytes[8];
+    std::memcpy(bytes, data_.data() + pos_, size);
+    pos_ += size;
+    if (format_ == Format::kBinaryBig) std::reverse(bytes, bytes + size);
+    switch (type) {
+      case PlyType::kInt8: *value = static_cast<int8_t>(bytes[0]); break;
+      case PlyType::kUint8: *value = bytes[0]; break;
+      case PlyType::kInt16: { int16_t v; std::memcpy(&v, bytes, 2); *value = v; break; }
+      case PlyType::kUint16: { uint16_t v; std::memcpy(&v, bytes, 2); *value = v; break; }
+      case PlyType::kInt32: { int32_t v; std::memcpy(&v, bytes, 4); *value = v; break; }
+      case PlyType::kUint32: { uint32_t v; std::memcpy(&v, bytes, 4); *value = v; break; }
+      case PlyType::kFloat32: { float v; std::memcpy(&v, bytes, 4); *value = v; break; }
+      case PlyType::kFloat64: { double v; std::memcpy(&v, bytes, 8); *value = v; break; }
+    }
+    return true;
+  }
+
+  // True if anything but white space is left after the last element.
+  bool HasTrailingData() {
+    if (format_ != Format::kAscii) return pos_ < data_.size();
+    for (size_t i = pos_; i < data_.size(); ++i) {
+      if (!std::isspace(static_cast<unsigned char>(data_[i]))) return true;
+    }
+    return false;
+  }
+
+  bool ascii() const { return format_ == Format::kAscii; }
+
+ private:
+  void SkipSpaces() {
+    while (cursor_ < line_end_ && std::isspace(static_cast<unsigned char>(data_[cursor_]))) ++cursor_;
+  }
+
+  bool ReadAscii(PlyType type, double* value) {
+    SkipSpaces();
+    if (cursor_ >= line_end_) return false;
+    size_t end = cursor_;
+    while (end < line_end_ && !std::isspace(static_cast<unsigned char>(data_[end]))) ++end;
+    token_.assign(data_, cursor_, end - cursor_);
+    cursor_ = end;
+    char* parse_end = nullptr;
+    if (IsInteger(type)) {
+      errno = 0;
+      const long long v = std::strtoll(token_.c_str(), &parse_end, 10);
+      if (errno != 0 || *parse_end != '\0') {
+        ThrowError(path_, "'" + token_ + "' is not an integer" + Context());
+      }
+      *value = static_cast<double>(v);
+    } else {
+      *value = std::strtod(token_.c_str(), &parse_end);
+      if (*parse_end != '\0' || parse_end == token_.c_str()) {
+        ThrowError(path_, "'" + token_ + "' is not a number" + Context());
+      }
+    }
+    return true;
+  }
+
+ public:
+  std::string Context() const {
+    if (format_ != Format::kAscii) return " (byte " + std::to_string(pos_) + ")";
+    size_t line = 1;
+    for (size_t i = 0; i < line_begin_ && i < data_.size(); ++i) line += data_[i] == '\n';
+    return " (line " + std::to_string(line) + ")";
+  }
+
+ private:
+  const std::string& data_;
+  Format format_;
+  size_t pos_;
+  size_t line_begin_ = 0, line_end_ = 0, cursor_ = 0;
+  std::string token_;
+  const std::string& path_;
+};
+
+int FindProperty(const Element& element, const char* name) {
+  for (size_t i = 0; i < element.properties.size(); ++i) {
+    if (element.properties[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+}  // namespace
+
+ScanMesh ReadPly(const std::string& path) {
+  const std::string data = ReadWholeFile(path);
+  const Header header = ParseHeader(data, path);
+  ScanMesh mesh;
+  BodyReader reader(data, header, path);
+  bool have_grid = false;
+  std::vector<std::vector<int>> polygons;
+
+  for (const Element& element : header.elements) {
+    const std::string what = element.name == "vertex" ? "vertices" : element.name + " entries";
+    const bool is_vertex = element.name == "vertex";
+    const bool is_face = element.name == "face";
+    const bool is_grid = element.name == "range_grid";
+    int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ilist = -1;
+    if (is_vertex) {
+      if (!mesh.points.empty()) ThrowError(path, "more than one vertex element");
+      ix = FindProperty(element, "x");
+      iy = FindProperty(element, "y");
+      iz = FindProperty(element, "z");
+      if (ix < 0 || iy < 0 || iz < 0) ThrowError(path, "the vertex element needs properties x, y and z");
+      inx = FindProperty(element, "nx");
+      iny = FindProperty(element, "ny");
+      inz = FindProperty(element, "nz");
+      if (!(inx >= 0 && iny >= 0 && inz >= 0)) inx = iny = inz = -1;
+      if (element.count > 500000000ull) ThrowError(path, "implausible vertex count " + std::to_string(element.count));
+      mesh.points.reserve(element.count);
+      if (inx >= 0) mesh.normals.reserve(element.count);
+    }
+    if (is_face || is_grid) {
+      ilist = FindProperty(element, "vertex_indices");
+      if (ilist < 0) ilist = FindProperty(element, "vertex_index");
+      if (ilist < 0 || !element.properties[ilist].is_list || !IsInteger(element.properties[ilist].type)) {
+        ThrowError(path, "the " + element.name + " element needs an integer list 'vertex_indices'");
+      }
+    }
+    if (is_grid) {
+      if (have_grid) ThrowError(path, "more than one range_grid element");
+      if (header.num_cols <= 0 || header.num_rows <= 0) {
+        ThrowError(path, "a range_grid element needs 'obj_info num_cols' and 'obj_info num_rows' in the header");
+      }
+      if (element.count != static_cast<uint64_t>(header.num_cols) * header.num_rows) {
+        ThrowError(path, "range_grid has " + std::to_string(element.count) + " cells, but num_cols x num_rows is " +
+                             std::to_string(header.num_cols) + " x " + std::to_string(header.num_rows));
+      }
+      have_grid = true;
+      mesh.grid.rows = header.num_rows;
+      mesh.grid.cols = header.num_cols;
+      mesh.grid.cell_point.assign(element.count, -1);
+    }
+
+    double values[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
+    std::vector<int> list;
+    for (uint64_t i = 0; i < element.count; ++i) {
+      if (!reader.BeginInstance()) {
+        ThrowError(path, "the file ends after " + std::to_string(i) + " of " + std::to_string(element.count) + " " +
+                             what + " (truncated, or the header's count is wrong)");
+      }
+      for (size_t p = 0; p < element.properties.size(); ++p) {
+        const Property& property = element.properties[p];
+        auto fail = [&] {
+          ThrowError(path, "the file ends inside " + element.name + " " + std::to_string(i) + " of " +
+                               std::to_string(element.count) + " (truncated, or the header's count is wrong)" +
+                               reader.Context());
+        };
+        double value = 0.0;
+        if (!property.is_list) {
+          if (!reader.Read(property.type, &value)) fail();
+          const int ip = static_cast<int>(p);
+          if (ip == ix) values[0] = value;
+          if (ip == iy) values[1] = value;
+          if (ip == iz) values[2] = value;
+          if (ip == inx) normal[0] = value;
+          if (ip == iny) normal[1] = value;
+          if (ip == inz) normal[2] = value;
+          continue;
+        }
+        double count = 0.0;
+        if (!reader.Read(property.count_type, &count)) fail();
+        if (count < 0 || count > 1000) {
+          ThrowError(path, element.name + " " + std::to_string(i) + ": bad list length " + std::to_string(count) +
+                               reader.Context());
+        }
+        if (static_cast<int>(p) == ilist) list.clear();
+        for (int k = 0; k < static_cast<int>(count); ++k) {
+          if (!reader.Read(property.type, &value)) fail();
+          if (static_cast<int>(p) == ilist) list.push_back(static_cast<int>(value));
+        }
+      }
+      if (reader.ascii() && reader.LineHasMore()) {
+        ThrowError(path, element.name + " " + std::to_string(i) + " has more values than the header declares" +
+                             reader.Context());
+      }
+      if (is_vertex) {
+        mesh.points.emplace_back(values[0], values[1], values[2]);
+        if (inx >= 0) mesh.normals.emplace_back(normal[0], normal[1], normal[2]);
+      } else if (is_face) {
+        if (list.size() < 3) {
+          ThrowError(path, "face " + std::to_string(i) + " has " + std::to_string(list.size()) + " vertices (at least 3 needed)");
+        }
+        polygons.push_back(list);
+      } else if (is_grid) {
+        if (list.size() > 1) {
+          ThrowError(path, "range_grid cell " + std::to_string(i) + " lists " + std::to_string(list.size()) +
+                               " vertices (0 or 1 expected)");
+        }
+        if (!list.empty()) mesh.grid.cell_point[i] = list[0];
+      }
+    }
+  }
+  if (reader.HasTrailingData()) {
+    ThrowError(path, "data after the last element: the header's counts are wrong" + reader.Context());
+  }
+  // Indices and coordinates.
+  const int n = static_cast<int>(mesh.points.size());
+  for (size_t i = 0; i < polygons.size(); ++i) {
+    for (int v : polygons[i]) {
+      if (v < 0 || v >= n) {
+        ThrowError(path, "face " + std::to_string(i) + " refers to vertex " + std::to_string(v) + ", but there are " +
+                             std::to_string(n) + " vertices");
+      }
+    }
+    for (size_t k = 1; k + 1 < polygons[i].size(); ++k) {
+      mesh.faces.emplace_back(polygons[i][0], polygons[i][k], polygons[i][k + 1]);
+    }
+  }
+  for (size_t c = 0; c < mesh.grid.cell_point.size(); ++c) {
+    const int v = mesh.grid.cell_point[c];
+    if (v >= n) {
+      ThrowError(path, "range_grid cell " + std::to_string(c) + " refers to vertex " + std::to_string(v) +
+                           ", but there are " + std::to_string(n) + " vertices");
+    }
+  }
+  RequireFinitePoints(mesh, path);
+  for (size_t i = 0; i < mesh.normals.size(); ++i) {
+    if (!mesh.normals[i].allFinite()) ThrowError(path, "vertex " + std::to_string(i) + " has a NaN or infinite normal");
+  }
+  if (mesh.points.empty()) ThrowError(path, "no vertices");
+  return mesh;
+}
+
+void WritePly(const std::string& path, const ScanMesh& mesh) {
+  const size_t n = mesh.points.size();
+  const bool normals = mesh.normals.size() == n && n > 0;
+  const bool rms = mesh.fit_rms_m.size() == n && n > 0;
+  const bool neighbours = mesh.fit_neighbours.size() == n && n > 0;
+  const bool hull = mesh.hull_distance_m.size() == n && n > 0;
+  AtomicFile file(path);
+  {
+    std::ofstream out(file.temporary_path(), std::ios::binary);
+    if (!out) ThrowError(path, "cannot open for writing");
+    out << "ply\nformat binary_little_endian 1.0\ncomment ibrdf scan (lengths in metres)\n";
+    out << "element vertex " << n << "\nproperty double x\nproperty double y\nproperty double z\n";
+    if (normals) out << "property float nx\nproperty float ny\nproperty float nz\n";
+    if (rms) out << "property float quality\n";
+    if (neighbours) out << "property int fit_neighbours\n";
+    if (hull) out << "property float hull_distance\n";
+    out << "element face " << mesh.faces.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+    static_assert(sizeof(float) == 4 && sizeof(int32_t) == 4, "PLY sizes");
+    auto put = [&out](const auto& value) { out.write(reinterpret_cast<const char*>(&value), sizeof(value)); };
+    for (size_t i = 0; i < n; ++i) {
+      for (int k = 0; k < 3; ++k) put(mesh.points[i][k]);
+      if (normals) {
+        for (int k = 0; k < 3; ++k) put(static_cast<float>(mesh.normals[i][k]));
+      }
+      if (rms) put(mesh.fit_rms_m[i]);
+      if (neighbours) put(static_cast<int32_t>(mesh.fit_neighbours[i]));
+      if (hull) put(mesh.hull_distance_m[i]);
+    }
+    for (const Eigen::Vector3i& f : mesh.faces) {
+      put(static_cast<uint8_t>(3));
+      for (int k = 0; k < 3; ++k) put(static_cast<int32_t>(f[k]));
+    }
+    out.flush();
+    if (!out) ThrowError(path, "write failed (disk full?)");
+  }
+  file.Commit();
+}
+
+}  // namespace ibrdf
