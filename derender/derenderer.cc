@@ -2,6 +2,7 @@
 
 #include <array>
 #include <atomic>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <mutex>
@@ -34,6 +35,44 @@ double SignalVariance(const RadiometrySpec& radiometry, double encoded, double l
     variance += (step * slope) * (step * slope) / 12.0;
   }
   return variance;
+}
+
+// The pixel box [x0, x1) x [y0, y1) that holds the projection of the sample's bounding sphere in one
+// photo, with a 2-pixel margin; the whole image where the cone around the sphere is too wide to
+// project (or holds the camera). Pixels outside it cannot see the sample.
+struct PixelBox {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+PixelBox SampleBox(const Camera& camera, const Rigid3d& camera_from_world, const AnalyticSample& sample) {
+  const PixelBox whole{0, 0, camera.width, camera.height};
+  const Eigen::Vector3d c = camera_from_world * sample.BoundingCenter();
+  const double distance = c.norm();
+  const double radius = sample.BoundingRadius();
+  if (!(distance > 1.5 * radius)) return whole;
+  const Eigen::Vector3d axis = c / distance;
+  const double sin_alpha = radius / distance, cos_alpha = std::sqrt(1.0 - sin_alpha * sin_alpha);
+  const Eigen::Vector3d u = axis.unitOrthogonal(), v = axis.cross(u);
+  double x_min = 1e300, x_max = -1e300, y_min = 1e300, y_max = -1e300;
+  constexpr int kPoints = 64;
+  for (int k = 0; k < kPoints; ++k) {
+    const double angle = 2.0 * M_PI * k / kPoints;
+    const Eigen::Vector3d d = cos_alpha * axis + sin_alpha * (std::cos(angle) * u + std::sin(angle) * v);
+    if (!(d.z() > 0.1)) return whole;  // near or behind the image plane's horizon: do not cull
+    const Eigen::Vector2d p = camera.ImageFromCamera(d);
+    if (!p.allFinite()) return whole;
+    x_min = std::min(x_min, p.x());
+    x_max = std::max(x_max, p.x());
+    y_min = std::min(y_min, p.y());
+    y_max = std::max(y_max, p.y());
+  }
+  // The 64-gon's chords fall short of the curve by under 0.002 of its radius; 2 pixels cover that.
+  PixelBox box;
+  box.x0 = std::clamp(static_cast<int>(std::floor(x_min)) - 2, 0, camera.width);
+  box.x1 = std::clamp(static_cast<int>(std::ceil(x_max)) + 2, 0, camera.width);
+  box.y0 = std::clamp(static_cast<int>(std::floor(y_min)) - 2, 0, camera.height);
+  box.y1 = std::clamp(static_cast<int>(std::ceil(y_max)) + 2, 0, camera.height);
+  return box;
 }
 
 }  // namespace
@@ -107,8 +146,13 @@ void DerenderPhoto(const Session& session, size_t photo_index, const Image& imag
   enum { kOff, kUnlit, kGrazingE, kGrazingI, kNonFinite, kSaturated, kBelow, kNumReasons };
   std::array<uint64_t, kNumReasons> counts{};
 
-  for (int y = 0; y < image.height; y += stride) {
-    for (int x = 0; x < image.width; x += stride) {
+  // Only the pixels that can see the sample are traced; the others are off the sample by construction.
+  const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, sample);
+  const int x_start = (box.x0 + stride - 1) / stride * stride, y_start = (box.y0 + stride - 1) / stride * stride;
+  uint64_t traced = 0;
+  for (int y = y_start; y < box.y1; y += stride) {
+    for (int x = x_start; x < box.x1; x += stride) {
+      ++traced;
       const Eigen::Vector2f& xy = rays[size_t(y) * image.width + x];
       const Eigen::Vector3d direction =
           (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
@@ -177,6 +221,8 @@ void DerenderPhoto(const Session& session, size_t photo_index, const Image& imag
       samples->push_back(s);
     }
   }
+  const uint64_t examined = uint64_t((image.width + stride - 1) / stride) * uint64_t((image.height + stride - 1) / stride);
+  counts[kOff] += examined - traced;
   const auto& reasons = RejectionReasons();
   for (int r = 0; r < kNumReasons; ++r) (*rejected)[reasons[r].first] += counts[r];
 }
@@ -206,6 +252,7 @@ DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& o
   std::vector<double> decode_s(session.photos.size(), 0.0);
   ProgressBar progress("photos", session.photos.size());
   tbb::parallel_for(size_t(0), session.photos.size(), [&](size_t i) {
+    if (session.photos[i].role == PhotoRole::kTargets) { progress.Add(1); return; }  // alignment-only photos
     Timer decode_timer;
     const Image image = ReadImage(session.PhotoPath(i));
     decode_s[i] = decode_timer.ElapsedSeconds();
