@@ -1,6 +1,7 @@
 #include "reconstruct/local_regression.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <mutex>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "core/error.h"
 
@@ -41,11 +43,19 @@ struct Mirror {
 
 // Accumulates the weighted normal equations of a degree-2 fit directly from the kd-tree's radius search
 // (no neighbour list is stored). Degree 1 and 0 use leading blocks of the same matrices, because the
-// basis is nested: 1, x, y, z, x^2, y^2, z^2, xy, xz, yz.
+// basis is nested: 1, x, y, z, x^2, y^2, z^2, xy, xz, yz. A point is a bin of `counts[index]` samples
+// at its centroid with their mean value: it adds count * w to the weights and count * w^2 to the
+// squared weights, as that many samples at one place would.
 struct NormalEquations {
   const float* xyz = nullptr;
-  const float* values = nullptr;
+  const float* values = nullptr;       // mean value of each point
+  const float* ranges = nullptr;       // low[3], high[3] of each point's samples
+  const uint32_t* counts = nullptr;    // samples of each point
+  // Leave-one-out: the point holding the left-out sample, and that sample's position and value, which
+  // are taken out of the point's statistics.
   int64_t exclude = -1;
+  const float* exclude_xyz = nullptr;
+  const float* exclude_value = nullptr;
   float query[3] = {0, 0, 0};
   Mirror mirror{1, 1};
   float radius = 1.0f;  // of the support in scaled units (the growth factor)
@@ -56,42 +66,62 @@ struct NormalEquations {
   double b[kMaxCoefficients][3] = {};
   double sum_w = 0.0, sum_w2 = 0.0;
   float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};  // range of the neighbours' values
-  uint32_t count = 0;
+  uint32_t count = 0;   // samples with non-zero weight
+  uint32_t points = 0;  // points (bins) with non-zero weight
 
   // nanoflann's result-set interface.
   float worstDist() const { return radius_squared; }
-  size_t size() const { return count; }
+  size_t size() const { return points; }
   bool full() const { return true; }
   bool addPoint(float distance_squared, uint32_t index) {
-    if (distance_squared >= radius_squared || static_cast<int64_t>(index) == exclude) return true;
+    if (distance_squared >= radius_squared) return true;
+    const float* p = xyz + 3 * size_t(index);
+    const float* f = values + 3 * size_t(index);
+    double n = counts[index];
+    float position[3] = {p[0], p[1], p[2]};
+    float mean[3] = {f[0], f[1], f[2]};
+    if (static_cast<int64_t>(index) == exclude) {
+      if (n <= 1.0) return true;
+      double d2 = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        position[k] = static_cast<float>((n * p[k] - exclude_xyz[k]) / (n - 1.0));
+        mean[k] = static_cast<float>((n * f[k] - exclude_value[k]) / (n - 1.0));
+        const double dk = double(position[k]) - query[k];
+        d2 += dk * dk;
+      }
+      n -= 1.0;
+      distance_squared = static_cast<float>(d2);
+      if (distance_squared >= radius_squared) return true;
+    }
     const double r = std::sqrt(double(distance_squared)) / radius;
     const double t = 1.0 - r * r * r;
     const double w = t * t * t;
     if (!(w > 0.0)) return true;
-    const float* p = xyz + 3 * size_t(index);
-    const double dx = mirror.su * (p[0] - query[0]) / radius;
-    const double dy = mirror.sv * (p[1] - query[1]) / radius;
-    const double dz = (p[2] - query[2]) / radius;
+    const double dx = mirror.su * (position[0] - query[0]) / radius;
+    const double dy = mirror.sv * (position[1] - query[1]) / radius;
+    const double dz = (position[2] - query[2]) / radius;
     const double basis[kMaxCoefficients] = {1.0, dx, dy, dz, dx * dx, dy * dy, dz * dz, dx * dy, dx * dz, dy * dz};
-    const float* f = values + 3 * size_t(index);
+    const float* range = ranges + 6 * size_t(index);
     for (int c = 0; c < 3; ++c) {
-      low[c] = count == 0 ? f[c] : std::min(low[c], f[c]);
-      high[c] = count == 0 ? f[c] : std::max(high[c], f[c]);
+      low[c] = points == 0 ? range[c] : std::min(low[c], range[c]);
+      high[c] = points == 0 ? range[3 + c] : std::max(high[c], range[3 + c]);
     }
+    const double nw = n * w, nw2 = nw * w;
     for (int i = 0; i < kMaxCoefficients; ++i) {
-      const double wb = w * basis[i];
-      const double w2b = w * wb;
+      const double wb = nw * basis[i];
+      const double w2b = nw2 * basis[i];
       for (int j = i; j < kMaxCoefficients; ++j) {
         a[i][j] += wb * basis[j];
         a2[i][j] += w2b * basis[j];
       }
-      b[i][0] += wb * f[0];
-      b[i][1] += wb * f[1];
-      b[i][2] += wb * f[2];
+      b[i][0] += wb * mean[0];
+      b[i][1] += wb * mean[1];
+      b[i][2] += wb * mean[2];
     }
-    sum_w += w;
-    sum_w2 += w * w;
-    ++count;
+    sum_w += nw;
+    sum_w2 += nw2;
+    count += static_cast<uint32_t>(n);
+    ++points;
     return true;
   }
   void Reset() {
@@ -99,15 +129,21 @@ struct NormalEquations {
     for (auto& row : a2) std::fill(std::begin(row), std::end(row), 0.0);
     for (auto& row : b) std::fill(std::begin(row), std::end(row), 0.0);
     sum_w = sum_w2 = 0.0;
-    count = 0;
+    count = points = 0;
   }
 };
 
 }  // namespace
 
 struct LocalRegression::Impl {
-  Cloud cloud;
-  std::vector<float> values;  // 3 a point (log f in log space)
+  Cloud cloud;                  // the points: bin centroids (every sample without binning), scaled
+  std::vector<float> values;    // 3 a point: mean value (log f in log space)
+  std::vector<float> ranges;    // 6 a point: low[3], high[3] of its samples' values
+  std::vector<uint32_t> counts; // samples a point
+  // Every kept sample (scaled, folded coordinates and value) and the point it went to, for
+  // leave-one-out.
+  std::vector<float> sample_xyz, sample_values;
+  std::vector<uint32_t> sample_point;
   std::unique_ptr<Tree> tree;
   std::vector<Mirror> mirrors;  // the identity first
   bool fold_reciprocity = false, fold_bilateral = false;
@@ -159,6 +195,10 @@ bool LocalRegressionOptions::Check(std::string* why) const {
   }
   if (min_neighbors < 1 || !(max_growth >= 1.0)) {
     *why = "min_neighbors must be at least 1 and max_growth at least 1";
+    return false;
+  }
+  if (!(bin_fraction_h >= 0.0 && bin_fraction_h <= 1.0) || !(bin_fraction_d >= 0.0 && bin_fraction_d <= 1.0)) {
+    *why = "bin fractions must be in [0, 1]";
     return false;
   }
   if (log_space && !(log_floor > 0.0)) {
@@ -272,15 +312,66 @@ LocalRegression::LocalRegression(const std::vector<BrdfSample>& samples, const L
   values.resize(3 * kept);
   xyz.shrink_to_fit();
   values.shrink_to_fit();
-  impl.cloud.xyz = std::move(xyz);
-  impl.values = std::move(values);
+
+  // Bins: sort the samples by cell key, then one point per run of equal keys.
+  const bool binning = options.bin_fraction_h > 0.0 && options.bin_fraction_d > 0.0;
+  // Key: the cell (three int32 indices; unique per sample without binning) and the sample index.
+  using Keyed = std::pair<std::array<int32_t, 3>, uint32_t>;
+  std::vector<Keyed> keyed(kept);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, kept, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      std::array<int32_t, 3> cell = {static_cast<int32_t>(i), 0, 0};
+      if (binning) {
+        for (int k = 0; k < 3; ++k) {
+          const double edge = k < 2 ? options.bin_fraction_h : options.bin_fraction_d;
+          cell[k] = static_cast<int32_t>(std::clamp(std::floor(xyz[3 * i + k] / edge), -2.0e9, 2.0e9));
+        }
+      }
+      keyed[i] = {cell, static_cast<uint32_t>(i)};
+    }
+  });
+  if (binning) tbb::parallel_sort(keyed.begin(), keyed.end());
+  impl.sample_point.resize(kept);
+  for (size_t begin = 0; begin < kept;) {
+    size_t end = begin + 1;
+    while (end < kept && keyed[end].first == keyed[begin].first) ++end;
+    const uint32_t point = static_cast<uint32_t>(impl.counts.size());
+    double centroid[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
+    float low[3], high[3];
+    for (size_t r = begin; r < end; ++r) {
+      const uint32_t i = keyed[r].second;
+      impl.sample_point[i] = point;
+      for (int k = 0; k < 3; ++k) {
+        centroid[k] += xyz[3 * i + k];
+        const float f = values[3 * i + k];
+        mean[k] += f;
+        low[k] = r == begin ? f : std::min(low[k], f);
+        high[k] = r == begin ? f : std::max(high[k], f);
+      }
+    }
+    const double count = double(end - begin);
+    for (int k = 0; k < 3; ++k) impl.cloud.xyz.push_back(static_cast<float>(centroid[k] / count));
+    for (int k = 0; k < 3; ++k) impl.values.push_back(static_cast<float>(mean[k] / count));
+    for (int k = 0; k < 3; ++k) impl.ranges.push_back(low[k]);
+    for (int k = 0; k < 3; ++k) impl.ranges.push_back(high[k]);
+    impl.counts.push_back(static_cast<uint32_t>(end - begin));
+    begin = end;
+  }
+  impl.cloud.xyz.shrink_to_fit();
+  impl.values.shrink_to_fit();
+  impl.ranges.shrink_to_fit();
+  impl.counts.shrink_to_fit();
+  impl.sample_xyz = std::move(xyz);
+  impl.sample_values = std::move(values);
   impl.tree = std::make_unique<Tree>(3, impl.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(24));
   if (kept > 0) impl.tree->buildIndex();
 }
 
 LocalRegression::~LocalRegression() = default;
 
-size_t LocalRegression::size() const { return impl_->values.size() / 3; }
+size_t LocalRegression::size() const { return impl_->sample_values.size() / 3; }
+
+size_t LocalRegression::points() const { return impl_->counts.size(); }
 
 Estimate LocalRegression::Evaluate(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const {
   return EvaluateAt(RegressionCoordinates(wi, wo));
@@ -303,7 +394,13 @@ Estimate LocalRegression::EvaluateAt(const Eigen::Vector3d& uvw_in, int64_t excl
   NormalEquations eq;
   eq.xyz = impl.cloud.xyz.data();
   eq.values = impl.values.data();
-  eq.exclude = exclude;
+  eq.ranges = impl.ranges.data();
+  eq.counts = impl.counts.data();
+  if (exclude >= 0 && size_t(exclude) < size()) {
+    eq.exclude = impl.sample_point[size_t(exclude)];
+    eq.exclude_xyz = &impl.sample_xyz[3 * size_t(exclude)];
+    eq.exclude_value = &impl.sample_values[3 * size_t(exclude)];
+  }
   const nanoflann::SearchParams params(32, 0.0f, false);
   float growth = 1.0f;
   for (;;) {
@@ -426,12 +523,13 @@ double LocalRegression::LeaveOneOutRelativeRms(size_t count, uint64_t seed) cons
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 64), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t k = range.begin(); k != range.end(); ++k) {
       const size_t i = indices[k];
-      const float* p = &impl.cloud.xyz[3 * i];
+      const float* p = &impl.sample_xyz[3 * i];
       const Eigen::Vector3d uvw(p[0] / impl.scale_h, p[1] / impl.scale_h, p[2] / impl.scale_d);
       const Estimate e = EvaluateAt(uvw, static_cast<int64_t>(i));
       double sum = 0.0;
       for (int c = 0; c < 3; ++c) {
-        const double f = options_.log_space ? std::exp(impl.values[3 * i + c]) : impl.values[3 * i + c];
+        const double f =
+            options_.log_space ? std::exp(impl.sample_values[3 * i + c]) : impl.sample_values[3 * i + c];
         const double rel = (e.value[c] - f) / std::max(std::abs(f), 1e-4);
         sum += rel * rel;
       }

@@ -166,5 +166,37 @@ TEST(LocalRegression, LeaveOneOutSelectsABandwidth) {
   EXPECT_TRUE(best.radius_h_deg == 1.5 || best.radius_h_deg == 3.0);
 }
 
+// Binning aggregates samples into cells but keeps every sample's weight: the binned fit stays close to
+// the per-sample fit, and with cells so small that each holds one sample it is the per-sample fit.
+TEST(LocalRegression, BinningAgreesWithPerSampleFit) {
+  const auto material = LoadMaterial(MaterialPath("bluepaint"));
+  const auto samples = SessionSamples(*material, CameraEffects(), 10, 200, 150);
+  LocalRegressionOptions unbinned;
+  unbinned.bin_fraction_h = unbinned.bin_fraction_d = 0.0;
+  LocalRegressionOptions tiny;
+  tiny.bin_fraction_h = tiny.bin_fraction_d = 1e-7;
+  const LocalRegression exact(samples, unbinned), binned(samples, LocalRegressionOptions()),
+      singletons(samples, tiny);
+  EXPECT_EQ(exact.points(), exact.size());
+  EXPECT_LT(binned.points(), binned.size());
+  EXPECT_EQ(binned.size(), exact.size());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> theta(0.1, 1.2), phi(-M_PI, M_PI);
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Vector3d wi = FromSpherical(theta(rng), phi(rng)), wo = FromSpherical(theta(rng), phi(rng));
+    const Estimate a = exact.Evaluate(wi, wo), b = binned.Evaluate(wi, wo), c = singletons.Evaluate(wi, wo);
+    EXPECT_TRUE(b.value.allFinite());
+    EXPECT_EQ(a.neighbors, c.neighbors);
+    EXPECT_NEAR((a.value - c.value).norm(), 0.0, 1e-4 * (1e-3 + a.value.norm()));
+    if (a.status == EstimateStatus::kFull && b.status == EstimateStatus::kFull) {
+      EXPECT_NEAR((a.value - b.value).norm(), 0.0, 0.05 * a.value.norm());
+    }
+  }
+  // Leave-one-out removes the left-out sample from its cell: finite and close to the unbinned score.
+  const double loo_exact = exact.LeaveOneOutRelativeRms(300), loo_binned = binned.LeaveOneOutRelativeRms(300);
+  EXPECT_TRUE(std::isfinite(loo_binned));
+  EXPECT_NEAR(loo_binned, loo_exact, 0.5 * loo_exact + 0.01);
+}
+
 }  // namespace
 }  // namespace ibrdf
