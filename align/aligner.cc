@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include <ceres/ceres.h>
@@ -11,6 +12,7 @@
 #include <opencv2/core.hpp>
 #include <tbb/parallel_for.h>
 
+#include "align/cost_functions/marker_corner_error.h"
 #include "align/cost_functions/reprojection_error.h"
 #include "align/cost_functions/sphere_tangent_error.h"
 #include "align/markers.h"
@@ -112,6 +114,32 @@ std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& 
   return points;
 }
 
+Rigid3d PoseFromAngleAxis(const double* rotation, const double* translation) {
+  double matrix[9];
+  ceres::AngleAxisToRotationMatrix(rotation, matrix);  // column-major
+  Eigen::Matrix3d r;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) r(row, col) = matrix[col * 3 + row];
+  }
+  return Rigid3d(Eigen::Quaterniond(r), Eigen::Vector3d(translation[0], translation[1], translation[2]));
+}
+
+void AngleAxisFromPose(const Rigid3d& pose, double* rotation, double* translation) {
+  const Eigen::Matrix3d r = pose.rotation.toRotationMatrix();
+  double matrix[9];
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) matrix[col * 3 + row] = r(row, col);
+  }
+  ceres::RotationMatrixToAngleAxis(matrix, rotation);
+  for (int k = 0; k < 3; ++k) translation[k] = pose.translation[k];
+}
+
+// A light marker seen in one posed photo.
+struct LightSighting {
+  size_t photo;
+  std::array<Eigen::Vector2d, 4> corners;
+};
+
 }  // namespace
 
 bool AlignOptions::Check(std::string* why) const {
@@ -138,6 +166,19 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     }
     reference[target.id] = &target;
   }
+  std::map<int, const LightMarkerSpec*> light_markers;
+  if (session.targets->light) {
+    if (session.light.kind != Light::Kind::kPoint) {
+      ThrowError(session.manifest_path + ": /targets/light", "markers on the light need a point light");
+    }
+    for (const LightMarkerSpec& marker : session.targets->light->markers) {
+      if (marker.id >= dictionary.size()) {
+        ThrowError(session.manifest_path + ": /targets/light", "marker id " + std::to_string(marker.id) +
+                                                                  " is not in " + dictionary.name());
+      }
+      light_markers[marker.id] = &marker;
+    }
+  }
   session.CheckPhotos();
   const Camera& camera = session.camera;
   const std::array<double, 8> intrinsics = OpenCvIntrinsics(camera);
@@ -148,6 +189,7 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
   AlignResult result;
   result.images.resize(session.photos.size());
   std::vector<std::vector<Observation>> observations(session.photos.size());
+  std::vector<std::map<int, std::array<Eigen::Vector2d, 4>>> light_detections(session.photos.size());
   std::vector<Image> images(session.photos.size());
   ProgressBar progress("detect", session.photos.size());
   tbb::parallel_for(size_t(0), session.photos.size(), [&](size_t i) {
@@ -165,6 +207,11 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     RefineMarkerCorners(linear, camera, &detections);
     for (const MarkerDetection& d : detections) ++seen[d.id];
     for (const MarkerDetection& d : detections) {
+      if (light_markers.count(d.id) && seen[d.id] == 1) {
+        ++alignment.light_markers;
+        light_detections[i][d.id] = d.corners;
+        continue;
+      }
       if (!reference.count(d.id) || seen[d.id] > 1) {
         ++alignment.ignored_markers;
         continue;
@@ -178,6 +225,7 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
 
   // Per photo: PnP for a start, then Ceres with a robust loss on every corner.
   std::map<int, std::pair<int, double>> marker_sums;  // id -> (observations, sum of squared residuals)
+  std::vector<std::vector<bool>> corner_inliers(session.photos.size());  // per photo, per observation
   double all_squared = 0.0;
   size_t all_count = 0;
   for (size_t i = 0; i < session.photos.size(); ++i) {
@@ -260,19 +308,14 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
       sums.second += r2;
     }
     alignment.rms_px = std::sqrt(squared / inliers);
-    double matrix[9];
-    ceres::AngleAxisToRotationMatrix(rotation, matrix);  // column-major
-    Eigen::Matrix3d r;
-    for (int row = 0; row < 3; ++row) {
-      for (int col = 0; col < 3; ++col) r(row, col) = matrix[col * 3 + row];
-    }
-    alignment.camera_from_world = Rigid3d(Eigen::Quaterniond(r), Eigen::Vector3d(translation[0], translation[1], translation[2]));
+    alignment.camera_from_world = PoseFromAngleAxis(rotation, translation);
     if (alignment.rms_px > options.max_image_rms_px) {
       alignment.dropped_reason = "reprojection RMS " + std::to_string(alignment.rms_px) + " px above " +
                                  std::to_string(options.max_image_rms_px);
       continue;
     }
     alignment.used = true;
+    corner_inliers[i] = inlier;
     all_squared += squared;
     all_count += inliers;
   }
@@ -280,6 +323,134 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     result.markers.push_back({id, sums.first / 4, std::sqrt(sums.second / sums.first)});
   }
   result.rms_px = all_count ? std::sqrt(all_squared / all_count) : 0.0;
+
+  // The light from its markers. Each marker's pose starts from a square PnP in one photo (the
+  // candidate that best explains all photos seeing it); then one Ceres problem refines the light
+  // markers' poses together with the poses of the photos that see them, whose reference corners stay
+  // in the problem (the known layout keeps gauge and scale): the light markers, large and seen
+  // square-on, tie those photos' poses to each other. The light is where the markers say, averaged.
+  if (options.fit_light && session.targets->light) {
+    LightFit& fit = result.light;
+    const double half = 0.5 * session.targets->light->size;
+    const std::array<Eigen::Vector3d, 4> corners_in_marker = {
+        Eigen::Vector3d(-half, -half, 0.0), Eigen::Vector3d(half, -half, 0.0), Eigen::Vector3d(half, half, 0.0),
+        Eigen::Vector3d(-half, half, 0.0)};
+    std::vector<cv::Point3d> object;
+    for (const Eigen::Vector3d& c : corners_in_marker) object.emplace_back(c.x(), c.y(), c.z());
+    std::map<size_t, std::array<double, 6>> cameras;  // photo -> camera_from_world (angle-axis, translation)
+    std::vector<std::vector<LightSighting>> sightings(session.targets->light->markers.size());
+    std::vector<std::array<double, 6>> marker_poses(sightings.size());  // world_from_marker
+    for (size_t m = 0; m < sightings.size(); ++m) {
+      const int id = session.targets->light->markers[m].id;
+      for (size_t i = 0; i < session.photos.size(); ++i) {
+        const auto it = light_detections[i].find(id);
+        if (!result.images[i].used || it == light_detections[i].end()) continue;
+        sightings[m].push_back({i, it->second});
+        if (!cameras.count(i)) AngleAxisFromPose(result.images[i].camera_from_world, cameras[i].data(), cameras[i].data() + 3);
+      }
+    }
+    auto sighting_cost = [&](const LightSighting& sighting, const double* marker_pose, double* squared) {
+      const double* pose = cameras.at(sighting.photo).data();
+      for (int c = 0; c < 4; ++c) {
+        double residual[2];
+        MarkerCornerError(intrinsics, corners_in_marker[c], sighting.corners[c].x(), sighting.corners[c].y())(
+            pose, pose + 3, marker_pose, marker_pose + 3, residual);
+        *squared += residual[0] * residual[0] + residual[1] * residual[1];
+      }
+    };
+    ceres::Problem problem;
+    for (size_t m = 0; m < sightings.size(); ++m) {
+      // The start: both of IPPE's solutions in every photo, the one that best explains all photos.
+      double best_cost = std::numeric_limits<double>::infinity();
+      for (const LightSighting& sighting : sightings[m]) {
+        std::vector<cv::Point2d> pixels;
+        for (const Eigen::Vector2d& p : sighting.corners) pixels.emplace_back(p.x() - 0.5, p.y() - 0.5);
+        std::vector<cv::Mat> rvecs, tvecs;
+        cv::solvePnPGeneric(object, pixels, camera_matrix, distortion, rvecs, tvecs, false, cv::SOLVEPNP_IPPE_SQUARE);
+        for (size_t k = 0; k < rvecs.size(); ++k) {
+          const double r[3] = {rvecs[k].at<double>(0), rvecs[k].at<double>(1), rvecs[k].at<double>(2)};
+          const double t[3] = {tvecs[k].at<double>(0), tvecs[k].at<double>(1), tvecs[k].at<double>(2)};
+          std::array<double, 6> candidate;
+          AngleAxisFromPose(result.images[sighting.photo].camera_from_world.Inverse() * PoseFromAngleAxis(r, t),
+                            candidate.data(), candidate.data() + 3);
+          double cost = 0.0;
+          for (const LightSighting& other : sightings[m]) sighting_cost(other, candidate.data(), &cost);
+          if (cost < best_cost) {
+            best_cost = cost;
+            marker_poses[m] = candidate;
+          }
+        }
+      }
+      for (const LightSighting& sighting : sightings[m]) {
+        double* pose = cameras.at(sighting.photo).data();
+        for (int c = 0; c < 4; ++c) {
+          problem.AddResidualBlock(
+              MarkerCornerError::Create(intrinsics, corners_in_marker[c], sighting.corners[c].x(), sighting.corners[c].y()),
+              new ceres::HuberLoss(options.huber_px), pose, pose + 3, marker_poses[m].data(), marker_poses[m].data() + 3);
+        }
+      }
+    }
+    std::vector<std::array<double, 3>> layout_points;  // constants: the reference corners
+    for (const auto& [i, pose] : cameras) {
+      for (size_t o = 0; o < observations[i].size(); ++o) {
+        if (corner_inliers[i][o]) layout_points.push_back({});
+      }
+    }
+    size_t next_point = 0;
+    for (auto& [i, pose] : cameras) {
+      for (size_t o = 0; o < observations[i].size(); ++o) {
+        if (!corner_inliers[i][o]) continue;
+        const Eigen::Vector3d& p = reference.at(observations[i][o].marker_id)->corners[observations[i][o].corner];
+        std::array<double, 3>& point = layout_points[next_point++];
+        point = {p.x(), p.y(), p.z()};
+        problem.AddResidualBlock(ReprojectionError::Create(intrinsics, observations[i][o].pixel.x(), observations[i][o].pixel.y()),
+                                 new ceres::HuberLoss(options.huber_px), pose.data(), pose.data() + 3, point.data());
+        problem.SetParameterBlockConstant(point.data());
+      }
+    }
+    bool solved = true;
+    if (problem.NumResidualBlocks() > 0) {
+      ceres::Solver::Options solver_options;
+      solver_options.linear_solver_type = ceres::DENSE_QR;
+      solver_options.max_num_iterations = 100;
+      solver_options.function_tolerance = 1e-14;
+      solver_options.parameter_tolerance = 1e-14;
+      ceres::Solver::Summary summary;
+      ceres::Solve(solver_options, &problem, &summary);
+      solved = summary.IsSolutionUsable();
+      if (!solved) fit.reason = "the light markers' refinement failed (" + summary.message + "); the light stays as given";
+    }
+    if (solved) {
+      for (const auto& [i, pose] : cameras) result.images[i].camera_from_world = PoseFromAngleAxis(pose.data(), pose.data() + 3);
+    }
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int estimated = 0;
+    for (size_t m = 0; m < sightings.size(); ++m) {
+      const LightMarkerSpec& spec = session.targets->light->markers[m];
+      LightMarkerFit marker;
+      marker.id = spec.id;
+      marker.photos = solved ? static_cast<int>(sightings[m].size()) : 0;
+      if (marker.photos > 0) {
+        double squared = 0.0;
+        for (const LightSighting& sighting : sightings[m]) sighting_cost(sighting, marker_poses[m].data(), &squared);
+        marker.rms_px = std::sqrt(squared / (4.0 * sightings[m].size()));
+        marker.world_from_marker = PoseFromAngleAxis(marker_poses[m].data(), marker_poses[m].data() + 3);
+        marker.light_in_world = marker.world_from_marker * spec.light_in_marker;
+        sum += marker.light_in_world;
+        ++estimated;
+      }
+      fit.markers.push_back(marker);
+    }
+    if (estimated == 0) {
+      if (fit.reason.empty()) fit.reason = "no marker of the light was seen in a posed photo; the light stays as given";
+    } else {
+      fit.fitted = true;
+      fit.position = sum / estimated;
+      for (const LightMarkerFit& marker : fit.markers) {
+        if (marker.photos > 0) fit.spread_m = std::max(fit.spread_m, (marker.light_in_world - fit.position).norm());
+      }
+    }
+  }
 
   // The aligned session: used photos with their poses.
   result.session = session;
@@ -290,6 +461,7 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     photo.camera_from_world = result.images[i].camera_from_world;
     result.session.photos.push_back(photo);
   }
+  if (result.light.fitted) result.session.light.position = result.light.position;
   if (result.session.photos.empty()) ThrowError(session.manifest_path, "no photo could be aligned (see the reasons above)");
 
   // The sphere from its silhouettes: rays through sub-pixel limb points are tangent to it. Three
@@ -305,7 +477,7 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
       std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> rays;  // origin, direction
       const Eigen::Vector3d current(center[0], center[1], center[2]);
       for (size_t i = 0; i < session.photos.size(); ++i) {
-        if (!result.images[i].used) continue;
+        if (!result.images[i].used || session.photos[i].role == PhotoRole::kTargets) continue;
         const Rigid3d& pose = result.images[i].camera_from_world;
         const Rigid3d world_from_camera = pose.Inverse();
         const Eigen::Vector3d c = pose * current;
@@ -380,6 +552,13 @@ std::string AlignResult::BriefReport() const {
   } else {
     report += "sample pose as given";
   }
+  if (light.fitted) {
+    std::snprintf(buffer, sizeof(buffer), "; light at (%.5f, %.5f, %.5f) m from %zu markers (spread %.3f mm)",
+                  light.position.x(), light.position.y(), light.position.z(), light.markers.size(), 1e3 * light.spread_m);
+    report += buffer;
+  } else if (!light.reason.empty()) {
+    report += "; " + light.reason;
+  }
   return report;
 }
 
@@ -389,6 +568,7 @@ nlohmann::json ToJson(const AlignResult& result) {
     nlohmann::json entry = {{"photo", image.photo},
                             {"used", image.used},
                             {"markers", image.markers},
+                            {"light_markers", image.light_markers},
                             {"ignored_markers", image.ignored_markers},
                             {"outlier_corners", image.outlier_corners},
                             {"rms_px", image.rms_px}};
@@ -408,7 +588,26 @@ nlohmann::json ToJson(const AlignResult& result) {
                       {"rejected_points", result.sphere.rejected_points},
                       {"rms_m", result.sphere.rms_m}};
   }
+  if (result.light.fitted || !result.light.reason.empty()) {
+    nlohmann::json light_markers = nlohmann::json::array();
+    for (const LightMarkerFit& marker : result.light.markers) {
+      nlohmann::json entry = {{"id", marker.id}, {"photos", marker.photos}};
+      if (marker.photos > 0) {
+        entry["rms_px"] = marker.rms_px;
+        entry["light_in_world"] = ToJson(marker.light_in_world);
+      }
+      light_markers.push_back(entry);
+    }
+    json["light"] = {{"fitted", result.light.fitted}, {"markers", light_markers}};
+    if (result.light.fitted) {
+      json["light"]["position"] = ToJson(result.light.position);
+      json["light"]["spread_m"] = result.light.spread_m;
+    } else {
+      json["light"]["reason"] = result.light.reason;
+    }
+  }
   return json;
 }
 
 }  // namespace ibrdf
+

@@ -20,12 +20,13 @@ void AddAlignCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "align",
       "Find the session's geometry from its photos: camera poses from ArUco markers of known layout\n"
-      "(PnP, then Ceres with a robust loss), and a sphere's centre and radius from its silhouettes. Writes\n"
+      "(PnP, then Ceres with a robust loss), the light from markers on it, and a sphere's centre and radius\n"
+      "from its silhouettes. Photos with \"role\": \"targets\" are posed and kept but not used for the sample. Writes\n"
       "OUT/session.json (the aligned session; photos stay where they are) and OUT/alignment.json (residuals).");
   struct Args {
     std::string session, out;
     AlignOptions options;
-    bool overwrite = false, no_sphere = false;
+    bool overwrite = false, no_sphere = false, no_light = false;
   };
   auto args = std::make_shared<Args>();
   command->add_option("session", args->session, "Session folder or session.json with a \"targets\" block")->required();
@@ -33,6 +34,7 @@ void AddAlignCommand(CLI::App& app) {
   command->add_option("--min-markers", args->options.min_markers_per_image, "Reference markers a photo needs")->capture_default_str();
   command->add_option("--max-rms-px", args->options.max_image_rms_px, "Drop photos whose corner RMS exceeds this")->capture_default_str();
   command->add_flag("--no-sphere", args->no_sphere, "Keep the sphere as given instead of fitting its silhouettes");
+  command->add_flag("--no-light", args->no_light, "Keep the light as given instead of finding it from its markers");
   command->add_flag("--overwrite", args->overwrite, "Replace an existing output folder");
   command->callback([args] {
     StageLog stage("align");
@@ -40,6 +42,7 @@ void AddAlignCommand(CLI::App& app) {
     if (SameFile(args->out, session.directory)) ThrowError(args->out, "is the input session's folder; no stage overwrites its inputs");
     AlignOptions options = args->options;
     options.fit_sphere = !args->no_sphere;
+    options.fit_light = !args->no_light;
     AtomicDirectory directory(args->out, args->overwrite);
     AlignResult result = AlignSession(session, options);
     for (const ImageAlignment& image : result.images) {

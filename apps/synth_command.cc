@@ -59,9 +59,13 @@ void AddSynthCommand(CLI::App& app) {
                     "Put the sample on a platform with a ring of ArUco markers of known layout (for `ibrdf align`);\n"
                     "cameras then look down from 45 degrees unless --camera-elevation-deg says otherwise");
   command->add_option("--target-dictionary", o.target_dictionary, "ArUco dictionary of the markers")->capture_default_str();
+  auto* light_photos = command->add_option("--light-photos", o.light_target_photos,
+                      "With --targets: a card of ArUco markers on the light, and this many extra photos (role\n"
+                      "\"targets\") that see both the platform and the card (default 3 with --targets; 0: none)");
   command->add_flag("--overwrite", args->overwrite, "Replace an existing output folder");
-  command->callback([args, elevation] {
+  command->callback([args, elevation, light_photos] {
     args->elevation_given = elevation->count();
+    const bool light_photos_given = light_photos->count() > 0;
     SynthOptions options = args->options;
     options.sample = args->sample == "cylinder" ? SampleSpec::Kind::kCylinder : SampleSpec::Kind::kSphere;
     options.effects = args->effects == "none" ? CameraEffects::None() : CameraEffects();
@@ -81,6 +85,7 @@ void AddSynthCommand(CLI::App& app) {
     if (args->targets) {
       options.targets = true;
       if (args->elevation_given == 0) options.camera_elevation_deg = 45.0;
+      if (!light_photos_given) options.light_target_photos = 3;
     }
     if (!args->origin.empty()) options.origin = Eigen::Vector3d(args->origin[0], args->origin[1], args->origin[2]);
     if (!args->intensity.empty()) {

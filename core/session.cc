@@ -169,6 +169,12 @@ PhotoSpec ParsePhoto(JsonObject object, const std::string& directory) {
   photo.gain = object.Number("gain", 1.0);
   RequirePositive(object, "gain", photo.gain);
   if (object.Has("camera_from_world")) photo.camera_from_world = ParsePose(object.Object("camera_from_world"));
+  const std::string role = object.String("role", "measurement");
+  if (role == "targets") {
+    photo.role = PhotoRole::kTargets;
+  } else if (role != "measurement") {
+    ThrowError(object.Where("role"), "unknown role \"" + role + "\" (expected \"measurement\" or \"targets\")");
+  }
   const std::string path = ResolvePath(directory, photo.file);
   if (!fs::is_regular_file(path)) ThrowError(object.Where("file"), "photo " + path + " does not exist");
   object.Finish();
@@ -200,6 +206,27 @@ TargetsSpec ParseTargets(JsonObject object) {
     }
     marker.Finish();
     targets.reference.push_back(target);
+  }
+  if (object.Has("light")) {
+    JsonObject light = object.Object("light");
+    LightTargetsSpec spec;
+    spec.size = light.Number("size");
+    RequirePositive(light, "size", spec.size);
+    for (JsonObject& marker : light.Objects("markers")) {
+      LightMarkerSpec m;
+      m.id = marker.Integer("id");
+      if (m.id < 0) ThrowError(marker.Where("id"), "marker ids are non-negative");
+      if (!seen.insert(m.id).second) {
+        ThrowError(marker.Where("id"), "marker id " + std::to_string(m.id) + " is listed twice");
+      }
+      m.light_in_marker = marker.Vector3("light_in_marker");
+      if (!m.light_in_marker.allFinite()) ThrowError(marker.Where("light_in_marker"), "expected finite numbers");
+      marker.Finish();
+      spec.markers.push_back(m);
+    }
+    if (spec.markers.empty()) ThrowError(light.Where("markers"), "expected at least one marker on the light");
+    light.Finish();
+    targets.light = spec;
   }
   object.Finish();
   return targets;
@@ -301,11 +328,19 @@ nlohmann::json Session::ToJson() const {
       reference.push_back({{"id", target.id}, {"corners", corners}});
     }
     json["targets"] = {{"dictionary", targets->dictionary}, {"reference", reference}};
+    if (targets->light) {
+      nlohmann::json markers = nlohmann::json::array();
+      for (const LightMarkerSpec& m : targets->light->markers) {
+        markers.push_back({{"id", m.id}, {"light_in_marker", ibrdf::ToJson(m.light_in_marker)}});
+      }
+      json["targets"]["light"] = {{"size", targets->light->size}, {"markers", markers}};
+    }
   }
   json["photos"] = nlohmann::json::array();
   for (const PhotoSpec& photo : photos) {
     nlohmann::json p = {{"file", photo.file}, {"exposure_s", photo.exposure_s}, {"gain", photo.gain}};
     if (photo.camera_from_world) p["camera_from_world"] = PoseToJson(*photo.camera_from_world);
+    if (photo.role == PhotoRole::kTargets) p["role"] = "targets";
     json["photos"].push_back(p);
   }
   return json;

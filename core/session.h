@@ -51,16 +51,36 @@ struct TargetSpec {
   std::array<Eigen::Vector3d, 4> corners;  // metres, world frame
 };
 
+// A marker attached to the light: its pose is estimated from the photos, and the light lies at
+// `light_in_marker` in the marker's own frame (origin at the printed square's centre, x to the right
+// and y down the print, +z into the print; see align/markers.h).
+struct LightMarkerSpec {
+  int id = -1;
+  Eigen::Vector3d light_in_marker = Eigen::Vector3d::Zero();  // metres, marker frame
+};
+
+// The markers on the light (the paper's section 3.2: the light's position from targets on it).
+struct LightTargetsSpec {
+  double size = 0.0;                     // metres, printed side of every light marker (border included)
+  std::vector<LightMarkerSpec> markers;  // at least one
+};
+
 struct TargetsSpec {
   std::string dictionary;              // OpenCV predefined dictionary name, e.g. "DICT_4X4_50"
   std::vector<TargetSpec> reference;   // markers with known layout
+  std::optional<LightTargetsSpec> light;  // markers on the light, if any
 };
+
+// What a photo is for: measurement photos are derendered; target photos only serve the alignment
+// (e.g. views of the light's markers, which lie outside the measurement photos' field of view).
+enum class PhotoRole { kMeasurement, kTargets };
 
 struct PhotoSpec {
   std::string file;          // relative to the session folder
   double exposure_s = 1.0;   // exposure time, seconds
   double gain = 1.0;         // linear gain relative to the base ISO
   std::optional<Rigid3d> camera_from_world;  // known pose, if any
+  PhotoRole role = PhotoRole::kMeasurement;
 };
 
 struct Session {

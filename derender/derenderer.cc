@@ -252,7 +252,10 @@ DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& o
   std::vector<double> decode_s(session.photos.size(), 0.0);
   ProgressBar progress("photos", session.photos.size());
   tbb::parallel_for(size_t(0), session.photos.size(), [&](size_t i) {
-    if (session.photos[i].role == PhotoRole::kTargets) { progress.Add(1); return; }  // alignment-only photos
+    if (session.photos[i].role == PhotoRole::kTargets) {  // alignment-only photos are not measured
+      progress.Add(1);
+      return;
+    }
     Timer decode_timer;
     const Image image = ReadImage(session.PhotoPath(i));
     decode_s[i] = decode_timer.ElapsedSeconds();
@@ -276,8 +279,11 @@ DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& o
   const int stride = options.pixel_stride;
   const uint64_t per_image = uint64_t((session.camera.width + stride - 1) / stride) *
                              uint64_t((session.camera.height + stride - 1) / stride);
-  result.summary.photos = session.photos.size();
-  result.summary.pixels_examined = per_image * session.photos.size();
+  const size_t measured = static_cast<size_t>(std::count_if(session.photos.begin(), session.photos.end(), [](const PhotoSpec& p) {
+    return p.role != PhotoRole::kTargets;
+  }));
+  result.summary.photos = measured;
+  result.summary.pixels_examined = per_image * measured;
   result.summary.accepted = result.samples.size();
   result.summary.total_s = timer.ElapsedSeconds();
   result.summary.success = true;

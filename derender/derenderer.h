@@ -33,7 +33,7 @@ struct DerenderOptions {
 
 struct DerenderSummary {
   bool success = false;           // false until the stage ran to the end
-  uint64_t photos = 0;
+  uint64_t photos = 0;            // measurement photos (alignment-only photos are skipped)
   uint64_t pixels_examined = 0;   // pixels looked at (after the stride)
   uint64_t accepted = 0;
   RejectionCounts rejected;       // reason -> count; see RejectionReasons()

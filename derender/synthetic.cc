@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <random>
 
 #include <nlohmann/json.hpp>
@@ -69,6 +70,8 @@ Session BuildSession(const SynthOptions& options) {
     TargetsSpec targets;
     targets.dictionary = options.target_dictionary;
     targets.reference = TargetLayout(options);
+    const LightTargetsSpec light = LightTargetLayout(options, nullptr);
+    if (!light.markers.empty()) targets.light = light;
     session.targets = targets;
   }
 
@@ -86,6 +89,29 @@ Session BuildSession(const SynthOptions& options) {
                                                     options.origin, Eigen::Vector3d::UnitZ());
     session.photos.push_back(photo);
   }
+  // Target photos: from behind and above the sample, opposite the light, looking past the sample at
+  // the light's card, turned so the long side of the frame runs from the platform to the card; spread
+  // sideways (0.25 m apart) so the card's markers are seen from several directions.
+  if (options.targets && options.light_target_photos > 0) {
+    const int n = options.light_target_photos;
+    for (int k = 0; k < n; ++k) {
+      const double lateral = 0.25 * (k - 0.5 * (n - 1));
+      PhotoSpec photo;
+      char name[40];
+      std::snprintf(name, sizeof(name), "photos/target-%03d.%s", k, effects.bits == 0 ? "exr" : "png");
+      photo.file = name;
+      photo.role = PhotoRole::kTargets;
+      // A roll of 10 to 18 degrees keeps the markers' sides off the pixel grid: an edge along a pixel
+      // row is anti-aliased by CompositeTargets' 4 x 4 rays in quarter-pixel steps (a corner bias of up
+      // to 0.12 px, which the light's 2 m lever turns into millimetres).
+      const Rigid3d roll(Eigen::Quaterniond(Eigen::AngleAxisd((10.0 + 4.0 * k) * kDegree, Eigen::Vector3d::UnitZ())),
+                         Eigen::Vector3d::Zero());
+      photo.camera_from_world = roll * LookAtCameraFromWorld(options.origin + Eigen::Vector3d(-0.7, lateral, 0.55),
+                                                             options.origin + Eigen::Vector3d(0.35, -0.2 * lateral, -0.1),
+                                                             -Eigen::Vector3d::UnitY());
+      session.photos.push_back(photo);
+    }
+  }
   return session;
 }
 
@@ -95,22 +121,81 @@ double PlatformHeight(const SynthOptions& options) {
   return options.origin.z() - below;
 }
 
-// The platform: dark, with the markers of TargetLayout printed on white cards.
-class PlatformTexture {
+// A flat board carrying markers on white cards: the platform (a dark disk) or the light's card (a
+// white rectangle).
+struct Board {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d u_axis = Eigen::Vector3d::UnitX(), v_axis = Eigen::Vector3d::UnitY();  // in-plane, unit
+  double radius = 0.0;            // a disk of this radius when > 0, else a rectangle
+  double half_u = 0.0, half_v = 0.0;
+  double background = 0.0;        // the board's value off the marker cards
+  std::vector<TargetSpec> markers;
+  std::vector<std::vector<bool>> modules;
+};
+
+// The boards of a target session, and their appearance along a ray.
+class TargetScene {
  public:
-  explicit PlatformTexture(const SynthOptions& options)
-      : options_(options), dictionary_(options.target_dictionary, "synth --target-dictionary"),
-        layout_(TargetLayout(options)), height_(PlatformHeight(options)) {
-    for (const TargetSpec& target : layout_) modules_.push_back(dictionary_.Modules(target.id));
+  explicit TargetScene(const SynthOptions& options) : options_(options), dictionary_(options.target_dictionary, "synth --target-dictionary") {
+    Board platform;
+    platform.center = Eigen::Vector3d(options.origin.x(), options.origin.y(), PlatformHeight(options));
+    platform.radius = options.platform_radius;
+    platform.background = options.target_black;
+    platform.markers = TargetLayout(options);
+    boards_.push_back(platform);
+    std::vector<TargetSpec> light_markers;
+    LightTargetLayout(options, &light_markers);
+    if (!light_markers.empty()) {
+      // The card: the markers' cards side by side, in the plane through the light facing the sample.
+      Board card;
+      const Eigen::Vector3d light = options.origin + options.light_distance * Eigen::Vector3d::UnitX();
+      card.center = light - options.light_card_drop * Eigen::Vector3d::UnitZ();
+      card.normal = Eigen::Vector3d::UnitX();
+      card.u_axis = Eigen::Vector3d::UnitY();
+      card.v_axis = Eigen::Vector3d::UnitZ();
+      const double pitch = options.light_marker_size * (1.0 + 2.0 * options.card_margin);
+      card.half_u = 0.5 * pitch * options.light_marker_count;
+      card.half_v = 0.5 * pitch;
+      card.background = options.target_white;
+      card.markers = light_markers;
+      boards_.push_back(card);
+    }
+    for (Board& board : boards_) {
+      for (const TargetSpec& target : board.markers) board.modules.push_back(dictionary_.Modules(target.id));
+    }
   }
-  // The value in [black, white] at a point on the platform plane; < 0 off the platform.
-  double At(const Eigen::Vector3d& p) const {
-    const Eigen::Vector2d offset(p.x() - options_.origin.x(), p.y() - options_.origin.y());
-    if (offset.norm() > options_.platform_radius) return -1.0;
+
+  // The value of the nearest board along the ray, its distance in `t`; < 0 where no board is hit.
+  double Trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double* t) const {
+    double best = -1.0;
+    *t = std::numeric_limits<double>::infinity();
+    for (const Board& board : boards_) {
+      const double denominator = direction.dot(board.normal);
+      if (!(std::abs(denominator) > 1e-12)) continue;
+      const double tb = (board.center - origin).dot(board.normal) / denominator;
+      if (!(tb > 0.0) || !(tb < *t)) continue;
+      const double value = At(board, origin + tb * direction);
+      if (value < 0.0) continue;
+      best = value;
+      *t = tb;
+    }
+    return best;
+  }
+
+ private:
+  // The value in [black, white] at a point on the board's plane; < 0 off the board.
+  double At(const Board& board, const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d offset = p - board.center;
+    if (board.radius > 0.0) {
+      if ((offset - offset.dot(board.normal) * board.normal).norm() > board.radius) return -1.0;
+    } else if (std::abs(offset.dot(board.u_axis)) > board.half_u || std::abs(offset.dot(board.v_axis)) > board.half_v) {
+      return -1.0;
+    }
     const int n = dictionary_.modules();
-    for (size_t m = 0; m < layout_.size(); ++m) {
+    for (size_t m = 0; m < board.markers.size(); ++m) {
       // Marker axes from its corners: x along top-left -> top-right, y along top-left -> bottom-left.
-      const std::array<Eigen::Vector3d, 4>& c = layout_[m].corners;
+      const std::array<Eigen::Vector3d, 4>& c = board.markers[m].corners;
       const Eigen::Vector3d x_axis = c[1] - c[0], y_axis = c[3] - c[0];
       const double u = (p - c[0]).dot(x_axis) / x_axis.squaredNorm();
       const double v = (p - c[0]).dot(y_axis) / y_axis.squaredNorm();
@@ -118,40 +203,36 @@ class PlatformTexture {
       if (u < -margin || u >= 1.0 + margin || v < -margin || v >= 1.0 + margin) continue;
       if (u < 0.0 || u >= 1.0 || v < 0.0 || v >= 1.0) return options_.target_white;  // the card's border
       const int col = std::min(n - 1, int(u * n)), row = std::min(n - 1, int(v * n));
-      return modules_[m][size_t(row) * n + col] ? options_.target_white : options_.target_black;
+      return board.modules[m][size_t(row) * n + col] ? options_.target_white : options_.target_black;
     }
-    return options_.target_black;  // the dark platform
+    return board.background;
   }
-  double height() const { return height_; }
 
- private:
   const SynthOptions& options_;
   MarkerDictionary dictionary_;
-  std::vector<TargetSpec> layout_;
-  std::vector<std::vector<bool>> modules_;
-  double height_;
+  std::vector<Board> boards_;
 };
 
-// Composites the platform into a photo's linear signal where the pixel centre misses the sample:
-// 4 x 4 rays per pixel, the platform's fraction of them averaged (sharp, anti-aliased marker edges).
-void CompositePlatform(const Session& session, size_t photo_index, const PlatformTexture& platform,
-                       const std::vector<uint8_t>& sample_mask, Image* signal) {
+// Composites the target boards into a photo's linear signal where the pixel centre misses the sample:
+// 4 x 4 rays per pixel, the boards' fraction of them averaged (sharp, anti-aliased marker edges).
+void CompositeTargets(const Session& session, size_t photo_index, const TargetScene& scene,
+                      const std::vector<uint8_t>& sample_mask, Image* signal) {
   const Camera& camera = session.camera;
   const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
   const Rigid3d world_from_camera = session.photos[photo_index].camera_from_world->Inverse();
   const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
   const Eigen::Vector3d center = world_from_camera.translation;
-  // The platform's value along a ray through an image point; 0 where it shows nothing (or the sample
+  // The boards' value along a ray through an image point; 0 where it shows nothing (or the sample
   // is in front).
   auto value_at = [&](const Eigen::Vector2d& pixel) {
     const Eigen::Vector2d xy = camera.CamPlaneFromImage(pixel);
     const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
-    if (!(direction.z() < 0.0)) return 0.0;
-    const double t = (platform.height() - center.z()) / direction.z();
-    if (!(t > 0.0)) return 0.0;
+    double t;
+    const double value = scene.Trace(center, direction, &t);
+    if (!(value > 0.0)) return 0.0;
     SurfaceHit hit;
     if (sample->Intersect(center, direction, &hit) && hit.t < t) return 0.0;
-    return std::max(0.0, platform.At(center + t * direction));
+    return value;
   };
   // Values at the pixel corners; a pixel whose four corners agree is uniform (one value), the others
   // (edges) are averaged over 4 x 4 rays.
@@ -203,6 +284,37 @@ std::vector<TargetSpec> TargetLayout(const SynthOptions& options) {
     layout.push_back(target);
   }
   return layout;
+}
+
+LightTargetsSpec LightTargetLayout(const SynthOptions& options, std::vector<TargetSpec>* corners) {
+  LightTargetsSpec spec;
+  if (corners) corners->clear();
+  if (!options.targets || options.light_target_photos <= 0) return spec;
+  spec.size = options.light_marker_size;
+  const Eigen::Vector3d light = options.origin + options.light_distance * Eigen::Vector3d::UnitX();
+  // Printed upright for a viewer at the sample looking at the light: x along -y, y down (-z), so
+  // x cross y (into the print) points away from the sample, along +x.
+  const Eigen::Vector3d x_axis = -Eigen::Vector3d::UnitY(), y_axis = -Eigen::Vector3d::UnitZ();
+  Eigen::Matrix3d world_from_marker;
+  world_from_marker << x_axis, y_axis, x_axis.cross(y_axis);
+  const double pitch = options.light_marker_size * (1.0 + 2.0 * options.card_margin);
+  const double half = 0.5 * options.light_marker_size;
+  for (int k = 0; k < options.light_marker_count; ++k) {
+    const Eigen::Vector3d center = light - options.light_card_drop * Eigen::Vector3d::UnitZ() +
+                                   pitch * (k - 0.5 * (options.light_marker_count - 1)) * x_axis;
+    LightMarkerSpec marker;
+    marker.id = options.light_marker_first_id + k;
+    marker.light_in_marker = world_from_marker.transpose() * (light - center);
+    spec.markers.push_back(marker);
+    if (corners) {
+      TargetSpec target;
+      target.id = marker.id;
+      target.corners = {center - half * x_axis - half * y_axis, center + half * x_axis - half * y_axis,
+                        center + half * x_axis + half * y_axis, center - half * x_axis + half * y_axis};
+      corners->push_back(target);
+    }
+  }
+  return spec;
 }
 
 CameraEffects CameraEffects::None() {
@@ -276,6 +388,13 @@ bool SynthOptions::Check(std::string* why) const {
       *why = "targets: need 0 <= target_black < target_white <= 1";
       return false;
     }
+    if (light_target_photos < 0 || (light_target_photos > 0 &&
+                                    (light_marker_count < 1 || light_marker_first_id < target_count ||
+                                     !(light_marker_size > 0.0) || !(light_card_drop > 0.5 * light_marker_size *
+                                                                                           (1.0 + 2.0 * card_margin))))) {
+      *why = "targets: light markers need ids above the ring's, a positive size, and a card below the light";
+      return false;
+    }
   }
   return effects.Check(why);
 }
@@ -340,8 +459,8 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   const CameraEffects& effects = options.effects;
   std::atomic<uint64_t> saturated{0};
   ProgressBar progress("photos", session.photos.size());
-  std::unique_ptr<PlatformTexture> platform;
-  if (options.targets) platform = std::make_unique<PlatformTexture>(options);
+  std::unique_ptr<TargetScene> scene;
+  if (options.targets) scene = std::make_unique<TargetScene>(options);
   // Photos one after another; each renders and adds noise in parallel over rows.
   for (size_t i = 0; i < session.photos.size(); ++i) {
     std::vector<uint8_t> mask;
@@ -366,7 +485,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
 
     // Radiance to linear signal, then the platform (its values are already signal).
     for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
-    if (platform) CompositePlatform(session, i, *platform, mask, &image);
+    if (scene) CompositeTargets(session, i, *scene, mask, &image);
     const double levels_max = effects.bits > 0 ? std::ldexp(1.0, effects.bits) - 1.0 : 0.0;
     std::atomic<uint64_t> clipped{0};
     // One random stream per row, seeded from the session seed, the photo and the row: the output does
@@ -431,6 +550,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
         {"exposure_target", options.exposure_target},
         {"seed", options.seed},
         {"targets", options.targets},
+        {"light_target_photos", options.targets ? options.light_target_photos : 0},
         {"effects",
          {{"shot_noise", effects.shot_noise},
           {"read_noise", effects.read_noise},

@@ -75,6 +75,18 @@ struct SynthOptions {
   double card_margin = 0.25;        // white card border around each marker, in marker sides
   double target_white = 0.55;       // the cards' white as a fraction of full scale
   double target_black = 0.02;       // printed black and the platform, the same way
+  // Markers on the light (for the align stage's light estimate): a white card in the vertical plane
+  // through the light, facing the sample, with its markers' centres light_card_drop below the light,
+  // ids light_marker_first_id on; and light_target_photos extra photos (role "targets", never
+  // derendered) from behind and above the sample, looking past it at the light, that see both the
+  // platform's ring (their poses) and the card (the light markers' poses). The placement suits the
+  // default scene (light_distance 1.2 m, the default platform); 0 photos (the default): no light
+  // markers. 3 photos give the light within 0.3 mm at the default noise.
+  int light_target_photos = 0;
+  int light_marker_first_id = 20;
+  int light_marker_count = 2;
+  double light_marker_size = 0.06;  // metres, printed side (border included)
+  double light_card_drop = 0.08;    // metres, light to the markers' centres, straight down
 
   bool Check(std::string* why) const;
 };
@@ -86,6 +98,10 @@ Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel
 
 // The reference markers' corners of a target session (empty when options.targets is off).
 std::vector<TargetSpec> TargetLayout(const SynthOptions& options);
+
+// The light's markers of a target session: their world corners (`corners`, optional) and the session's
+// description of them (the light's offset in each marker's frame). Empty when there are none.
+LightTargetsSpec LightTargetLayout(const SynthOptions& options, std::vector<TargetSpec>* corners);
 
 // Writes a complete session folder: session.json, photos/, and truth.json with the material and the
 // generator options. The folder appears only when complete.

@@ -3,6 +3,7 @@
 #include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
 
+#include "align/cost_functions/marker_corner_error.h"
 #include "align/cost_functions/reprojection_error.h"
 #include "align/cost_functions/sphere_tangent_error.h"
 
@@ -27,6 +28,33 @@ TEST(ReprojectionError, ZeroAtTheTrueProjectionAndGradientsCheck) {
   ceres::GradientChecker checker(cost.get(), static_cast<const std::vector<const ceres::Manifold*>*>(nullptr), numeric);
   ceres::GradientChecker::ProbeResults results;
   std::vector<double*> parameters = {rotation, translation, point};
+  EXPECT_TRUE(checker.Probe(parameters.data(), 1e-6, &results)) << results.error_log;
+}
+
+// A marker corner through the marker's pose equals the world point through ReprojectionError.
+TEST(MarkerCornerError, MatchesReprojectionOfTheWorldCornerAndGradientsCheck) {
+  const std::array<double, 8> intrinsics = {1200, 1210, 400, 300, -0.08, 0.02, 5e-4, -3e-4};
+  double camera_rotation[3] = {0.1, -0.2, 0.05};
+  double camera_translation[3] = {0.01, -0.02, 0.8};
+  double marker_rotation[3] = {0.3, 0.2, -0.4};
+  double marker_translation[3] = {0.05, 0.02, -0.03};
+  const Eigen::Vector3d corner(-0.015, 0.015, 0.0);
+  double point[3];
+  const double c[3] = {corner.x(), corner.y(), corner.z()};
+  ceres::AngleAxisRotatePoint(marker_rotation, c, point);
+  for (int k = 0; k < 3; ++k) point[k] += marker_translation[k];
+  double expected[2], residual[2];
+  ReprojectionError(intrinsics, 410.0, 290.0)(camera_rotation, camera_translation, point, expected);
+  MarkerCornerError(intrinsics, corner, 410.0, 290.0)(camera_rotation, camera_translation, marker_rotation,
+                                                      marker_translation, residual);
+  EXPECT_NEAR(residual[0], expected[0], 1e-12);
+  EXPECT_NEAR(residual[1], expected[1], 1e-12);
+
+  std::unique_ptr<ceres::CostFunction> cost(MarkerCornerError::Create(intrinsics, corner, 410.0, 290.0));
+  ceres::NumericDiffOptions numeric;
+  ceres::GradientChecker checker(cost.get(), static_cast<const std::vector<const ceres::Manifold*>*>(nullptr), numeric);
+  ceres::GradientChecker::ProbeResults results;
+  std::vector<double*> parameters = {camera_rotation, camera_translation, marker_rotation, marker_translation};
   EXPECT_TRUE(checker.Probe(parameters.data(), 1e-6, &results)) << results.error_log;
 }
 

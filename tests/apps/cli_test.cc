@@ -181,7 +181,7 @@ TEST(Cli, AlignWritesAnAlignedSessionThatDerenders) {
   result = RunIbrdf("align " + session + " --out " + (dir / "aligned"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const nlohmann::json report = ReadJson(dir / "aligned/alignment.json");
-  EXPECT_EQ(report["images"].size(), 3u);
+  EXPECT_EQ(report["images"].size(), 6u);  // 3 measurement photos and 3 of the light's markers
   EXPECT_LT(report["rms_px"].get<double>(), 0.5);
   result = RunIbrdf("derender " + (dir / "aligned") + " --out " + (dir / "samples.npy"));
   EXPECT_EQ(result.exit_code, 0) << result.output;
