@@ -43,20 +43,6 @@ struct Observation {
   Eigen::Vector2d pixel;
 };
 
-// Bilinear sample of the luminance at a continuous pixel position (centres at +0.5).
-double Luminance(const Image& image, double px, double py) {
-  const double x = px - 0.5, y = py - 0.5;
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= image.width || y0 + 1 >= image.height) return -1.0;
-  const double fx = x - x0, fy = y - y0;
-  auto lum = [&](int xi, int yi) {
-    if (image.channels < 3) return double(image.at(xi, yi, 0));
-    return 0.2126 * image.at(xi, yi, 0) + 0.7152 * image.at(xi, yi, 1) + 0.0722 * image.at(xi, yi, 2);
-  };
-  return (1 - fx) * (1 - fy) * lum(x0, y0) + fx * (1 - fy) * lum(x0 + 1, y0) + (1 - fx) * fy * lum(x0, y0 + 1) +
-         fx * fy * lum(x0 + 1, y0 + 1);
-}
-
 // Silhouette edge points of a sphere in one photo: along radial lines from the sphere's projected
 // centre, the sharpest drop from a lit limb to the dark background, located at sub-pixel precision
 // where the profile crosses the mid level. Edges against anything bright (the platform) or on the
@@ -75,8 +61,8 @@ std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& 
     // Search the band around the predicted silhouette, with room for the inside and outside levels.
     const double s0 = radius_px - band_px - 3.0, s1 = radius_px + band_px + 3.0;
     std::vector<double> profile;
-    for (double s = s0; s <= s1; s += step) profile.push_back(Luminance(image, center_px.x() + s * direction.x(), center_px.y() + s * direction.y()));
-    if (std::any_of(profile.begin(), profile.end(), [](double v) { return v < 0.0; })) continue;
+    for (double s = s0; s <= s1; s += step) profile.push_back(BilinearLuminance(image, center_px.x() + s * direction.x(), center_px.y() + s * direction.y()));
+    if (std::any_of(profile.begin(), profile.end(), [](double v) { return !std::isfinite(v); })) continue;
     // The sharpest drop over one pixel.
     const int span = static_cast<int>(1.0 / step);
     int best = -1;

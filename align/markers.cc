@@ -32,20 +32,6 @@ constexpr NamedDictionary kDictionaries[] = {
     {"DICT_6X6_250", cv::aruco::DICT_6X6_250, 6, 250},    {"DICT_6X6_1000", cv::aruco::DICT_6X6_1000, 6, 1000},
 };
 
-// Bilinear luminance at a continuous pixel position (centres at +0.5); NaN outside.
-double Sample(const Image& image, const Eigen::Vector2d& p) {
-  const double x = p.x() - 0.5, y = p.y() - 0.5;
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= image.width || y0 + 1 >= image.height) return NAN;
-  const double fx = x - x0, fy = y - y0;
-  auto lum = [&](int xi, int yi) {
-    if (image.channels < 3) return double(image.at(xi, yi, 0));
-    return 0.2126 * image.at(xi, yi, 0) + 0.7152 * image.at(xi, yi, 1) + 0.0722 * image.at(xi, yi, 2);
-  };
-  return (1 - fx) * (1 - fy) * lum(x0, y0) + fx * (1 - fy) * lum(x0 + 1, y0) + (1 - fx) * fy * lum(x0, y0 + 1) +
-         fx * fy * lum(x0 + 1, y0 + 1);
-}
-
 }  // namespace
 
 void RefineMarkerCorners(const Image& image, const Camera& camera, std::vector<MarkerDetection>* detections) {
@@ -69,7 +55,10 @@ void RefineMarkerCorners(const Image& image, const Camera& camera, std::vector<M
         // Profile across the edge, from 3 px outside (white card) to 3 px inside (black border).
         const double step = 0.1, reach = 3.0;
         std::vector<double> profile;
-        for (double s = -reach; s <= reach + 1e-9; s += step) profile.push_back(Sample(image, base + s * inward));
+        for (double s = -reach; s <= reach + 1e-9; s += step) {
+          const Eigen::Vector2d p = base + s * inward;
+          profile.push_back(BilinearLuminance(image, p.x(), p.y()));
+        }
         if (std::any_of(profile.begin(), profile.end(), [](double v) { return !std::isfinite(v); })) continue;
         const double outside = profile.front(), inside = profile.back();
         if (!(outside > inside + 0.05)) continue;  // no clear white-to-black step

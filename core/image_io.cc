@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 
@@ -40,6 +41,19 @@ bool IsRawExtension(const std::string& path) {
                                      ".raf", ".pef", ".srw", ".crw", ".erf", ".3fr", ".iiq"};
   const std::string ext = LowerExtension(path);
   return std::any_of(std::begin(kRaw), std::end(kRaw), [&](const char* e) { return ext == e; });
+}
+
+double BilinearLuminance(const Image& image, double px, double py) {
+  const double x = px - 0.5, y = py - 0.5;
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  if (!(x0 >= 0 && y0 >= 0 && x0 + 1 < image.width && y0 + 1 < image.height)) return NAN;
+  const double fx = x - x0, fy = y - y0;
+  auto luminance = [&](int xi, int yi) {
+    if (image.channels < 3) return double(image.at(xi, yi, 0));
+    return 0.2126 * image.at(xi, yi, 0) + 0.7152 * image.at(xi, yi, 1) + 0.0722 * image.at(xi, yi, 2);
+  };
+  return (1 - fx) * (1 - fy) * luminance(x0, y0) + fx * (1 - fy) * luminance(x0 + 1, y0) +
+         (1 - fx) * fy * luminance(x0, y0 + 1) + fx * fy * luminance(x0 + 1, y0 + 1);
 }
 
 ImageSpec ReadImageSpec(const std::string& path) {

@@ -21,6 +21,11 @@ struct Image {
   float at(int x, int y, int c) const { return pixels[(size_t(y) * width + x) * channels + c]; }
 };
 
+// Rec. 709 luminance at a continuous pixel position (pixel centres at +0.5, COLMAP's convention),
+// interpolated bilinearly between pixel centres; the first channel of a grey image. NaN where the
+// 2 x 2 neighbourhood leaves the image.
+double BilinearLuminance(const Image& image, double x, double y);
+
 // Storage formats for WriteImage.
 enum class PixelFormat { kUint8, kUint16, kHalf, kFloat };
 
