@@ -100,6 +100,17 @@ std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& 
   return points;
 }
 
+// Options for the stage's small problems (a pose, a few marker poses, a sphere): dense QR, tight
+// tolerances so sub-millimetre answers converge fully.
+ceres::Solver::Options SmallProblemOptions(double tolerance) {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.max_num_iterations = 100;
+  options.function_tolerance = tolerance;
+  options.parameter_tolerance = tolerance;
+  return options;
+}
+
 Rigid3d PoseFromAngleAxis(const double* rotation, const double* translation) {
   double matrix[9];
   ceres::AngleAxisToRotationMatrix(rotation, matrix);  // column-major
@@ -252,11 +263,7 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
                                  new ceres::HuberLoss(options.huber_px), rotation, translation, points[o].data());
         problem.SetParameterBlockConstant(points[o].data());  // the layout is known: gauge and scale fixed
       }
-      ceres::Solver::Options solver_options;
-      solver_options.linear_solver_type = ceres::DENSE_QR;
-      solver_options.max_num_iterations = 100;
-      solver_options.function_tolerance = 1e-12;
-      solver_options.parameter_tolerance = 1e-12;
+      const ceres::Solver::Options solver_options = SmallProblemOptions(1e-12);
       ceres::Solve(solver_options, &problem, &summary);
       if (!summary.IsSolutionUsable() || solve == 1) break;
       std::vector<double> norms;
@@ -396,11 +403,7 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     }
     bool solved = true;
     if (problem.NumResidualBlocks() > 0) {
-      ceres::Solver::Options solver_options;
-      solver_options.linear_solver_type = ceres::DENSE_QR;
-      solver_options.max_num_iterations = 100;
-      solver_options.function_tolerance = 1e-14;
-      solver_options.parameter_tolerance = 1e-14;
+      const ceres::Solver::Options solver_options = SmallProblemOptions(1e-14);
       ceres::Solver::Summary summary;
       ceres::Solve(solver_options, &problem, &summary);
       solved = summary.IsSolutionUsable();
@@ -485,11 +488,7 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
                                    new ceres::CauchyLoss(2e-4), center, &radius);
         }
         problem.SetParameterLowerBound(&radius, 0, 1e-6);
-        ceres::Solver::Options solver_options;
-        solver_options.linear_solver_type = ceres::DENSE_QR;
-        solver_options.max_num_iterations = 100;
-        solver_options.function_tolerance = 1e-15;
-        solver_options.parameter_tolerance = 1e-15;
+        const ceres::Solver::Options solver_options = SmallProblemOptions(1e-15);
         ceres::Solver::Summary summary;
         ceres::Solve(solver_options, &problem, &summary);
         std::vector<double> residuals(rays.size());
