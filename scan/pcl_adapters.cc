@@ -1,5 +1,6 @@
 // PCL, in this one translation unit (it compiles slowly and pulls VTK).
 #include <cmath>
+#include <type_traits>
 #include <filesystem>
 
 #include <pcl/features/normal_3d.h>
@@ -50,27 +51,27 @@ ScanMesh ReadPcdFile(const std::string& path) {
   bool has_normals = false;
   for (const auto& field : blob.fields) has_normals |= field.name == "normal_x";
   ScanMesh mesh;
+  // The same loop for both point types; normals only for the type that has them.
+  auto append = [&](const auto& cloud) {
+    for (const auto& p : cloud) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        if (cloud.isOrganized()) continue;
+        ThrowError(path, "a point has a NaN or infinite coordinate");
+      }
+      mesh.points.emplace_back(p.x, p.y, p.z);
+      if constexpr (std::is_same_v<std::decay_t<decltype(p)>, pcl::PointNormal>) {
+        mesh.normals.emplace_back(p.normal_x, p.normal_y, p.normal_z);
+      }
+    }
+  };
   if (has_normals) {
     pcl::PointCloud<pcl::PointNormal> cloud;
     pcl::fromPCLPointCloud2(blob, cloud);
-    for (const auto& p : cloud) {
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        if (cloud.isOrganized()) continue;
-        ThrowError(path, "a point has a NaN or infinite coordinate");
-      }
-      mesh.points.emplace_back(p.x, p.y, p.z);
-      mesh.normals.emplace_back(p.normal_x, p.normal_y, p.normal_z);
-    }
+    append(cloud);
   } else {
     pcl::PointCloud<pcl::PointXYZ> cloud;
     pcl::fromPCLPointCloud2(blob, cloud);
-    for (const auto& p : cloud) {
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        if (cloud.isOrganized()) continue;
-        ThrowError(path, "a point has a NaN or infinite coordinate");
-      }
-      mesh.points.emplace_back(p.x, p.y, p.z);
-    }
+    append(cloud);
   }
   for (const Eigen::Vector3d& n : mesh.normals) {
     if (!n.allFinite()) ThrowError(path, "a point has a NaN or infinite normal");
