@@ -192,13 +192,13 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
   tbb::parallel_for(size_t(0), session.photos.size(), [&](size_t i) {
     ImageAlignment& alignment = result.images[i];
     alignment.photo = i;
+    // Linearized in place, so detection sees the same contrast whatever the file's response; the
+    // sphere fit reads the same linear image later.
     images[i] = ReadImage(session.PhotoPath(i));
-    // Linearize, so detection sees the same contrast whatever the file's response.
-    Image linear = images[i];
+    Image& linear = images[i];
     for (float& v : linear.pixels) {
       v = static_cast<float>(std::max(0.0, session.radiometry.response.ToLinear(v) - session.radiometry.black_level));
     }
-    images[i] = linear;
     std::map<int, int> seen;
     std::vector<MarkerDetection> detections = DetectMarkers(linear, dictionary);
     RefineMarkerCorners(linear, camera, &detections);
