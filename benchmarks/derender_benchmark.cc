@@ -21,6 +21,7 @@
 #include "core/session.h"
 #include "derender/analytic_sample.h"
 #include "derender/derenderer.h"
+#include "derender/radiance_image.h"
 #include "derender/synthetic.h"
 
 namespace ibrdf {
@@ -83,11 +84,13 @@ void BM_DerenderSession(benchmark::State& state) {
   SetRates(state, session, samples);
 }
 
-// The per-pixel geometry and radiometry alone, on photos decoded beforehand, one thread.
+// The per-pixel geometry alone, on radiance images decoded and linearized beforehand, one thread.
 void BM_DerenderDecodedPhotos(benchmark::State& state) {
   const Session& session = BenchSession(false);
-  std::vector<Image> images;
-  for (size_t i = 0; i < session.photos.size(); ++i) images.push_back(ReadImage(session.PhotoPath(i)));
+  std::vector<RadianceImage> images;
+  for (size_t i = 0; i < session.photos.size(); ++i) {
+    images.push_back(ReadRadianceImage(session, {i}, DerenderOptions().min_signal));
+  }
   const std::vector<Eigen::Vector2f> rays = PixelRays(session.camera);
   const auto sample = AnalyticSample::Create(session.sample);
   uint64_t samples = 0;

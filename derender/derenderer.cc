@@ -15,27 +15,12 @@
 #include "core/error.h"
 #include "core/light.h"
 #include "derender/analytic_sample.h"
+#include "derender/radiance_image.h"
 
 namespace ibrdf {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
-
-// Variance of a linear signal v (normalized units) from the camera noise model: shot noise
-// v / full_well, read noise (read / full_well)^2, and the file's quantization step through the slope
-// of the response.
-double SignalVariance(const RadiometrySpec& radiometry, double encoded, double linear) {
-  const CameraNoise& noise = *radiometry.noise;
-  double variance = std::max(linear, 0.0) / noise.full_well_e +
-                    (noise.read_noise_e / noise.full_well_e) * (noise.read_noise_e / noise.full_well_e);
-  if (noise.bits > 0) {
-    const double step = 1.0 / (std::ldexp(1.0, noise.bits) - 1.0);
-    const double slope = (radiometry.response.ToLinear(std::min(encoded + 0.5 * step, 1.0)) -
-                          radiometry.response.ToLinear(std::max(encoded - 0.5 * step, 0.0))) / step;
-    variance += (step * slope) * (step * slope) / 12.0;
-  }
-  return variance;
-}
 
 // The pixel box [x0, x1) x [y0, y1) that holds the projection of the sample's bounding sphere in one
 // photo, with a 2-pixel margin; the whole image where the cone around the sphere is too wide to
@@ -127,7 +112,7 @@ std::vector<Eigen::Vector2f> PixelRays(const Camera& camera) {
   return rays;
 }
 
-void DerenderPhoto(const Session& session, size_t photo_index, const Image& image,
+void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
                    const std::vector<Eigen::Vector2f>& rays, const AnalyticSample& sample,
                    const DerenderOptions& options, std::vector<BrdfSample>* samples,
                    RejectionCounts* rejected) {
@@ -135,12 +120,9 @@ void DerenderPhoto(const Session& session, size_t photo_index, const Image& imag
   const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
   const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
   const Eigen::Vector3d camera_center = world_from_camera.translation;
-  const RadiometrySpec& radiometry = session.radiometry;
-  const double radiance_scale = 1.0 / (photo.exposure_s * photo.gain);
   const double cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
   const double cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
   const int stride = options.pixel_stride;
-  const bool grey = image.channels == 1;
 
   // Counters per reason, in RejectionReasons() order.
   enum { kOff, kUnlit, kGrazingE, kGrazingI, kNonFinite, kSaturated, kBelow, kNumReasons };
@@ -176,24 +158,18 @@ void DerenderPhoto(const Session& session, size_t photo_index, const Image& imag
         ++counts[kGrazingI];
         continue;
       }
-      // Pixel values: the saturation test on file values, then linearize and subtract the black level.
-      double encoded[3], linear[3];
-      bool finite = true, saturated = false;
-      for (int c = 0; c < 3; ++c) {
-        encoded[c] = image.at(x, y, grey ? 0 : c);
-        finite = finite && std::isfinite(encoded[c]);
-        saturated = saturated || encoded[c] >= radiometry.saturation_level;
-        linear[c] = radiometry.response.ToLinear(encoded[c]) - radiometry.black_level;
-      }
-      if (!finite) {
+      // Pixel values: the radiometric flags in RejectionReasons() order.
+      const size_t p = image.Index(x, y);
+      const uint8_t flags = image.flags[p];
+      if (flags & kPixelNonFinite) {
         ++counts[kNonFinite];
         continue;
       }
-      if (saturated) {
+      if (flags & kPixelSaturated) {
         ++counts[kSaturated];
         continue;
       }
-      if (std::min({linear[0], linear[1], linear[2]}) < options.min_signal) {
+      if (flags & kPixelBelowSignal) {
         ++counts[kBelow];
         continue;
       }
@@ -206,11 +182,8 @@ void DerenderPhoto(const Session& session, size_t photo_index, const Image& imag
         s.wi[c] = static_cast<float>(wi[c]);
         s.wo[c] = static_cast<float>(wo[c]);
         const double irradiance = incidence.irradiance[c];
-        s.brdf[c] = static_cast<float>(linear[c] * radiance_scale / irradiance);
-        s.sigma[c] = radiometry.noise
-                         ? static_cast<float>(std::sqrt(SignalVariance(radiometry, encoded[c], linear[c])) *
-                                              radiance_scale / irradiance)
-                         : 0.0f;
+        s.brdf[c] = static_cast<float>(image.radiance[3 * p + c] / irradiance);
+        s.sigma[c] = static_cast<float>(image.sigma[3 * p + c] / irradiance);
       }
       s.theta_i = static_cast<float>(angles.theta_i);
       s.theta_e = static_cast<float>(angles.theta_e);
@@ -247,41 +220,34 @@ DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& o
   session.CheckPhotos();
 
   const std::vector<Eigen::Vector2f> rays = PixelRays(session.camera);
-  std::vector<std::vector<BrdfSample>> per_photo(session.photos.size());
-  std::vector<RejectionCounts> per_photo_rejected(session.photos.size());
-  std::vector<double> decode_s(session.photos.size(), 0.0);
-  ProgressBar progress("photos", session.photos.size());
-  tbb::parallel_for(size_t(0), session.photos.size(), [&](size_t i) {
-    if (session.photos[i].role == PhotoRole::kTargets) {  // alignment-only photos are not measured
-      progress.Add(1);
-      return;
-    }
-    Timer decode_timer;
-    const Image image = ReadImage(session.PhotoPath(i));
-    decode_s[i] = decode_timer.ElapsedSeconds();
+  const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
+  std::vector<std::vector<BrdfSample>> per_group(groups.size());
+  std::vector<RejectionCounts> per_group_rejected(groups.size());
+  std::vector<double> decode_s(groups.size(), 0.0);
+  ProgressBar progress("photos", groups.size());
+  tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
+    const RadianceImage image = ReadRadianceImage(session, groups[g], options.min_signal, &decode_s[g]);
     // Room for every examined pixel: only the pages written are touched, and the vector never regrows
     // (regrowth copies and page faults cost more than the per-pixel geometry).
-    per_photo[i].reserve(size_t((image.width + options.pixel_stride - 1) / options.pixel_stride) *
+    per_group[g].reserve(size_t((image.width + options.pixel_stride - 1) / options.pixel_stride) *
                          size_t((image.height + options.pixel_stride - 1) / options.pixel_stride));
-    DerenderPhoto(session, i, image, rays, *sample, options, &per_photo[i], &per_photo_rejected[i]);
+    DerenderPhoto(session, groups[g].front(), image, rays, *sample, options, &per_group[g], &per_group_rejected[g]);
     progress.Add(1);
   });
   progress.Finish();
 
   size_t total = 0;
-  for (const auto& samples : per_photo) total += samples.size();
+  for (const auto& samples : per_group) total += samples.size();
   result.samples.reserve(total);
-  for (size_t i = 0; i < per_photo.size(); ++i) {
-    result.samples.insert(result.samples.end(), per_photo[i].begin(), per_photo[i].end());
-    for (const auto& [reason, count] : per_photo_rejected[i]) result.summary.rejected[reason] += count;
-    result.summary.decode_s += decode_s[i];
+  for (size_t g = 0; g < per_group.size(); ++g) {
+    result.samples.insert(result.samples.end(), per_group[g].begin(), per_group[g].end());
+    for (const auto& [reason, count] : per_group_rejected[g]) result.summary.rejected[reason] += count;
+    result.summary.decode_s += decode_s[g];
   }
   const int stride = options.pixel_stride;
   const uint64_t per_image = uint64_t((session.camera.width + stride - 1) / stride) *
                              uint64_t((session.camera.height + stride - 1) / stride);
-  const size_t measured = static_cast<size_t>(std::count_if(session.photos.begin(), session.photos.end(), [](const PhotoSpec& p) {
-    return p.role != PhotoRole::kTargets;
-  }));
+  const size_t measured = groups.size();
   result.summary.photos = measured;
   result.summary.pixels_examined = per_image * measured;
   result.summary.accepted = result.samples.size();

@@ -56,10 +56,12 @@ const std::vector<std::pair<std::string, std::string>>& RejectionReasons();
 // camera inside the sample.
 DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& options);
 
-// The per-pixel core, for one decoded photo: appends accepted samples and counts rejections.
-// `rays` holds the undistorted image-plane point (x, y) of every pixel centre, row-major.
+// The per-pixel core, for one photo's radiance image (radiance_image.h; photo_index gives the pose):
+// appends accepted samples and counts rejections. `rays` holds the undistorted image-plane point
+// (x, y) of every pixel centre, row-major.
 class AnalyticSample;
-void DerenderPhoto(const Session& session, size_t photo_index, const Image& image,
+struct RadianceImage;
+void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
                    const std::vector<Eigen::Vector2f>& rays, const AnalyticSample& sample,
                    const DerenderOptions& options, std::vector<BrdfSample>* samples,
                    RejectionCounts* rejected);
