@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
@@ -12,9 +13,11 @@
 #include <opencv2/core.hpp>
 #include <tbb/parallel_for.h>
 
+#include "align/bundle_adjustment.h"
 #include "align/cost_functions/marker_corner_error.h"
 #include "align/cost_functions/reprojection_error.h"
 #include "align/cost_functions/sphere_tangent_error.h"
+#include "align/cylinder_fit.h"
 #include "align/markers.h"
 #include "core/error.h"
 #include "core/image_io.h"
@@ -23,25 +26,6 @@
 
 namespace ibrdf {
 namespace {
-
-// fx, fy, cx, cy, k1, k2, p1, p2 of any supported model.
-std::array<double, 8> OpenCvIntrinsics(const Camera& camera) {
-  std::array<double, 8> k = {camera.FocalX(), camera.FocalY(), camera.PrincipalX(), camera.PrincipalY(), 0, 0, 0, 0};
-  const std::vector<double>& p = camera.params;
-  switch (camera.model) {
-    case CameraModelId::kSimpleRadial: k[4] = p[3]; break;
-    case CameraModelId::kRadial: k[4] = p[3]; k[5] = p[4]; break;
-    case CameraModelId::kOpenCV: k[4] = p[4]; k[5] = p[5]; k[6] = p[6]; k[7] = p[7]; break;
-    default: break;
-  }
-  return k;
-}
-
-struct Observation {
-  int marker_id;
-  int corner;
-  Eigen::Vector2d pixel;
-};
 
 // Silhouette edge points of a sphere in one photo: along radial lines from the sphere's projected
 // centre, the sharpest drop from a lit limb to the dark background, located at sub-pixel precision
@@ -111,26 +95,6 @@ ceres::Solver::Options SmallProblemOptions(double tolerance) {
   return options;
 }
 
-Rigid3d PoseFromAngleAxis(const double* rotation, const double* translation) {
-  double matrix[9];
-  ceres::AngleAxisToRotationMatrix(rotation, matrix);  // column-major
-  Eigen::Matrix3d r;
-  for (int row = 0; row < 3; ++row) {
-    for (int col = 0; col < 3; ++col) r(row, col) = matrix[col * 3 + row];
-  }
-  return Rigid3d(Eigen::Quaterniond(r), Eigen::Vector3d(translation[0], translation[1], translation[2]));
-}
-
-void AngleAxisFromPose(const Rigid3d& pose, double* rotation, double* translation) {
-  const Eigen::Matrix3d r = pose.rotation.toRotationMatrix();
-  double matrix[9];
-  for (int row = 0; row < 3; ++row) {
-    for (int col = 0; col < 3; ++col) matrix[col * 3 + row] = r(row, col);
-  }
-  ceres::RotationMatrixToAngleAxis(matrix, rotation);
-  for (int k = 0; k < 3; ++k) translation[k] = pose.translation[k];
-}
-
 // A light marker seen in one posed photo.
 struct LightSighting {
   size_t photo;
@@ -140,52 +104,89 @@ struct LightSighting {
 }  // namespace
 
 bool AlignOptions::Check(std::string* why) const {
-  if (min_markers_per_image < 1 || !(max_image_rms_px > 0.0) || !(huber_px > 0.0) || silhouette_lines < 8) {
-    *why = "min_markers_per_image >= 1, max_image_rms_px > 0, huber_px > 0, silhouette_lines >= 8";
+  if (min_markers_per_image < 1 || !(max_image_rms_px > 0.0) || !(huber_px > 0.0) || silhouette_lines < 8 ||
+      !(corner_sigma_px > 0.0) || !(max_position_sigma_m > 0.0) || !(max_rotation_sigma_deg > 0.0) ||
+      !(ambiguity_ratio > 0.0)) {
+    *why = "min_markers_per_image >= 1, max_image_rms_px > 0, huber_px > 0, silhouette_lines >= 8, corner_sigma_px > 0, "
+           "max_position_sigma_m > 0, max_rotation_sigma_deg > 0, ambiguity_ratio > 0";
     return false;
   }
-  return true;
+  return bundle.Check(why) && cylinder.Check(why);
 }
 
 AlignResult AlignSession(const Session& session, const AlignOptions& options) {
   Timer timer;
   std::string why;
   if (!options.Check(&why)) ThrowError("align options", why);
-  if (!session.targets || session.targets->reference.empty()) {
-    ThrowError(session.manifest_path + ": /targets", "align needs reference markers of known layout");
+  if (!session.targets || (session.targets->reference.empty() && !session.targets->unknown_layout)) {
+    ThrowError(session.manifest_path + ": /targets", "align needs markers of known layout (reference) or of unknown layout (unknown_layout)");
   }
-  const MarkerDictionary dictionary(session.targets->dictionary, session.manifest_path + ": /targets/dictionary");
-  std::map<int, const TargetSpec*> reference;
-  for (const TargetSpec& target : session.targets->reference) {
-    if (target.id >= dictionary.size()) {
-      ThrowError(session.manifest_path + ": /targets/reference", "marker id " + std::to_string(target.id) +
-                                                                    " is not in " + dictionary.name());
+  const TargetsSpec& targets = *session.targets;
+  const MarkerDictionary dictionary(targets.dictionary, session.manifest_path + ": /targets/dictionary");
+  auto check_id = [&](int id, const std::string& block) {
+    if (id >= dictionary.size()) {
+      ThrowError(session.manifest_path + ": /targets/" + block, "marker id " + std::to_string(id) + " is not in " + dictionary.name());
     }
-    reference[target.id] = &target;
+  };
+  // The markers of the pose: known layout (fixed), unknown layout (free; the origin marker fixed), and
+  // the sample's (free; their layout in the sample frame serves the cylinder fit only).
+  std::map<int, BundleMarker> markers;
+  std::map<int, std::string> kinds;
+  for (const TargetSpec& target : targets.reference) {
+    check_id(target.id, "reference");
+    BundleMarker& marker = markers[target.id];
+    marker.id = target.id;
+    marker.fixed = marker.posed = true;
+    marker.corners = target.corners;
+    kinds[target.id] = "reference";
+  }
+  if (targets.unknown_layout) {
+    const UnknownLayoutSpec& layout = *targets.unknown_layout;
+    for (const int id : layout.ids) {
+      check_id(id, "unknown_layout");
+      BundleMarker& marker = markers[id];
+      marker.id = id;
+      marker.size = layout.size;
+      kinds[id] = "unknown";
+      if (layout.origin_id && *layout.origin_id == id) {
+        // The world frame: origin at the marker's centre, x to the right, y up the print, z out of it.
+        const double h = 0.5 * layout.size;
+        marker.fixed = marker.posed = true;
+        marker.corners = {Eigen::Vector3d(-h, h, 0.0), Eigen::Vector3d(h, h, 0.0), Eigen::Vector3d(h, -h, 0.0),
+                          Eigen::Vector3d(-h, -h, 0.0)};
+        marker.world_from_marker = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX())), Eigen::Vector3d::Zero());
+      }
+    }
+  }
+  if (targets.sample) {
+    for (const TargetSpec& target : targets.sample->markers) {
+      check_id(target.id, "sample");
+      BundleMarker& marker = markers[target.id];
+      marker.id = target.id;
+      marker.size = (target.corners[1] - target.corners[0]).norm();
+      kinds[target.id] = "sample";
+    }
   }
   std::map<int, const LightMarkerSpec*> light_markers;
-  if (session.targets->light) {
+  if (targets.light) {
     if (session.light.kind != Light::Kind::kPoint) {
       ThrowError(session.manifest_path + ": /targets/light", "markers on the light need a point light");
     }
-    for (const LightMarkerSpec& marker : session.targets->light->markers) {
-      if (marker.id >= dictionary.size()) {
-        ThrowError(session.manifest_path + ": /targets/light", "marker id " + std::to_string(marker.id) +
-                                                                  " is not in " + dictionary.name());
-      }
+    for (const LightMarkerSpec& marker : targets.light->markers) {
+      check_id(marker.id, "light");
       light_markers[marker.id] = &marker;
     }
   }
   session.CheckPhotos();
   const Camera& camera = session.camera;
-  const std::array<double, 8> intrinsics = OpenCvIntrinsics(camera);
+  const std::array<double, 8> intrinsics = ProjectionIntrinsics(camera);
   const cv::Mat camera_matrix = (cv::Mat_<double>(3, 3) << intrinsics[0], 0, intrinsics[2] - 0.5, 0, intrinsics[1],
                                  intrinsics[3] - 0.5, 0, 0, 1);
   const cv::Mat distortion = (cv::Mat_<double>(1, 4) << intrinsics[4], intrinsics[5], intrinsics[6], intrinsics[7]);
 
   AlignResult result;
   result.images.resize(session.photos.size());
-  std::vector<std::vector<Observation>> observations(session.photos.size());
+  std::vector<BundleImage> bundle_images(session.photos.size());
   std::vector<std::map<int, std::array<Eigen::Vector2d, 4>>> light_detections(session.photos.size());
   std::vector<Image> images(session.photos.size());
   ProgressBar progress("detect", session.photos.size());
@@ -209,111 +210,117 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
         light_detections[i][d.id] = d.corners;
         continue;
       }
-      if (!reference.count(d.id) || seen[d.id] > 1) {
+      if (!markers.count(d.id) || seen[d.id] > 1) {
         ++alignment.ignored_markers;
         continue;
       }
-      ++alignment.markers;
-      for (int k = 0; k < 4; ++k) observations[i].push_back({d.id, k, d.corners[k]});
+      for (int k = 0; k < 4; ++k) bundle_images[i].corners.push_back({d.id, k, d.corners[k], true});
     }
     progress.Add(1);
   });
   progress.Finish();
 
-  // Per photo: PnP for a start, then Ceres with a robust loss on every corner.
-  std::map<int, std::pair<int, double>> marker_sums;  // id -> (observations, sum of squared residuals)
-  std::vector<std::vector<bool>> corner_inliers(session.photos.size());  // per photo, per observation
+  // Poses: chained start, then the bundle adjustment; photos that fail a check are dropped and the
+  // adjustment repeated without them.
+  InitializeByChaining(camera, options.huber_px, &bundle_images, &markers);
+  BundleAdjustmentOptions bundle_options = options.bundle;
+  bundle_options.huber_px = options.huber_px;
+  for (int round = 0; round < 4; ++round) {
+    if (std::none_of(bundle_images.begin(), bundle_images.end(), [](const BundleImage& b) { return b.posed; })) break;
+    result.bundle = BundleAdjust(camera, bundle_options, &bundle_images, &markers);
+    if (!result.bundle.success && round == 0) {
+      ThrowError(session.manifest_path + ": /targets", "the bundle adjustment failed: " + result.bundle.message);
+    }
+    if (!result.bundle.success) {
+      // Dropping photos cut the rest off from the fixed markers: they cannot be posed either.
+      for (size_t i = 0; i < session.photos.size(); ++i) {
+        if (!bundle_images[i].posed) continue;
+        bundle_images[i].posed = false;
+        result.images[i].dropped_reason = "no pose once the photos linking it to the fixed markers were dropped (" +
+                                          result.bundle.message + ")";
+      }
+      break;
+    }
+    bool dropped = false;
+    for (size_t i = 0; i < session.photos.size(); ++i) {
+      BundleImage& image = bundle_images[i];
+      ImageAlignment& alignment = result.images[i];
+      if (!image.posed) continue;
+      std::set<int> seen;
+      for (const CornerObservation& o : image.corners) {
+        if (markers.at(o.marker_id).posed) seen.insert(o.marker_id);
+      }
+      alignment.markers = static_cast<int>(seen.size());
+      alignment.outlier_corners = image.outliers;
+      alignment.rms_px = image.rms_px;
+      alignment.camera_from_world = image.camera_from_world;
+      const PoseUncertainty uncertainty =
+          EstimatePoseUncertainty(camera, image, markers, std::max(options.corner_sigma_px, image.rms_px));
+      alignment.position_sigma_m = uncertainty.position_sigma_m;
+      alignment.rotation_sigma_deg = uncertainty.rotation_sigma_deg;
+      Rigid3d alternative;
+      alignment.alternative_rms_px = AlternativePoseRms(camera, image, markers, options.huber_px, &alternative);
+      char buffer[200];
+      if (alignment.markers < options.min_markers_per_image) {
+        alignment.dropped_reason = "only " + std::to_string(alignment.markers) + " posed markers seen (need " +
+                                   std::to_string(options.min_markers_per_image) + ")";
+      } else if (image.rms_px > options.max_image_rms_px) {
+        std::snprintf(buffer, sizeof(buffer), "reprojection RMS %.3f px above %.3f", image.rms_px, options.max_image_rms_px);
+        alignment.dropped_reason = buffer;
+      } else if (!(uncertainty.position_sigma_m <= options.max_position_sigma_m) ||
+                 !(uncertainty.rotation_sigma_deg <= options.max_rotation_sigma_deg)) {
+        std::snprintf(buffer, sizeof(buffer),
+                      "pose poorly determined by its corners (nearly collinear or too few, small or distant markers): "
+                      "position sigma %.3f mm (limit %.3f), rotation sigma %.4f deg (limit %.4f)",
+                      1e3 * uncertainty.position_sigma_m, 1e3 * options.max_position_sigma_m,
+                      uncertainty.rotation_sigma_deg, options.max_rotation_sigma_deg);
+        alignment.dropped_reason = buffer;
+      } else if (alignment.alternative_rms_px >= 0.0 &&
+                 alignment.alternative_rms_px < options.ambiguity_ratio * std::max(image.rms_px, options.corner_sigma_px)) {
+        std::snprintf(buffer, sizeof(buffer),
+                      "ambiguous pose: a second pose, %.1f deg away, explains the coplanar corners with RMS %.3f px (own %.3f px)",
+                      alternative.rotation.angularDistance(image.camera_from_world.rotation) * 180.0 / M_PI,
+                      alignment.alternative_rms_px, image.rms_px);
+        alignment.dropped_reason = buffer;
+      }
+      if (!alignment.dropped_reason.empty()) {
+        image.posed = false;
+        dropped = true;
+      }
+    }
+    if (!dropped) break;
+  }
+  for (size_t i = 0; i < session.photos.size(); ++i) {
+    ImageAlignment& alignment = result.images[i];
+    alignment.used = bundle_images[i].posed;
+    if (alignment.used || !alignment.dropped_reason.empty()) continue;
+    std::set<int> detected;
+    for (const CornerObservation& o : bundle_images[i].corners) detected.insert(o.marker_id);
+    alignment.markers = static_cast<int>(detected.size());
+    alignment.dropped_reason = detected.empty() ? "no marker of the pose seen"
+                                                : "no pose: none of its " + std::to_string(detected.size()) +
+                                                      " markers could be posed from the others";
+  }
+  // Markers no used photo sees have no estimate.
+  for (auto& [id, marker] : markers) {
+    if (!marker.fixed && marker.images == 0) marker.posed = false;
+  }
   double all_squared = 0.0;
   size_t all_count = 0;
   for (size_t i = 0; i < session.photos.size(); ++i) {
-    ImageAlignment& alignment = result.images[i];
-    if (alignment.markers < options.min_markers_per_image) {
-      alignment.dropped_reason = "only " + std::to_string(alignment.markers) + " reference markers seen (need " +
-                                 std::to_string(options.min_markers_per_image) + ")";
-      continue;
-    }
-    std::vector<cv::Point3d> object;
-    std::vector<cv::Point2d> pixels;
-    for (const Observation& o : observations[i]) {
-      const Eigen::Vector3d& p = reference.at(o.marker_id)->corners[o.corner];
-      object.emplace_back(p.x(), p.y(), p.z());
-      pixels.emplace_back(o.pixel.x() - 0.5, o.pixel.y() - 0.5);  // OpenCV's pixel centres
-    }
-    cv::Mat rvec, tvec;
-    if (!cv::solvePnP(object, pixels, camera_matrix, distortion, rvec, tvec, false, cv::SOLVEPNP_SQPNP)) {
-      alignment.dropped_reason = "no pose from the markers (PnP failed)";
-      continue;
-    }
-    double rotation[3] = {rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)};
-    double translation[3] = {tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)};
-    std::vector<std::array<double, 3>> points;
-    for (const Observation& o : observations[i]) {
-      const Eigen::Vector3d& p = reference.at(o.marker_id)->corners[o.corner];
-      points.push_back({p.x(), p.y(), p.z()});
-    }
-    // Two solves: the second without corners beyond 3 robust sigmas (at least 0.5 px) of the first,
-    // which are corners of markers partly hidden (by the sample) or cut by the frame.
-    std::vector<bool> inlier(observations[i].size(), true);
-    ceres::Solver::Summary summary;
-    for (int solve = 0; solve < 2; ++solve) {
-      ceres::Problem problem;
-      for (size_t o = 0; o < observations[i].size(); ++o) {
-        if (!inlier[o]) continue;
-        problem.AddResidualBlock(ReprojectionError::Create(intrinsics, observations[i][o].pixel.x(), observations[i][o].pixel.y()),
-                                 new ceres::HuberLoss(options.huber_px), rotation, translation, points[o].data());
-        problem.SetParameterBlockConstant(points[o].data());  // the layout is known: gauge and scale fixed
-      }
-      const ceres::Solver::Options solver_options = SmallProblemOptions(1e-12);
-      ceres::Solve(solver_options, &problem, &summary);
-      if (!summary.IsSolutionUsable() || solve == 1) break;
-      std::vector<double> norms;
-      for (size_t o = 0; o < observations[i].size(); ++o) {
-        double residual[2];
-        ReprojectionError(intrinsics, observations[i][o].pixel.x(), observations[i][o].pixel.y())(
-            rotation, translation, points[o].data(), residual);
-        norms.push_back(std::hypot(residual[0], residual[1]));
-      }
-      std::vector<double> sorted = norms;
-      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-      const double limit = std::max(0.5, 3.0 * 1.4826 * sorted[sorted.size() / 2]);
-      for (size_t o = 0; o < norms.size(); ++o) {
-        inlier[o] = norms[o] <= limit;
-        alignment.outlier_corners += !inlier[o];
-      }
-    }
-    if (!summary.IsSolutionUsable()) {
-      alignment.dropped_reason = "pose refinement failed: " + summary.message;
-      continue;
-    }
-    // Residuals, per photo and per marker.
-    double squared = 0.0;
-    size_t inliers = 0;
-    for (size_t o = 0; o < observations[i].size(); ++o) {
-      if (!inlier[o]) continue;
-      ++inliers;
-      double residual[2];
-      ReprojectionError(intrinsics, observations[i][o].pixel.x(), observations[i][o].pixel.y())(
-          rotation, translation, points[o].data(), residual);
-      const double r2 = residual[0] * residual[0] + residual[1] * residual[1];
-      squared += r2;
-      auto& sums = marker_sums[observations[i][o].marker_id];
-      ++sums.first;
-      sums.second += r2;
-    }
-    alignment.rms_px = std::sqrt(squared / inliers);
-    alignment.camera_from_world = PoseFromAngleAxis(rotation, translation);
-    if (alignment.rms_px > options.max_image_rms_px) {
-      alignment.dropped_reason = "reprojection RMS " + std::to_string(alignment.rms_px) + " px above " +
-                                 std::to_string(options.max_image_rms_px);
-      continue;
-    }
-    alignment.used = true;
-    corner_inliers[i] = inlier;
-    all_squared += squared;
-    all_count += inliers;
+    if (!result.images[i].used) continue;
+    all_squared += bundle_images[i].rms_px * bundle_images[i].rms_px * bundle_images[i].inliers;
+    all_count += bundle_images[i].inliers;
   }
-  for (const auto& [id, sums] : marker_sums) {
-    result.markers.push_back({id, sums.first / 4, std::sqrt(sums.second / sums.first)});
+  for (const auto& [id, marker] : markers) {
+    if (!marker.posed) continue;
+    MarkerResidual residual;
+    residual.id = id;
+    residual.kind = kinds.at(id);
+    residual.observations = marker.images;
+    residual.rms_px = marker.rms_px;
+    residual.corners = marker.corners;
+    result.markers.push_back(residual);
   }
   result.rms_px = all_count ? std::sqrt(all_squared / all_count) : 0.0;
 
@@ -359,7 +366,7 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
         std::vector<cv::Point2d> pixels;
         for (const Eigen::Vector2d& p : sighting.corners) pixels.emplace_back(p.x() - 0.5, p.y() - 0.5);
         std::vector<cv::Mat> rvecs, tvecs;
-        cv::solvePnPGeneric(object, pixels, camera_matrix, distortion, rvecs, tvecs, false, cv::SOLVEPNP_IPPE_SQUARE);
+        cv::solvePnPGeneric(object, pixels, camera_matrix, distortion, rvecs, tvecs, false, cv::SOLVEPNP_IPPE);
         for (size_t k = 0; k < rvecs.size(); ++k) {
           const double r[3] = {rvecs[k].at<double>(0), rvecs[k].at<double>(1), rvecs[k].at<double>(2)};
           const double t[3] = {tvecs[k].at<double>(0), tvecs[k].at<double>(1), tvecs[k].at<double>(2)};
@@ -383,20 +390,22 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
         }
       }
     }
-    std::vector<std::array<double, 3>> layout_points;  // constants: the reference corners
+    // The layout's corners (known, or as the bundle adjustment estimated them) stay constant here.
+    auto usable = [&](const CornerObservation& o) { return o.inlier && markers.at(o.marker_id).posed; };
+    std::vector<std::array<double, 3>> layout_points;
     for (const auto& [i, pose] : cameras) {
-      for (size_t o = 0; o < observations[i].size(); ++o) {
-        if (corner_inliers[i][o]) layout_points.push_back({});
+      for (const CornerObservation& o : bundle_images[i].corners) {
+        if (usable(o)) layout_points.push_back({});
       }
     }
     size_t next_point = 0;
     for (auto& [i, pose] : cameras) {
-      for (size_t o = 0; o < observations[i].size(); ++o) {
-        if (!corner_inliers[i][o]) continue;
-        const Eigen::Vector3d& p = reference.at(observations[i][o].marker_id)->corners[observations[i][o].corner];
+      for (const CornerObservation& o : bundle_images[i].corners) {
+        if (!usable(o)) continue;
+        const Eigen::Vector3d& p = markers.at(o.marker_id).corners[o.corner];
         std::array<double, 3>& point = layout_points[next_point++];
         point = {p.x(), p.y(), p.z()};
-        problem.AddResidualBlock(ReprojectionError::Create(intrinsics, observations[i][o].pixel.x(), observations[i][o].pixel.y()),
+        problem.AddResidualBlock(ReprojectionError::Create(intrinsics, o.pixel.x(), o.pixel.y()),
                                  new ceres::HuberLoss(options.huber_px), pose.data(), pose.data() + 3, point.data());
         problem.SetParameterBlockConstant(point.data());
       }
@@ -451,6 +460,32 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     result.session.photos.push_back(photo);
   }
   if (result.light.fitted) result.session.light.position = result.light.position;
+  // Markers of unknown layout that were posed join the reference layout; the others stay unknown.
+  if (targets.unknown_layout) {
+    TargetsSpec& aligned = *result.session.targets;
+    std::vector<int> unposed;
+    for (const int id : targets.unknown_layout->ids) {
+      const BundleMarker& marker = markers.at(id);
+      if (marker.posed) {
+        TargetSpec target;
+        target.id = id;
+        target.corners = marker.corners;
+        aligned.reference.push_back(target);
+      } else {
+        unposed.push_back(id);
+      }
+    }
+    aligned.unknown_layout.reset();
+    if (!unposed.empty()) {
+      UnknownLayoutSpec rest;
+      rest.size = targets.unknown_layout->size;
+      rest.ids = unposed;
+      aligned.unknown_layout = rest;
+    }
+  }
+  if (result.session.photos.empty()) {
+    for (const ImageAlignment& image : result.images) Log(1, "dropped photo " + session.photos[image.photo].file + ": " + image.dropped_reason);
+  }
   if (result.session.photos.empty()) ThrowError(session.manifest_path, "no photo could be aligned (see the reasons above)");
 
   // The sphere from its silhouettes: rays through sub-pixel limb points are tangent to it. Three
@@ -517,6 +552,14 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
       result.session.sample.radius = fit.radius;
     }
   }
+  // The cylinder from the markers fixed to it.
+  if (options.fit_cylinder && session.sample.kind == SampleSpec::Kind::kCylinder && targets.sample) {
+    result.cylinder = FitCylinderToMarkers(*targets.sample, markers, session.sample, options.cylinder);
+    if (result.cylinder.fitted) {
+      result.session.sample.center = result.cylinder.center;
+      result.session.sample.axis = result.cylinder.axis;
+    }
+  }
   result.total_s = timer.ElapsedSeconds();
   result.success = true;
   return result;
@@ -529,7 +572,9 @@ std::string AlignResult::BriefReport() const {
   std::snprintf(buffer, sizeof(buffer), "align: %d of %zu photos posed, corner RMS %.3f px, %zu markers; ", used,
                 images.size(), rms_px, markers.size());
   std::string report = buffer;
-  if (sphere.fitted) {
+  if (cylinder.fitted || !cylinder.reason.empty()) {
+    report += cylinder.BriefReport();
+  } else if (sphere.fitted) {
     std::snprintf(buffer, sizeof(buffer), "sphere centre (%.5f, %.5f, %.5f) m, radius %.5f m from %d silhouette points (RMS %.3f mm, %d rejected)",
                   sphere.center.x(), sphere.center.y(), sphere.center.z(), sphere.radius, sphere.silhouette_points,
                   1e3 * sphere.rms_m, sphere.rejected_points);
@@ -557,15 +602,43 @@ nlohmann::json ToJson(const AlignResult& result) {
                             {"ignored_markers", image.ignored_markers},
                             {"outlier_corners", image.outlier_corners},
                             {"rms_px", image.rms_px}};
+    if (image.used || image.position_sigma_m > 0.0) {
+      entry["position_sigma_m"] = std::isfinite(image.position_sigma_m) ? nlohmann::json(image.position_sigma_m) : nlohmann::json(nullptr);
+      entry["rotation_sigma_deg"] = std::isfinite(image.rotation_sigma_deg) ? nlohmann::json(image.rotation_sigma_deg) : nlohmann::json(nullptr);
+    }
+    if (image.alternative_rms_px >= 0.0) entry["alternative_pose_rms_px"] = image.alternative_rms_px;
     if (!image.used) entry["dropped"] = image.dropped_reason;
     images.push_back(entry);
   }
   nlohmann::json markers = nlohmann::json::array();
   for (const MarkerResidual& marker : result.markers) {
-    markers.push_back({{"id", marker.id}, {"observations", marker.observations}, {"rms_px", marker.rms_px}});
+    nlohmann::json entry = {{"id", marker.id}, {"kind", marker.kind}, {"observations", marker.observations}, {"rms_px", marker.rms_px}};
+    if (marker.kind != "reference") {
+      nlohmann::json corners = nlohmann::json::array();
+      for (const Eigen::Vector3d& c : marker.corners) corners.push_back(ToJson(c));
+      entry["corners"] = corners;
+    }
+    markers.push_back(entry);
   }
   nlohmann::json json = {{"format", "ibrdf-alignment"}, {"version", 1}, {"rms_px", result.rms_px},
                          {"images", images},          {"markers", markers}, {"total_s", result.total_s}};
+  json["bundle_adjustment"] = {{"images", result.bundle.images},
+                               {"free_markers", result.bundle.free_markers},
+                               {"fixed_markers", result.bundle.fixed_markers},
+                               {"corners", result.bundle.corners},
+                               {"outlier_corners", result.bundle.outliers},
+                               {"initial_rms_px", result.bundle.initial_rms_px},
+                               {"final_rms_px", result.bundle.final_rms_px},
+                               {"iterations", result.bundle.iterations}};
+  if (result.cylinder.fitted) {
+    json["cylinder"] = {{"center", ToJson(result.cylinder.center)},
+                        {"axis", ToJson(result.cylinder.axis)},
+                        {"markers", result.cylinder.markers},
+                        {"rejected_markers", result.cylinder.rejected_markers},
+                        {"rms_m", result.cylinder.rms_m}};
+  } else if (!result.cylinder.reason.empty()) {
+    json["cylinder"] = {{"fitted", false}, {"reason", result.cylinder.reason}};
+  }
   if (result.sphere.fitted) {
     json["sphere"] = {{"center", ToJson(result.sphere.center)},
                       {"radius", result.sphere.radius},

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file_util.h"
 
 namespace fs = std::filesystem;
 
@@ -124,11 +125,64 @@ T Parse(std::istringstream& in, const std::string& where, const char* what) {
   return value;
 }
 
+// A little-endian binary writer into an AtomicFile.
+class BinaryWriter {
+ public:
+  explicit BinaryWriter(const std::string& path) : file_(path), out_(file_.temporary_path(), std::ios::binary) {
+    if (!out_) ThrowError(path, "cannot write file");
+  }
+  template <typename T>
+  void Write(const T& value) {
+    out_.write(reinterpret_cast<const char*>(&value), sizeof(T));
+  }
+  void WriteString(const std::string& s) { out_.write(s.c_str(), static_cast<std::streamsize>(s.size() + 1)); }
+  void Commit() {
+    out_.close();
+    if (!out_) ThrowError(file_.final_path(), "write failed");
+    file_.Commit();
+  }
+
+ private:
+  AtomicFile file_;
+  std::ofstream out_;
+};
+
+// A text file written through an AtomicFile, full double precision.
+class TextWriter {
+ public:
+  explicit TextWriter(const std::string& path) : file_(path), out_(file_.temporary_path()) {
+    if (!out_) ThrowError(path, "cannot write file");
+    out_.precision(17);
+  }
+  std::ofstream& out() { return out_; }
+  void Commit() {
+    out_.close();
+    if (!out_) ThrowError(file_.final_path(), "write failed");
+    file_.Commit();
+  }
+
+ private:
+  AtomicFile file_;
+  std::ofstream out_;
+};
+
+void RequireDirectory(const std::string& directory) {
+  if (!fs::is_directory(directory)) ThrowError(directory, "is not a folder (the COLMAP model is written into it)");
+}
+
 }  // namespace
 
 const char* ColmapModelNameFromId(int model_id) {
   if (model_id < 0 || model_id >= static_cast<int>(std::size(kColmapModels))) return nullptr;
   return kColmapModels[model_id];
+}
+
+int ColmapModelIdFromName(const std::string& name) {
+  for (int id = 0; id < static_cast<int>(std::size(kColmapModels)); ++id) {
+    if (name == kColmapModels[id]) return id;
+  }
+  IBRDF_CHECK(false) << "not a COLMAP camera model: " << name;
+  return -1;
 }
 
 ColmapModel ColmapModel::Read(const std::string& directory) {
@@ -311,6 +365,106 @@ void ColmapModel::Validate(const std::string& directory) const {
                                   ", " + std::to_string(index) + ") that names no 2D point");
       }
     }
+  }
+}
+
+void ColmapModel::WriteText(const std::string& directory) const {
+  RequireDirectory(directory);
+  {
+    TextWriter file((fs::path(directory) / "cameras.txt").string());
+    std::ofstream& out = file.out();
+    out << "# Camera list with one line of data per camera:\n#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
+        << "# Number of cameras: " << cameras.size() << "\n";
+    for (const auto& [id, camera] : cameras) {
+      out << id << " " << CameraModelName(camera.model) << " " << camera.width << " " << camera.height;
+      for (double p : camera.params) out << " " << p;
+      out << "\n";
+    }
+    file.Commit();
+  }
+  {
+    TextWriter file((fs::path(directory) / "images.txt").string());
+    std::ofstream& out = file.out();
+    out << "# Image list with two lines of data per image:\n"
+        << "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
+        << "# Number of images: " << images.size() << "\n";
+    for (const auto& [id, image] : images) {
+      const Eigen::Quaterniond& q = image.camera_from_world.rotation;
+      const Eigen::Vector3d& t = image.camera_from_world.translation;
+      out << id << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " " << t.x() << " " << t.y() << " "
+          << t.z() << " " << image.camera_id << " " << image.name << "\n";
+      for (size_t p = 0; p < image.points2d.size(); ++p) {
+        out << (p ? " " : "") << image.points2d[p].x() << " " << image.points2d[p].y() << " " << image.point3d_ids[p];
+      }
+      out << "\n";
+    }
+    file.Commit();
+  }
+  {
+    TextWriter file((fs::path(directory) / "points3D.txt").string());
+    std::ofstream& out = file.out();
+    out << "# 3D point list with one line of data per point:\n"
+        << "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
+        << "# Number of points: " << points.size() << "\n";
+    for (const auto& [id, point] : points) {
+      out << id << " " << point.xyz.x() << " " << point.xyz.y() << " " << point.xyz.z() << " " << int(point.rgb[0]) << " "
+          << int(point.rgb[1]) << " " << int(point.rgb[2]) << " " << point.error;
+      for (const auto& [image_id, index] : point.track) out << " " << image_id << " " << index;
+      out << "\n";
+    }
+    file.Commit();
+  }
+}
+
+void ColmapModel::WriteBinary(const std::string& directory) const {
+  RequireDirectory(directory);
+  {
+    BinaryWriter out((fs::path(directory) / "cameras.bin").string());
+    out.Write<uint64_t>(cameras.size());
+    for (const auto& [id, camera] : cameras) {
+      out.Write<uint32_t>(id);
+      out.Write<int32_t>(ColmapModelIdFromName(CameraModelName(camera.model)));
+      out.Write<uint64_t>(static_cast<uint64_t>(camera.width));
+      out.Write<uint64_t>(static_cast<uint64_t>(camera.height));
+      for (double p : camera.params) out.Write<double>(p);
+    }
+    out.Commit();
+  }
+  {
+    BinaryWriter out((fs::path(directory) / "images.bin").string());
+    out.Write<uint64_t>(images.size());
+    for (const auto& [id, image] : images) {
+      out.Write<uint32_t>(id);
+      const Eigen::Quaterniond& q = image.camera_from_world.rotation;
+      for (double v : {q.w(), q.x(), q.y(), q.z()}) out.Write<double>(v);
+      for (int k = 0; k < 3; ++k) out.Write<double>(image.camera_from_world.translation[k]);
+      out.Write<uint32_t>(image.camera_id);
+      out.WriteString(image.name);
+      out.Write<uint64_t>(image.points2d.size());
+      for (size_t p = 0; p < image.points2d.size(); ++p) {
+        out.Write<double>(image.points2d[p].x());
+        out.Write<double>(image.points2d[p].y());
+        out.Write<uint64_t>(image.point3d_ids[p] < 0 ? std::numeric_limits<uint64_t>::max()
+                                                     : static_cast<uint64_t>(image.point3d_ids[p]));
+      }
+    }
+    out.Commit();
+  }
+  {
+    BinaryWriter out((fs::path(directory) / "points3D.bin").string());
+    out.Write<uint64_t>(points.size());
+    for (const auto& [id, point] : points) {
+      out.Write<uint64_t>(id);
+      for (int c = 0; c < 3; ++c) out.Write<double>(point.xyz[c]);
+      for (int c = 0; c < 3; ++c) out.Write<uint8_t>(point.rgb[c]);
+      out.Write<double>(point.error);
+      out.Write<uint64_t>(point.track.size());
+      for (const auto& [image_id, index] : point.track) {
+        out.Write<uint32_t>(image_id);
+        out.Write<uint32_t>(index);
+      }
+    }
+    out.Commit();
   }
 }
 

@@ -1,6 +1,7 @@
 // COLMAP sparse models (cameras, images, points3D) in COLMAP's text and binary formats, as COLMAP 3.8
 // writes them (colmap/src/base/reconstruction.cc). Supported camera models: SIMPLE_PINHOLE, PINHOLE,
-// SIMPLE_RADIAL, RADIAL and OPENCV; any other is a clear error naming the file and the camera.
+// SIMPLE_RADIAL, RADIAL and OPENCV; any other is a clear error naming the file and the camera. Models
+// are also written (tests, and sessions handed to COLMAP).
 #pragma once
 
 #include <cstdint>
@@ -48,9 +49,17 @@ struct ColmapModel {
   // Checks references: every image's camera exists, every track names an existing image and 2D point.
   // Throws Error naming `directory` and the first dangling reference.
   void Validate(const std::string& directory) const;
+
+  // Writes the model in COLMAP 3.8's text (cameras.txt, images.txt, points3D.txt) or binary (.bin)
+  // format into `directory`, which must exist; each file appears only when complete. Doubles are
+  // written with 17 significant digits, so text round-trips exactly.
+  void WriteText(const std::string& directory) const;
+  void WriteBinary(const std::string& directory) const;
 };
 
 // COLMAP's numeric model ids (colmap/src/base/camera_models.h) and names, for error messages.
 const char* ColmapModelNameFromId(int model_id);
+// COLMAP's numeric id of a camera model ibrdf supports.
+int ColmapModelIdFromName(const std::string& name);
 
 }  // namespace ibrdf

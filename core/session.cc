@@ -1,5 +1,6 @@
 #include "core/session.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -60,6 +61,71 @@ Light ParseLight(JsonObject object) {
   return light;
 }
 
+Rigid3d ParsePose(JsonObject object);
+
+// The keys of a mesh sample (docs/session-format.md). The mesh file is not opened here: the scan
+// stage may write it after the session; the derenderer reports a missing or broken one.
+void ParseMeshSample(JsonObject& object, SampleSpec* sample) {
+  sample->kind = SampleSpec::Kind::kMesh;
+  sample->mesh_file = object.String("file");
+  if (sample->mesh_file.empty()) ThrowError(object.Where("file"), "must name the mesh file");
+  if (object.Has("world_from_mesh")) {
+    sample->world_from_mesh = Sim3dFromJson(object.Raw("world_from_mesh"), object.file(), "/sample/world_from_mesh");
+  }
+  if (object.Has("scan_inputs")) {
+    const nlohmann::json& inputs = object.Raw("scan_inputs");
+    if (!inputs.is_array()) ThrowError(object.Where("scan_inputs"), "expected an array, got " + JsonTypeName(inputs));
+    for (size_t i = 0; i < inputs.size(); ++i) {
+      const std::string pointer = "/sample/scan_inputs/" + std::to_string(i);
+      ScanInputSpec input;
+      if (inputs[i].is_string()) {
+        input.file = inputs[i].get<std::string>();
+      } else if (inputs[i].is_object()) {
+        JsonObject entry(inputs[i], object.file(), pointer);
+        input.file = entry.String("file");
+        if (entry.Has("world_from_scan")) input.world_from_scan = ParsePose(entry.Object("world_from_scan"));
+        entry.Finish();
+      } else {
+        ThrowError(object.file() + ": " + pointer,
+                   "expected a file name or {\"file\", \"world_from_scan\"}, got " + JsonTypeName(inputs[i]));
+      }
+      if (input.file.empty()) ThrowError(object.file() + ": " + pointer, "empty file name");
+      sample->scan_inputs.push_back(input);
+    }
+  }
+  if (object.Has("scan_targets")) {
+    std::set<int> seen;
+    for (JsonObject& marker : object.Objects("scan_targets")) {
+      ScanTargetSpec target;
+      target.id = marker.Integer("id");
+      if (target.id < 0) ThrowError(marker.Where("id"), "marker ids are non-negative");
+      if (!seen.insert(target.id).second) {
+        ThrowError(marker.Where("id"), "marker id " + std::to_string(target.id) + " is listed twice");
+      }
+      const nlohmann::json& corners = marker.Raw("corners");
+      if (!corners.is_array() || corners.size() != 4) {
+        ThrowError(marker.Where("corners"), "expected 4 corners [[x, y, z] x 4] (top-left, top-right, bottom-right, bottom-left)");
+      }
+      for (int k = 0; k < 4; ++k) {
+        const nlohmann::json& c = corners[k];
+        if (!c.is_array() || c.size() != 3 || !c[0].is_number() || !c[1].is_number() || !c[2].is_number()) {
+          ThrowError(marker.Where("corners") + "/" + std::to_string(k), "expected [x, y, z]");
+        }
+        target.corners[k] = Eigen::Vector3d(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
+        if (!target.corners[k].allFinite()) {
+          ThrowError(marker.Where("corners") + "/" + std::to_string(k), "expected finite numbers");
+        }
+      }
+      marker.Finish();
+      sample->scan_targets.push_back(target);
+    }
+  }
+  const std::string visibility = object.String("visibility", "auto");
+  if (!VisibilityFromName(visibility, &sample->visibility)) {
+    ThrowError(object.Where("visibility"), "unknown visibility \"" + visibility + "\" (expected auto, on or off)");
+  }
+}
+
 SampleSpec ParseSample(JsonObject object) {
   SampleSpec sample;
   const std::string kind = object.String("kind");
@@ -79,8 +145,7 @@ SampleSpec ParseSample(JsonObject object) {
     sample.length = object.Number("length");
     RequirePositive(object, "length", sample.length);
   } else if (kind == "mesh") {
-    sample.kind = SampleSpec::Kind::kMesh;
-    sample.mesh_file = object.String("file");
+    ParseMeshSample(object, &sample);
   } else {
     ThrowError(object.Where("kind"), "unknown sample kind \"" + kind + "\" (expected sphere, cylinder or mesh)");
   }
@@ -122,7 +187,7 @@ Response ParseResponse(JsonObject& parent) {
   return response;
 }
 
-RadiometrySpec ParseRadiometry(JsonObject object) {
+RadiometrySpec ParseRadiometry(JsonObject object, const std::string& directory) {
   RadiometrySpec radiometry;
   if (object.Has("response")) radiometry.response = ParseResponse(object);
   radiometry.black_level = object.Number("black_level", 0.0);
@@ -142,6 +207,11 @@ RadiometrySpec ParseRadiometry(JsonObject object) {
     if (noise.bits < 0 || noise.bits > 32) ThrowError(noise_object.Where("bits"), "expected 0 to 32");
     noise_object.Finish();
     radiometry.noise = noise;
+  }
+  if (object.Has("flat_field")) {
+    radiometry.flat_field = object.String("flat_field");
+    const std::string path = ResolvePath(directory, radiometry.flat_field);
+    if (!fs::is_regular_file(path)) ThrowError(object.Where("flat_field"), "flat-field image " + path + " does not exist");
   }
   object.Finish();
   return radiometry;
@@ -175,6 +245,10 @@ PhotoSpec ParsePhoto(JsonObject object, const std::string& directory) {
   } else if (role != "measurement") {
     ThrowError(object.Where("role"), "unknown role \"" + role + "\" (expected \"measurement\" or \"targets\")");
   }
+  if (object.Has("bracket")) {
+    photo.bracket = object.Integer("bracket");
+    if (*photo.bracket < 0) ThrowError(object.Where("bracket"), "bracket ids are non-negative");
+  }
   const std::string path = ResolvePath(directory, photo.file);
   if (!fs::is_regular_file(path)) ThrowError(object.Where("file"), "photo " + path + " does not exist");
   object.Finish();
@@ -185,13 +259,15 @@ TargetsSpec ParseTargets(JsonObject object) {
   TargetsSpec targets;
   targets.dictionary = object.String("dictionary");
   std::set<int> seen;
-  for (JsonObject& marker : object.Objects("reference")) {
+  auto marker_id = [&seen](JsonObject& marker) {
+    const int id = marker.Integer("id");
+    if (id < 0) ThrowError(marker.Where("id"), "marker ids are non-negative");
+    if (!seen.insert(id).second) ThrowError(marker.Where("id"), "marker id " + std::to_string(id) + " is listed twice");
+    return id;
+  };
+  auto marker_corners = [&](JsonObject& marker) {
     TargetSpec target;
-    target.id = marker.Integer("id");
-    if (target.id < 0) ThrowError(marker.Where("id"), "marker ids are non-negative");
-    if (!seen.insert(target.id).second) {
-      ThrowError(marker.Where("id"), "marker id " + std::to_string(target.id) + " is listed twice");
-    }
+    target.id = marker_id(marker);
     const nlohmann::json& corners = marker.Raw("corners");
     if (!corners.is_array() || corners.size() != 4) {
       ThrowError(marker.Where("corners"), "expected 4 corners [[x, y, z] x 4] (top-left, top-right, bottom-right, bottom-left)");
@@ -205,7 +281,57 @@ TargetsSpec ParseTargets(JsonObject object) {
       if (!target.corners[k].allFinite()) ThrowError(marker.Where("corners") + "/" + std::to_string(k), "expected finite numbers");
     }
     marker.Finish();
-    targets.reference.push_back(target);
+    return target;
+  };
+  if (object.Has("reference") || !object.Has("unknown_layout")) {
+    for (JsonObject& marker : object.Objects("reference")) targets.reference.push_back(marker_corners(marker));
+  }
+  if (object.Has("unknown_layout")) {
+    JsonObject layout = object.Object("unknown_layout");
+    UnknownLayoutSpec spec;
+    spec.size = layout.Number("size");
+    RequirePositive(layout, "size", spec.size);
+    const std::vector<double> ids = layout.Numbers("ids");
+    if (ids.empty()) ThrowError(layout.Where("ids"), "expected at least one marker id");
+    for (size_t k = 0; k < ids.size(); ++k) {
+      const std::string where = layout.Where("ids") + "/" + std::to_string(k);
+      if (!(ids[k] >= 0.0) || ids[k] != std::floor(ids[k]) || ids[k] > 1e6) ThrowError(where, "expected a non-negative integer id");
+      if (!seen.insert(int(ids[k])).second) ThrowError(where, "marker id " + std::to_string(int(ids[k])) + " is listed twice");
+      spec.ids.push_back(int(ids[k]));
+    }
+    if (layout.Has("origin_id")) {
+      spec.origin_id = layout.Integer("origin_id");
+      if (!targets.reference.empty()) {
+        ThrowError(layout.Where("origin_id"), "the known-layout markers in /targets/reference already fix the world frame; drop origin_id");
+      }
+      if (std::find(spec.ids.begin(), spec.ids.end(), *spec.origin_id) == spec.ids.end()) {
+        ThrowError(layout.Where("origin_id"), "marker " + std::to_string(*spec.origin_id) + " is not in ids");
+      }
+    } else if (targets.reference.empty()) {
+      ThrowError(layout.Where("origin_id"), "without known-layout markers (/targets/reference) one marker must fix the world frame: give origin_id");
+    }
+    layout.Finish();
+    targets.unknown_layout = spec;
+  }
+  if (object.Has("sample")) {
+    JsonObject sample = object.Object("sample");
+    SampleTargetsSpec spec;
+    for (JsonObject& marker : sample.Objects("markers")) {
+      const std::string where = marker.Where("corners");
+      const TargetSpec target = marker_corners(marker);
+      const double side = (target.corners[1] - target.corners[0]).norm();
+      for (int k = 0; k < 4; ++k) {
+        const double edge = (target.corners[(k + 1) % 4] - target.corners[k]).norm();
+        if (!(side > 0.0) || std::abs(edge - side) > 1e-3 * side ||
+            std::abs((target.corners[(k + 1) % 4] - target.corners[k]).dot(target.corners[(k + 2) % 4] - target.corners[(k + 1) % 4])) > 1e-3 * side * side) {
+          ThrowError(where, "the corners are not a square (sides and right angles within 0.1 %)");
+        }
+      }
+      spec.markers.push_back(target);
+    }
+    if (spec.markers.empty()) ThrowError(sample.Where("markers"), "expected at least one marker on the sample");
+    sample.Finish();
+    targets.sample = spec;
   }
   if (object.Has("light")) {
     JsonObject light = object.Object("light");
@@ -214,11 +340,7 @@ TargetsSpec ParseTargets(JsonObject object) {
     RequirePositive(light, "size", spec.size);
     for (JsonObject& marker : light.Objects("markers")) {
       LightMarkerSpec m;
-      m.id = marker.Integer("id");
-      if (m.id < 0) ThrowError(marker.Where("id"), "marker ids are non-negative");
-      if (!seen.insert(m.id).second) {
-        ThrowError(marker.Where("id"), "marker id " + std::to_string(m.id) + " is listed twice");
-      }
+      m.id = marker_id(marker);
       m.light_in_marker = marker.Vector3("light_in_marker");
       if (!m.light_in_marker.allFinite()) ThrowError(marker.Where("light_in_marker"), "expected finite numbers");
       marker.Finish();
@@ -230,6 +352,35 @@ TargetsSpec ParseTargets(JsonObject object) {
   }
   object.Finish();
   return targets;
+}
+
+CalibrationSpec ParseCalibration(JsonObject object, const std::string& directory) {
+  CalibrationSpec calibration;
+  if (object.Has("white_reference")) {
+    JsonObject white = object.Object("white_reference");
+    WhiteReferenceSpec spec;
+    spec.reflectance = white.Vector3("reflectance");
+    if (!((spec.reflectance.array() > 0.0).all() && (spec.reflectance.array() <= 1.0).all())) {
+      ThrowError(white.Where("reflectance"), "expected an albedo in (0, 1] per channel");
+    }
+    spec.center = white.Vector3("center");
+    spec.normal = white.Vector3("normal");
+    if (!(spec.normal.norm() > 0.0)) ThrowError(white.Where("normal"), "must be non-zero");
+    spec.normal.normalize();
+    spec.size = white.Number("size");
+    RequirePositive(white, "size", spec.size);
+    for (JsonObject& photo : white.Objects("photos")) {
+      spec.photos.push_back(ParsePhoto(photo, directory));
+      if (spec.photos.back().role != PhotoRole::kMeasurement) {
+        ThrowError(photo.Where("role"), "a white-reference photo has no role");
+      }
+    }
+    if (spec.photos.empty()) ThrowError(white.Where("photos"), "expected at least one photo of the white reference");
+    white.Finish();
+    calibration.white_reference = spec;
+  }
+  object.Finish();
+  return calibration;
 }
 
 nlohmann::json PoseToJson(const Rigid3d& pose) {
@@ -246,6 +397,25 @@ const char* SampleKindName(SampleSpec::Kind kind) {
     case SampleSpec::Kind::kMesh: return "mesh";
   }
   return "unknown";
+}
+
+const char* VisibilityName(Visibility visibility) {
+  switch (visibility) {
+    case Visibility::kAuto: return "auto";
+    case Visibility::kOn: return "on";
+    case Visibility::kOff: return "off";
+  }
+  return "unknown";
+}
+
+bool VisibilityFromName(const std::string& name, Visibility* visibility) {
+  for (Visibility v : {Visibility::kAuto, Visibility::kOn, Visibility::kOff}) {
+    if (name == VisibilityName(v)) {
+      *visibility = v;
+      return true;
+    }
+  }
+  return false;
 }
 
 Session Session::Load(const std::string& path) {
@@ -268,7 +438,8 @@ Session Session::Load(const std::string& path) {
   session.camera = ParseCamera(root.Object("camera"));
   session.light = ParseLight(root.Object("light"));
   session.sample = ParseSample(root.Object("sample"));
-  if (root.Has("radiometry")) session.radiometry = ParseRadiometry(root.Object("radiometry"));
+  if (root.Has("radiometry")) session.radiometry = ParseRadiometry(root.Object("radiometry"), session.directory);
+  if (root.Has("calibration")) session.calibration = ParseCalibration(root.Object("calibration"), session.directory);
   if (root.Has("targets")) session.targets = ParseTargets(root.Object("targets"));
   for (JsonObject& photo : root.Objects("photos")) {
     session.photos.push_back(ParsePhoto(photo, session.directory));
@@ -298,6 +469,28 @@ nlohmann::json Session::ToJson() const {
   s["kind"] = SampleKindName(sample.kind);
   if (sample.kind == SampleSpec::Kind::kMesh) {
     s["file"] = sample.mesh_file;
+    if (!sample.world_from_mesh.IsIdentity()) s["world_from_mesh"] = Sim3dToJson(sample.world_from_mesh);
+    if (!sample.scan_inputs.empty()) {
+      nlohmann::json inputs = nlohmann::json::array();
+      for (const ScanInputSpec& input : sample.scan_inputs) {
+        if (input.world_from_scan) {
+          inputs.push_back({{"file", input.file}, {"world_from_scan", PoseToJson(*input.world_from_scan)}});
+        } else {
+          inputs.push_back(input.file);
+        }
+      }
+      s["scan_inputs"] = inputs;
+    }
+    if (!sample.scan_targets.empty()) {
+      nlohmann::json targets_json = nlohmann::json::array();
+      for (const ScanTargetSpec& target : sample.scan_targets) {
+        nlohmann::json corners = nlohmann::json::array();
+        for (const Eigen::Vector3d& c : target.corners) corners.push_back(ibrdf::ToJson(c));
+        targets_json.push_back({{"id", target.id}, {"corners", corners}});
+      }
+      s["scan_targets"] = targets_json;
+    }
+    if (sample.visibility != Visibility::kAuto) s["visibility"] = VisibilityName(sample.visibility);
   } else {
     s["center"] = ibrdf::ToJson(sample.center);
     s["radius"] = sample.radius;
@@ -320,6 +513,7 @@ nlohmann::json Session::ToJson() const {
                   {"read_noise_e", radiometry.noise->read_noise_e},
                   {"bits", radiometry.noise->bits}};
   }
+  if (!radiometry.flat_field.empty()) r["flat_field"] = radiometry.flat_field;
   if (targets) {
     nlohmann::json reference = nlohmann::json::array();
     for (const TargetSpec& target : targets->reference) {
@@ -328,6 +522,20 @@ nlohmann::json Session::ToJson() const {
       reference.push_back({{"id", target.id}, {"corners", corners}});
     }
     json["targets"] = {{"dictionary", targets->dictionary}, {"reference", reference}};
+    if (targets->unknown_layout) {
+      const UnknownLayoutSpec& layout = *targets->unknown_layout;
+      json["targets"]["unknown_layout"] = {{"size", layout.size}, {"ids", layout.ids}};
+      if (layout.origin_id) json["targets"]["unknown_layout"]["origin_id"] = *layout.origin_id;
+    }
+    if (targets->sample) {
+      nlohmann::json markers = nlohmann::json::array();
+      for (const TargetSpec& target : targets->sample->markers) {
+        nlohmann::json corners = nlohmann::json::array();
+        for (const Eigen::Vector3d& c : target.corners) corners.push_back(ibrdf::ToJson(c));
+        markers.push_back({{"id", target.id}, {"corners", corners}});
+      }
+      json["targets"]["sample"] = {{"markers", markers}};
+    }
     if (targets->light) {
       nlohmann::json markers = nlohmann::json::array();
       for (const LightMarkerSpec& m : targets->light->markers) {
@@ -336,13 +544,28 @@ nlohmann::json Session::ToJson() const {
       json["targets"]["light"] = {{"size", targets->light->size}, {"markers", markers}};
     }
   }
-  json["photos"] = nlohmann::json::array();
-  for (const PhotoSpec& photo : photos) {
+  auto photo_json = [](const PhotoSpec& photo) {
     nlohmann::json p = {{"file", photo.file}, {"exposure_s", photo.exposure_s}, {"gain", photo.gain}};
     if (photo.camera_from_world) p["camera_from_world"] = PoseToJson(*photo.camera_from_world);
     if (photo.role == PhotoRole::kTargets) p["role"] = "targets";
-    json["photos"].push_back(p);
+    if (photo.bracket) p["bracket"] = *photo.bracket;
+    return p;
+  };
+  if (calibration) {
+    json["calibration"] = nlohmann::json::object();
+    if (calibration->white_reference) {
+      const WhiteReferenceSpec& white = *calibration->white_reference;
+      nlohmann::json white_photos = nlohmann::json::array();
+      for (const PhotoSpec& photo : white.photos) white_photos.push_back(photo_json(photo));
+      json["calibration"]["white_reference"] = {{"reflectance", ibrdf::ToJson(white.reflectance)},
+                                                {"center", ibrdf::ToJson(white.center)},
+                                                {"normal", ibrdf::ToJson(white.normal)},
+                                                {"size", white.size},
+                                                {"photos", white_photos}};
+    }
   }
+  json["photos"] = nlohmann::json::array();
+  for (const PhotoSpec& photo : photos) json["photos"].push_back(photo_json(photo));
   return json;
 }
 

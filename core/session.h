@@ -31,6 +31,30 @@ struct RadiometrySpec {
   double black_level = 0.0;      // linear signal of a dark pixel, subtracted (normalized file units)
   double saturation_level = 1.0; // file value at which a channel is clipped (normalized file units)
   std::optional<CameraNoise> noise;
+  // Optional flat-field image (relative to the session folder): the camera's relative sensitivity per
+  // pixel (vignetting x pixel response), linear, 1 where exposure and gain alone are right (normally
+  // the image centre). Radiance is divided by it. Empty: no flat field.
+  std::string flat_field;
+};
+
+// One raw range scan of a mesh sample (what `ibrdf scan` merges into the sample's mesh file).
+struct ScanInputSpec {
+  std::string file;                        // relative to the session folder
+  std::optional<Rigid3d> world_from_scan;  // into the mesh's (scan) frame; identity when absent
+};
+
+// A marker measured by the range scanner: its four corners in the scan (mesh) frame, in the order of
+// targets.reference (top-left, top-right, bottom-right, bottom-left of the print).
+struct ScanTargetSpec {
+  int id = -1;
+  std::array<Eigen::Vector3d, 4> corners;  // scan frame, the mesh file's units
+};
+
+// When the mesh derenderer traces shadow rays (docs/derender.md).
+enum class Visibility {
+  kAuto,  // only where the mesh's convexity report (scan/convexity.h) says needs_shadow_rays
+  kOn,    // always
+  kOff,   // never
 };
 
 struct SampleSpec {
@@ -40,7 +64,12 @@ struct SampleSpec {
   double radius = 0.0;                               // sphere and cylinder, metres
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   // cylinder axis, unit
   double length = 0.0;                               // cylinder length along the axis, metres
-  std::string mesh_file;                             // mesh: path relative to the session folder
+  // Mesh samples. The file need not exist when the session is read (the scan stage may write it).
+  std::string mesh_file;                             // the scan stage's PLY, relative to the session folder
+  Sim3d world_from_mesh;                             // p_world = s R p_mesh + t; identity when absent
+  std::vector<ScanInputSpec> scan_inputs;            // raw scans merged into mesh_file (kept, not read)
+  std::vector<ScanTargetSpec> scan_targets;          // markers seen by the scanner, mesh frame
+  Visibility visibility = Visibility::kAuto;
 };
 
 // Coded targets (ArUco markers) seen in the photos. Reference markers have a known layout: their four
@@ -65,10 +94,29 @@ struct LightTargetsSpec {
   std::vector<LightMarkerSpec> markers;  // at least one
 };
 
+// Markers whose layout is unknown (align/bundle_adjustment.h): each a rigid printed square of side
+// `size` whose pose the bundle adjustment estimates. Without known-layout markers, marker `origin_id`
+// fixes the gauge: the world frame has its origin at that marker's centre, x to the right of the print,
+// y up the print, z out of the print (up, for a marker lying face-up); the scale comes from `size`.
+struct UnknownLayoutSpec {
+  double size = 0.0;              // metres, printed side (border included)
+  std::vector<int> ids;
+  std::optional<int> origin_id;   // required when `reference` is empty, not allowed otherwise
+};
+
+// Markers fixed to the sample (a cylinder's end cap): their corners in the sample's own frame (origin
+// at the cylinder's centre, z along its axis), in OpenCV's order. Their world corners come from the
+// bundle adjustment; the rigid fit of the two gives the cylinder's centre and axis (align/cylinder_fit.h).
+struct SampleTargetsSpec {
+  std::vector<TargetSpec> markers;  // corners in the sample frame, metres; each a square
+};
+
 struct TargetsSpec {
   std::string dictionary;              // OpenCV predefined dictionary name, e.g. "DICT_4X4_50"
-  std::vector<TargetSpec> reference;   // markers with known layout
+  std::vector<TargetSpec> reference;   // markers with known layout (may be empty with unknown_layout)
+  std::optional<UnknownLayoutSpec> unknown_layout;  // markers of unknown layout, if any
   std::optional<LightTargetsSpec> light;  // markers on the light, if any
+  std::optional<SampleTargetsSpec> sample;  // markers on the sample, if any
 };
 
 // What a photo is for: measurement photos are derendered; target photos only serve the alignment
@@ -81,6 +129,26 @@ struct PhotoSpec {
   double gain = 1.0;         // linear gain relative to the base ISO
   std::optional<Rigid3d> camera_from_world;  // known pose, if any
   PhotoRole role = PhotoRole::kMeasurement;
+  // Exposure bracket: measurement photos with the same bracket id are exposures of one pose, merged
+  // into one high-dynamic-range radiance image (derender/radiance_image.h). Absent: photos with
+  // identical poses still form one bracket.
+  std::optional<int> bracket;
+};
+
+// A white reference (the paper's Spectralon step): a flat Lambertian target of known reflectance at a
+// known pose, photographed under the session's light; it gives the light's RGB intensity in the
+// session's radiance unit (derender/light_calibration.h).
+struct WhiteReferenceSpec {
+  Eigen::Vector3d reflectance = Eigen::Vector3d::Constant(0.99);  // Lambertian albedo per channel
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // the target's centre, world frame, metres
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // its front face's normal (unit), world frame
+  double size = 0.0;  // metres: the side of a square target or the diameter of a round one
+  std::vector<PhotoSpec> photos;  // each with a camera_from_world pose
+};
+
+// Radiometric calibration steps that change the session's stated values.
+struct CalibrationSpec {
+  std::optional<WhiteReferenceSpec> white_reference;
 };
 
 struct Session {
@@ -94,6 +162,7 @@ struct Session {
   RadiometrySpec radiometry;
   std::vector<PhotoSpec> photos;
   std::optional<TargetsSpec> targets;
+  std::optional<CalibrationSpec> calibration;
 
   // Reads and validates a manifest (a session.json path, or a folder holding session.json). Unknown
   // keys, missing fields, wrong types, missing photo files and impossible values are Errors naming the
@@ -114,5 +183,8 @@ struct Session {
 
 // "sphere", "cylinder", "mesh".
 const char* SampleKindName(SampleSpec::Kind kind);
+// "auto", "on", "off"; and back (false for any other name).
+const char* VisibilityName(Visibility visibility);
+bool VisibilityFromName(const std::string& name, Visibility* visibility);
 
 }  // namespace ibrdf

@@ -13,12 +13,21 @@ namespace ibrdf {
 struct SurfaceHit {
   double t = 0.0;                                    // ray parameter, metres along a unit direction
   Eigen::Vector3d point = Eigen::Vector3d::Zero();   // world frame
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, outward
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, outward (a mesh: interpolated; zero if none)
+  // Mesh samples only (analytic shapes leave the defaults): the face's own unit normal, the face hit,
+  // and the quality of the interpolated normal's local-plane fit (scan/local_plane_normals.h).
+  Eigen::Vector3d geometric_normal = Eigen::Vector3d::Zero();
+  int face = -1;
+  float fit_rms_m = -1.0f;  // RMS residual of the fit, metres, interpolated; < 0: unknown
+  int fit_neighbours = -1;  // fewest points in the fits of the face's corners; < 0: unknown
 };
 
-class AnalyticSample {
+// What the derenderer needs of a sample's surface: rays hit it, a camera must be outside it, and a
+// bounding sphere culls the pixels that cannot see it. Analytic shapes (below) and the scanned mesh
+// (mesh_sample.h) implement it.
+class SampleSurface {
  public:
-  virtual ~AnalyticSample() = default;
+  virtual ~SampleSurface() = default;
   // The nearest hit with t > 0 of the ray origin + t * direction (direction unit length) on the
   // measured surface. False for a miss, for a ray that starts inside, and (cylinder) for rays that hit
   // an end cap first: the caps are not measured.
@@ -26,10 +35,17 @@ class AnalyticSample {
                          SurfaceHit* hit) const = 0;
   // True if the point is inside the solid (a camera there sees no outer surface).
   virtual bool Contains(const Eigen::Vector3d& point) const = 0;
-  // A bounding sphere: centre and radius (framing synthetic views).
+  // A bounding sphere: centre and radius (framing synthetic views, culling pixels).
   virtual Eigen::Vector3d BoundingCenter() const = 0;
   virtual double BoundingRadius() const = 0;
+  // True if the sample itself blocks the segment from `from` to `to` (a shadow ray; `from` on the
+  // surface). The default suits convex shapes, which never shadow themselves.
+  virtual bool Occluded(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const { return false; }
+};
 
+// The paper's analytic shapes: exact intersections and normals, no mesh.
+class AnalyticSample : public SampleSurface {
+ public:
   // A sphere or cylinder from a session's sample; throws Error for a mesh sample.
   static std::unique_ptr<AnalyticSample> Create(const SampleSpec& spec);
 };

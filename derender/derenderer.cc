@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 
 #include <nlohmann/json.hpp>
@@ -13,23 +14,57 @@
 
 #include "core/brdf_coords.h"
 #include "core/error.h"
+#include "core/file_util.h"
+#include "core/json_reader.h"
 #include "core/light.h"
 #include "derender/analytic_sample.h"
+#include "derender/light_calibration.h"
+#include "derender/mesh_sample.h"
 #include "derender/radiance_image.h"
+#include "scan/convexity.h"
+#include "scan/scan_io.h"
+#include "scan/scan_pipeline.h"
 
 namespace ibrdf {
 namespace {
 
+namespace fs = std::filesystem;
+
 constexpr double kDegree = M_PI / 180.0;
+
+// Rejection reasons in RejectionReasons() order; each pixel counts once, under the first that applies.
+enum Reason {
+  kOff,
+  kMixed,
+  kTarget,
+  kLowQuality,
+  kBackfacing,
+  kUnlit,
+  kGrazingE,
+  kGrazingI,
+  kShadowed,
+  kShadowEdge,
+  kNonFinite,
+  kSaturated,
+  kBelow,
+  kNumReasons
+};
+using ReasonCounts = std::array<uint64_t, kNumReasons>;
+
+void AddCounts(const ReasonCounts& counts, RejectionCounts* rejected) {
+  const auto& reasons = RejectionReasons();
+  for (int r = 0; r < kNumReasons; ++r) (*rejected)[reasons[r].first] += counts[r];
+}
 
 // The pixel box [x0, x1) x [y0, y1) that holds the projection of the sample's bounding sphere in one
 // photo, with a 2-pixel margin; the whole image where the cone around the sphere is too wide to
 // project (or holds the camera). Pixels outside it cannot see the sample.
 struct PixelBox {
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool Empty() const { return x1 <= x0 || y1 <= y0; }
 };
 
-PixelBox SampleBox(const Camera& camera, const Rigid3d& camera_from_world, const AnalyticSample& sample) {
+PixelBox SampleBox(const Camera& camera, const Rigid3d& camera_from_world, const SampleSurface& sample) {
   const PixelBox whole{0, 0, camera.width, camera.height};
   const Eigen::Vector3d c = camera_from_world * sample.BoundingCenter();
   const double distance = c.norm();
@@ -37,6 +72,8 @@ PixelBox SampleBox(const Camera& camera, const Rigid3d& camera_from_world, const
   if (!(distance > 1.5 * radius)) return whole;
   const Eigen::Vector3d axis = c / distance;
   const double sin_alpha = radius / distance, cos_alpha = std::sqrt(1.0 - sin_alpha * sin_alpha);
+  // Entirely behind the camera: nothing to see.
+  if (axis.z() < -sin_alpha) return PixelBox{};
   const Eigen::Vector3d u = axis.unitOrthogonal(), v = axis.cross(u);
   double x_min = 1e300, x_max = -1e300, y_min = 1e300, y_max = -1e300;
   constexpr int kPoints = 64;
@@ -60,6 +97,391 @@ PixelBox SampleBox(const Camera& camera, const Rigid3d& camera_from_world, const
   return box;
 }
 
+// The radiometric tests of a pixel (flags from radiance_image.h) in RejectionReasons() order;
+// kNumReasons when measurable.
+inline Reason RadiometricReason(uint8_t flags) {
+  if (flags & kPixelNonFinite) return kNonFinite;
+  if (flags & kPixelSaturated) return kSaturated;
+  if (flags & kPixelBelowSignal) return kBelow;
+  return kNumReasons;
+}
+
+// f = L / E per channel, in the local frame of `normal`.
+inline BrdfSample MakeSample(const RadianceImage& image, size_t p, const Eigen::Vector3d& normal,
+                             const Incidence& incidence, const Eigen::Vector3d& wo_world, size_t photo_index, int x,
+                             int y) {
+  const LocalFrame frame = LocalFrame::FromNormal(normal);
+  const Eigen::Vector3d wi = frame.ToLocal(incidence.wi);
+  const Eigen::Vector3d wo = frame.ToLocal(wo_world);
+  const IsotropicAngles angles = ToIsotropic(wi, wo);
+  BrdfSample s;
+  for (int c = 0; c < 3; ++c) {
+    s.wi[c] = static_cast<float>(wi[c]);
+    s.wo[c] = static_cast<float>(wo[c]);
+    const double irradiance = incidence.irradiance[c];
+    s.brdf[c] = static_cast<float>(image.radiance[3 * p + c] / irradiance);
+    s.sigma[c] = static_cast<float>(image.sigma[3 * p + c] / irradiance);
+  }
+  s.theta_i = static_cast<float>(angles.theta_i);
+  s.theta_e = static_cast<float>(angles.theta_e);
+  s.delta_phi = static_cast<float>(angles.delta_phi);
+  s.image = static_cast<uint32_t>(photo_index);
+  s.pixel[0] = static_cast<uint32_t>(x);
+  s.pixel[1] = static_cast<uint32_t>(y);
+  return s;
+}
+
+uint64_t PixelsPerImage(const Camera& camera, int stride) {
+  return uint64_t((camera.width + stride - 1) / stride) * uint64_t((camera.height + stride - 1) / stride);
+}
+
+// Everything the mesh path prepares once per session.
+struct MeshPath {
+  std::unique_ptr<MeshSample> mesh;
+  std::unique_ptr<QuadOccluders> occluders;  // null without reference markers
+  bool shadow_rays = false;
+  std::string visibility_reason;
+  std::vector<Eigen::Vector2f> corner_rays;  // PixelCornerRays, when mixed pixels are masked
+  double half_diagonal = 0.0;                // a pixel's half-diagonal, radians (image centre)
+};
+
+struct MeshPhotoStats {
+  ReasonCounts counts{};
+  uint64_t shadow_rays = 0;
+  uint64_t shadow_tests_skipped = 0;
+};
+
+// Whether the light reaches `point` (on the surface, normal `normal`, fit residual `fit_rms_m`):
+// kNumReasons if it does, kShadowed or kShadowEdge if not.
+Reason ShadowTest(const MeshSample& mesh, const Light& light, const Incidence& incidence, const Eigen::Vector3d& point,
+                  const Eigen::Vector3d& normal, float fit_rms_m, const DerenderOptions& options,
+                  uint64_t* rays) {
+  const double offset = 4.0 * mesh.Epsilon() + options.shadow_ray_offset_fit_rms * std::max(0.0f, fit_rms_m);
+  const Eigen::Vector3d from = point + offset * normal;
+  const double distance = light.kind == Light::Kind::kPoint ? (light.position - from).norm()
+                                                             : 4.0 * mesh.BoundingRadius();
+  const Eigen::Vector3d to = light.kind == Light::Kind::kPoint ? light.position : Eigen::Vector3d(from + distance * incidence.wi);
+  ++*rays;
+  if (mesh.Occluded(from, to)) return kShadowed;
+  if (options.shadow_edge_rays > 0 && options.shadow_edge_deg > 0.0) {
+    const double radius = distance * std::tan(options.shadow_edge_deg * kDegree);
+    const Eigen::Vector3d u = incidence.wi.unitOrthogonal(), v = incidence.wi.cross(u);
+    for (int k = 0; k < options.shadow_edge_rays; ++k) {
+      const double angle = 2.0 * M_PI * k / options.shadow_edge_rays;
+      ++*rays;
+      if (mesh.Occluded(from, to + radius * (std::cos(angle) * u + std::sin(angle) * v))) return kShadowEdge;
+    }
+  }
+  return kNumReasons;
+}
+
+// The mesh path's per-pixel work for one photo: rows of pixels in blocks across threads, each row's
+// rays handed to Embree together; samples in row-major order.
+void DerenderMeshPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
+                       const std::vector<Eigen::Vector2f>& rays, const MeshPath& path,
+                       const DerenderOptions& options, std::vector<BrdfSample>* samples, MeshPhotoStats* stats) {
+  const MeshSample& mesh = *path.mesh;
+  const PhotoSpec& photo = session.photos[photo_index];
+  const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
+  const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
+  const Eigen::Vector3d camera_center = world_from_camera.translation;
+  const double cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
+  const double cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
+  const int stride = options.pixel_stride;
+  const int width = image.width;
+  const bool mask_mixed = options.mask_mixed_pixels && !path.corner_rays.empty();
+
+  const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, mesh);
+  const int x_start = (box.x0 + stride - 1) / stride * stride, y_start = (box.y0 + stride - 1) / stride * stride;
+  std::vector<int> xs, ys;
+  for (int x = x_start; x < box.x1; x += stride) xs.push_back(x);
+  for (int y = y_start; y < box.y1; y += stride) ys.push_back(y);
+  const uint64_t examined = PixelsPerImage(session.camera, stride);
+  stats->counts[kOff] += examined - uint64_t(xs.size()) * ys.size();
+  if (xs.empty() || ys.empty()) return;
+  // Corner columns used by the row's pixels: x and x + 1 of each.
+  std::vector<int> corner_xs;
+  for (int x : xs) {
+    if (corner_xs.empty() || corner_xs.back() != x) corner_xs.push_back(x);
+    corner_xs.push_back(x + 1);
+  }
+  std::vector<int> corner_index(size_t(width) + 1, -1);
+  for (size_t k = 0; k < corner_xs.size(); ++k) corner_index[corner_xs[k]] = int(k);
+
+  constexpr int kRowsPerBlock = 8;
+  const size_t blocks = (ys.size() + kRowsPerBlock - 1) / kRowsPerBlock;
+  std::vector<std::vector<BrdfSample>> block_samples(blocks);
+  std::vector<MeshPhotoStats> block_stats(blocks);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+    std::vector<BrdfSample>& out = block_samples[b];
+    MeshPhotoStats& local = block_stats[b];
+    const size_t nx = xs.size(), nc = corner_xs.size();
+    std::vector<Eigen::Vector3d> directions(nx), corner_directions(nc);
+    std::vector<SurfaceHit> hits(nx), corner_hits(nc);
+    std::unique_ptr<bool[]> found(new bool[nx]), corner_found(new bool[nc]);
+    // Corner distances (NaN: the corner ray misses) of the rows above and below the pixel row.
+    std::vector<double> top(nc), bottom(nc);
+    int bottom_row = -1;
+    auto trace_corners = [&](int row, std::vector<double>* depths) {
+      for (size_t k = 0; k < nc; ++k) {
+        const Eigen::Vector2f& xy = path.corner_rays[size_t(row) * (width + 1) + corner_xs[k]];
+        corner_directions[k] = (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+      }
+      mesh.IntersectBatch(camera_center, corner_directions.data(), nc, corner_hits.data(), corner_found.get());
+      for (size_t k = 0; k < nc; ++k) {
+        (*depths)[k] = corner_found[k] ? corner_hits[k].t : std::numeric_limits<double>::quiet_NaN();
+      }
+    };
+    const size_t row_end = std::min(ys.size(), (b + 1) * kRowsPerBlock);
+    for (size_t r = b * kRowsPerBlock; r < row_end; ++r) {
+      const int y = ys[r];
+      for (size_t i = 0; i < nx; ++i) {
+        const Eigen::Vector2f& xy = rays[size_t(y) * width + xs[i]];
+        directions[i] = (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+      }
+      mesh.IntersectBatch(camera_center, directions.data(), nx, hits.data(), found.get());
+      bool any_hit = false;
+      for (size_t i = 0; i < nx; ++i) any_hit |= found[i];
+      if (!any_hit) {
+        local.counts[kOff] += nx;
+        continue;
+      }
+      if (mask_mixed) {
+        if (bottom_row == y) {
+          top.swap(bottom);
+        } else {
+          trace_corners(y, &top);
+        }
+        trace_corners(y + 1, &bottom);
+        bottom_row = y + 1;
+      }
+      for (size_t i = 0; i < nx; ++i) {
+        const int x = xs[i];
+        if (!found[i]) {
+          ++local.counts[kOff];
+          continue;
+        }
+        const SurfaceHit& hit = hits[i];
+        const Eigen::Vector3d& direction = directions[i];
+        if (mask_mixed) {
+          const double tolerance = options.mixed_pixel_depth_factor * hit.t * path.half_diagonal;
+          const int k0 = corner_index[x], k1 = corner_index[x + 1];
+          const double corners[4] = {top[k0], top[k1], bottom[k0], bottom[k1]};
+          bool mixed = false;
+          for (double t : corners) mixed |= !(std::abs(t - hit.t) <= tolerance);  // NaN (a miss) is mixed
+          if (mixed) {
+            ++local.counts[kMixed];
+            continue;
+          }
+        }
+        if (path.occluders && path.occluders->Blocks(camera_center, direction, hit.t)) {
+          ++local.counts[kTarget];
+          continue;
+        }
+        const bool no_fit = hit.fit_neighbours >= 0 && hit.fit_neighbours < options.min_fit_neighbours;
+        const bool poor_fit = options.max_normal_fit_rms_m > 0.0 && hit.fit_rms_m > options.max_normal_fit_rms_m;
+        if (hit.normal.isZero(0.0) || no_fit || poor_fit) {
+          ++local.counts[kLowQuality];
+          continue;
+        }
+        const Eigen::Vector3d wo_world = -direction;
+        const double cos_e = wo_world.dot(hit.normal);
+        if (!(cos_e > 0.0) || !(wo_world.dot(hit.geometric_normal) > 0.0)) {
+          ++local.counts[kBackfacing];
+          continue;
+        }
+        const Incidence incidence = IncidenceAt(session.light, hit.point, hit.normal);
+        if (!incidence.lit) {
+          ++local.counts[kUnlit];
+          continue;
+        }
+        if (!(cos_e >= cos_max_e)) {
+          ++local.counts[kGrazingE];
+          continue;
+        }
+        if (!(incidence.cos_theta >= cos_max_i)) {
+          ++local.counts[kGrazingI];
+          continue;
+        }
+        if (path.shadow_rays) {
+          const Reason shadow = ShadowTest(mesh, session.light, incidence, hit.point, hit.normal, hit.fit_rms_m,
+                                           options, &local.shadow_rays);
+          if (shadow != kNumReasons) {
+            ++local.counts[shadow];
+            continue;
+          }
+        } else {
+          ++local.shadow_tests_skipped;
+        }
+        const size_t p = image.Index(x, y);
+        const Reason radiometric = RadiometricReason(image.flags[p]);
+        if (radiometric != kNumReasons) {
+          ++local.counts[radiometric];
+          continue;
+        }
+        out.push_back(MakeSample(image, p, hit.normal, incidence, wo_world, photo_index, x, y));
+      }
+    }
+  });
+  size_t total = samples->size();
+  for (const auto& block : block_samples) total += block.size();
+  samples->reserve(total);
+  for (size_t b = 0; b < blocks; ++b) {
+    samples->insert(samples->end(), block_samples[b].begin(), block_samples[b].end());
+    for (int r = 0; r < kNumReasons; ++r) stats->counts[r] += block_stats[b].counts[r];
+    stats->shadow_rays += block_stats[b].shadow_rays;
+    stats->shadow_tests_skipped += block_stats[b].shadow_tests_skipped;
+  }
+}
+
+// Whether the scan's convexity report asks for shadow rays: from the scan stage's sidecar
+// (<mesh>.json, convexity.needs_shadow_rays) when there is one, else computed here.
+bool NeedsShadowRays(const std::string& mesh_path, const ScanMesh& mesh, std::string* reason) {
+  const std::string sidecar = ScanSidecarPath(mesh_path);
+  if (fs::is_regular_file(sidecar)) {
+    const nlohmann::json json = ReadJsonFile(sidecar);
+    const auto convexity = json.find("convexity");
+    if (convexity != json.end() && convexity->is_object()) {
+      const auto needs = convexity->find("needs_shadow_rays");
+      if (needs != convexity->end() && needs->is_boolean()) {
+        *reason = std::string("auto: the scan's convexity report (") + sidecar + ") says " +
+                  (needs->get<bool>() ? "not convex" : "convex");
+        return needs->get<bool>();
+      }
+    }
+    ThrowError(sidecar, "expected convexity.needs_shadow_rays (a boolean), as `ibrdf scan` writes it");
+  }
+  const ConvexityReport report = ReportConvexity(mesh, ConvexityOptions());
+  *reason = "auto: " + report.BriefReport() + " (computed here: no scan sidecar " + sidecar + ")";
+  return report.needs_shadow_rays;
+}
+
+MeshPath PrepareMeshPath(const Session& session, const DerenderOptions& options) {
+  MeshPath path;
+  const std::string file = ResolvePath(session.directory, session.sample.mesh_file);
+  const std::string where = session.manifest_path + ": /sample/file";
+  if (!fs::exists(file)) {
+    ThrowError(where, "the mesh " + file + " does not exist (`ibrdf scan` writes it from the scan_inputs)");
+  }
+  if (!fs::is_regular_file(file)) ThrowError(where, file + " is not a file");
+  const ScanMesh mesh = ReadScanFile(file);
+  path.mesh = std::make_unique<MeshSample>(mesh, session.sample.world_from_mesh, file);
+  const Visibility visibility = options.visibility.value_or(session.sample.visibility);
+  const std::string source = options.visibility ? "option" : "session";
+  switch (visibility) {
+    case Visibility::kOn:
+      path.shadow_rays = true;
+      path.visibility_reason = "on (" + source + ")";
+      break;
+    case Visibility::kOff:
+      path.shadow_rays = false;
+      path.visibility_reason = "off (" + source + ")";
+      break;
+    case Visibility::kAuto:
+      path.shadow_rays = NeedsShadowRays(file, mesh, &path.visibility_reason);
+      break;
+  }
+  if (session.targets) {
+    std::vector<std::array<Eigen::Vector3d, 4>> quads;
+    for (const TargetSpec& target : session.targets->reference) quads.push_back(target.corners);
+    if (!quads.empty()) path.occluders = std::make_unique<QuadOccluders>(quads);
+  }
+  if (options.mask_mixed_pixels) {
+    path.corner_rays = PixelCornerRays(session.camera);
+    path.half_diagonal = 0.5 * std::hypot(1.0 / session.camera.FocalX(), 1.0 / session.camera.FocalY());
+  }
+  Log(1, "mesh " + file + ": " + std::to_string(path.mesh->NumPoints()) + " points, " +
+             std::to_string(path.mesh->NumFaces()) + " faces" +
+             (path.mesh->HasFitQuality() ? "" : " (no fit quality: normals taken as they are)") +
+             "; shadow rays " + (path.shadow_rays ? "on" : "off") + ": " + path.visibility_reason);
+  return path;
+}
+
+// The stage for either path: checks, decoding across photos (exposure groups), per-pixel work, merge.
+DerenderResult RunDerender(const Session& session, const DerenderOptions& options, const SampleSurface& sample,
+                           const MeshPath* mesh_path) {
+  Timer timer;
+  DerenderResult result;
+  result.summary.sample = SampleKindName(session.sample.kind);
+  // Everything that can be checked before decoding is checked first, so a bad session fails at once.
+  for (size_t i = 0; i < session.photos.size(); ++i) {
+    const PhotoSpec& photo = session.photos[i];
+    const std::string where = session.manifest_path + ": /photos/" + std::to_string(i);
+    if (!photo.camera_from_world) {
+      ThrowError(where, "photo " + photo.file + " has no camera_from_world pose (run `ibrdf align` first)");
+    }
+    if (sample.Contains(photo.camera_from_world->Inverse().translation)) {
+      ThrowError(where, "the camera centre is inside the sample");
+    }
+  }
+  const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
+  bool any_sees = groups.empty();
+  for (const auto& group : groups) {
+    any_sees |= !SampleBox(session.camera, *session.photos[group.front()].camera_from_world, sample).Empty();
+  }
+  if (!any_sees) {
+    ThrowError(session.manifest_path, "no photo sees the sample: its bounding sphere projects outside every "
+                                      "measurement photo (check the sample's position" +
+                                          std::string(mesh_path ? " and world_from_mesh" : "") + " and the poses)");
+  }
+  session.CheckPhotos();
+
+  const std::vector<Eigen::Vector2f> rays = PixelRays(session.camera);
+  std::vector<std::vector<BrdfSample>> per_group(groups.size());
+  std::vector<RejectionCounts> per_group_rejected(groups.size());
+  std::vector<MeshPhotoStats> per_group_mesh(groups.size());
+  std::vector<double> decode_s(groups.size(), 0.0);
+  ProgressBar progress("photos", groups.size());
+  tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
+    const RadianceImage image = ReadRadianceImage(session, groups[g], options.min_signal, &decode_s[g]);
+    if (mesh_path) {
+      DerenderMeshPhoto(session, groups[g].front(), image, rays, *mesh_path, options, &per_group[g], &per_group_mesh[g]);
+      AddCounts(per_group_mesh[g].counts, &per_group_rejected[g]);
+    } else {
+      // Room for every examined pixel: only the pages written are touched, and the vector never regrows
+      // (regrowth copies and page faults cost more than the per-pixel geometry).
+      per_group[g].reserve(PixelsPerImage(session.camera, options.pixel_stride));
+      DerenderPhoto(session, groups[g].front(), image, rays, sample, options, &per_group[g], &per_group_rejected[g]);
+    }
+    progress.Add(1);
+  });
+  progress.Finish();
+
+  size_t total = 0;
+  for (const auto& samples : per_group) total += samples.size();
+  result.samples.reserve(total);
+  for (size_t g = 0; g < per_group.size(); ++g) {
+    result.samples.insert(result.samples.end(), per_group[g].begin(), per_group[g].end());
+    for (const auto& [reason, count] : per_group_rejected[g]) result.summary.rejected[reason] += count;
+    result.summary.decode_s += decode_s[g];
+    result.summary.shadow_rays += per_group_mesh[g].shadow_rays;
+    result.summary.shadow_tests_skipped += per_group_mesh[g].shadow_tests_skipped;
+  }
+  const size_t measured = groups.size();
+  result.summary.photos = measured;
+  result.summary.pixels_examined = PixelsPerImage(session.camera, options.pixel_stride) * measured;
+  result.summary.accepted = result.samples.size();
+  if (measured > 0 && result.summary.rejected["off_sample"] == result.summary.pixels_examined) {
+    ThrowError(session.manifest_path, "no photo sees the sample: every pixel's ray misses it (check the sample's "
+                                      "position" + std::string(mesh_path ? " and world_from_mesh" : "") +
+                                          " and the poses)");
+  }
+  if (mesh_path) {
+    result.summary.mesh_faces = mesh_path->mesh->NumFaces();
+    result.summary.shadow_rays_on = mesh_path->shadow_rays;
+    result.summary.visibility_reason = mesh_path->visibility_reason;
+    if (!mesh_path->shadow_rays) {
+      Log(1, "shadow rays skipped for " + std::to_string(result.summary.shadow_tests_skipped) +
+                 " pixels (visibility " + mesh_path->visibility_reason + ")");
+    } else {
+      Log(1, std::to_string(result.summary.shadow_rays) + " shadow rays traced");
+    }
+  }
+  result.summary.total_s = timer.ElapsedSeconds();
+  result.summary.success = true;
+  return result;
+}
+
 }  // namespace
 
 bool DerenderOptions::Check(std::string* why) const {
@@ -75,15 +497,37 @@ bool DerenderOptions::Check(std::string* why) const {
     *why = "pixel_stride must be at least 1";
     return false;
   }
+  if (!(mixed_pixel_depth_factor > 0.0)) {
+    *why = "mixed_pixel_depth_factor must be positive";
+    return false;
+  }
+  if (!(max_normal_fit_rms_m >= 0.0) || min_fit_neighbours < 0) {
+    *why = "max_normal_fit_rms_m and min_fit_neighbours must not be negative";
+    return false;
+  }
+  if (!(shadow_ray_offset_fit_rms >= 0.0)) {
+    *why = "shadow_ray_offset_fit_rms must not be negative";
+    return false;
+  }
+  if (!(shadow_edge_deg >= 0.0 && shadow_edge_deg < 45.0) || shadow_edge_rays < 0 || shadow_edge_rays > 64) {
+    *why = "shadow_edge_deg must be in [0, 45) and shadow_edge_rays in [0, 64]";
+    return false;
+  }
   return true;
 }
 
 const std::vector<std::pair<std::string, std::string>>& RejectionReasons() {
   static const std::vector<std::pair<std::string, std::string>> kReasons = {
       {"off_sample", "the pixel's ray misses the sample (background, or a cylinder's end cap)"},
+      {"mixed_pixel", "mesh: the pixel straddles the silhouette (a corner ray misses, or hits at a very different depth)"},
+      {"occluded_by_target", "mesh: a reference marker lies between the camera and the sample"},
+      {"low_quality_normal", "mesh: no normal, or its local-plane fit is poor (fit RMS or neighbours out of bounds)"},
+      {"backfacing", "mesh: the interpolated or the face normal turns away from the camera"},
       {"unlit", "the light is behind the surface at the hit point"},
       {"grazing_exitance", "theta_e above max_theta_e_deg"},
       {"grazing_incidence", "theta_i above max_theta_i_deg"},
+      {"shadowed", "mesh, shadow rays on: the sample itself blocks the light"},
+      {"shadow_edge", "mesh, shadow rays on: lit, but within shadow_edge_deg of a shadow edge"},
       {"non_finite", "a pixel value is NaN or infinite"},
       {"saturated", "a channel reaches the saturation level"},
       {"below_signal", "the darkest channel's linear signal is below min_signal"},
@@ -112,8 +556,21 @@ std::vector<Eigen::Vector2f> PixelRays(const Camera& camera) {
   return rays;
 }
 
+std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera) {
+  const int columns = camera.width + 1;
+  std::vector<Eigen::Vector2f> rays(size_t(columns) * (camera.height + 1));
+  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height + 1), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      for (int x = 0; x < columns; ++x) {
+        rays[size_t(y) * columns + x] = camera.CamPlaneFromImage(Eigen::Vector2d(x, y)).cast<float>();
+      }
+    }
+  });
+  return rays;
+}
+
 void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
-                   const std::vector<Eigen::Vector2f>& rays, const AnalyticSample& sample,
+                   const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
                    const DerenderOptions& options, std::vector<BrdfSample>* samples,
                    RejectionCounts* rejected) {
   const PhotoSpec& photo = session.photos[photo_index];
@@ -123,10 +580,7 @@ void DerenderPhoto(const Session& session, size_t photo_index, const RadianceIma
   const double cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
   const double cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
   const int stride = options.pixel_stride;
-
-  // Counters per reason, in RejectionReasons() order.
-  enum { kOff, kUnlit, kGrazingE, kGrazingI, kNonFinite, kSaturated, kBelow, kNumReasons };
-  std::array<uint64_t, kNumReasons> counts{};
+  ReasonCounts counts{};
 
   // Only the pixels that can see the sample are traced; the others are off the sample by construction.
   const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, sample);
@@ -158,102 +612,38 @@ void DerenderPhoto(const Session& session, size_t photo_index, const RadianceIma
         ++counts[kGrazingI];
         continue;
       }
-      // Pixel values: the radiometric flags in RejectionReasons() order.
       const size_t p = image.Index(x, y);
-      const uint8_t flags = image.flags[p];
-      if (flags & kPixelNonFinite) {
-        ++counts[kNonFinite];
+      const Reason radiometric = RadiometricReason(image.flags[p]);
+      if (radiometric != kNumReasons) {
+        ++counts[radiometric];
         continue;
       }
-      if (flags & kPixelSaturated) {
-        ++counts[kSaturated];
-        continue;
-      }
-      if (flags & kPixelBelowSignal) {
-        ++counts[kBelow];
-        continue;
-      }
-      const LocalFrame frame = LocalFrame::FromNormal(hit.normal);
-      const Eigen::Vector3d wi = frame.ToLocal(incidence.wi);
-      const Eigen::Vector3d wo = frame.ToLocal(wo_world);
-      const IsotropicAngles angles = ToIsotropic(wi, wo);
-      BrdfSample s;
-      for (int c = 0; c < 3; ++c) {
-        s.wi[c] = static_cast<float>(wi[c]);
-        s.wo[c] = static_cast<float>(wo[c]);
-        const double irradiance = incidence.irradiance[c];
-        s.brdf[c] = static_cast<float>(image.radiance[3 * p + c] / irradiance);
-        s.sigma[c] = static_cast<float>(image.sigma[3 * p + c] / irradiance);
-      }
-      s.theta_i = static_cast<float>(angles.theta_i);
-      s.theta_e = static_cast<float>(angles.theta_e);
-      s.delta_phi = static_cast<float>(angles.delta_phi);
-      s.image = static_cast<uint32_t>(photo_index);
-      s.pixel[0] = static_cast<uint32_t>(x);
-      s.pixel[1] = static_cast<uint32_t>(y);
-      samples->push_back(s);
+      samples->push_back(MakeSample(image, p, hit.normal, incidence, wo_world, photo_index, x, y));
     }
   }
-  const uint64_t examined = uint64_t((image.width + stride - 1) / stride) * uint64_t((image.height + stride - 1) / stride);
-  counts[kOff] += examined - traced;
-  const auto& reasons = RejectionReasons();
-  for (int r = 0; r < kNumReasons; ++r) (*rejected)[reasons[r].first] += counts[r];
+  counts[kOff] += PixelsPerImage(session.camera, stride) - traced;
+  AddCounts(counts, rejected);
 }
 
 DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& options) {
-  Timer timer;
-  DerenderResult result;
   std::string why;
   if (!options.Check(&why)) ThrowError("derender options", why);
   const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
-  // Everything that can be checked before decoding is checked first, so a bad session fails at once.
-  for (size_t i = 0; i < session.photos.size(); ++i) {
-    const PhotoSpec& photo = session.photos[i];
-    const std::string where = session.manifest_path + ": /photos/" + std::to_string(i);
-    if (!photo.camera_from_world) {
-      ThrowError(where, "photo " + photo.file + " has no camera_from_world pose (run `ibrdf align` first)");
-    }
-    if (sample->Contains(photo.camera_from_world->Inverse().translation)) {
-      ThrowError(where, "the camera centre is inside the sample");
-    }
-  }
-  session.CheckPhotos();
+  return RunDerender(session, options, *sample, nullptr);
+}
 
-  const std::vector<Eigen::Vector2f> rays = PixelRays(session.camera);
-  const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
-  std::vector<std::vector<BrdfSample>> per_group(groups.size());
-  std::vector<RejectionCounts> per_group_rejected(groups.size());
-  std::vector<double> decode_s(groups.size(), 0.0);
-  ProgressBar progress("photos", groups.size());
-  tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
-    const RadianceImage image = ReadRadianceImage(session, groups[g], options.min_signal, &decode_s[g]);
-    // Room for every examined pixel: only the pages written are touched, and the vector never regrows
-    // (regrowth copies and page faults cost more than the per-pixel geometry).
-    per_group[g].reserve(size_t((image.width + options.pixel_stride - 1) / options.pixel_stride) *
-                         size_t((image.height + options.pixel_stride - 1) / options.pixel_stride));
-    DerenderPhoto(session, groups[g].front(), image, rays, *sample, options, &per_group[g], &per_group_rejected[g]);
-    progress.Add(1);
-  });
-  progress.Finish();
-
-  size_t total = 0;
-  for (const auto& samples : per_group) total += samples.size();
-  result.samples.reserve(total);
-  for (size_t g = 0; g < per_group.size(); ++g) {
-    result.samples.insert(result.samples.end(), per_group[g].begin(), per_group[g].end());
-    for (const auto& [reason, count] : per_group_rejected[g]) result.summary.rejected[reason] += count;
-    result.summary.decode_s += decode_s[g];
-  }
-  const int stride = options.pixel_stride;
-  const uint64_t per_image = uint64_t((session.camera.width + stride - 1) / stride) *
-                             uint64_t((session.camera.height + stride - 1) / stride);
-  const size_t measured = groups.size();
-  result.summary.photos = measured;
-  result.summary.pixels_examined = per_image * measured;
-  result.summary.accepted = result.samples.size();
-  result.summary.total_s = timer.ElapsedSeconds();
-  result.summary.success = true;
-  return result;
+DerenderResult Derender(const Session& measured_session, const DerenderOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("derender options", why);
+  // The light's intensity from the white reference, where the session has one (light_calibration.h).
+  LightCalibrationReport calibration;
+  LightCalibrationOptions calibration_options;
+  calibration_options.min_signal = options.min_signal;
+  const Session session = ApplyLightCalibration(measured_session, &calibration, calibration_options);
+  if (calibration.calibrated) Log(1, calibration.BriefReport());
+  if (session.sample.kind != SampleSpec::Kind::kMesh) return DerenderAnalytic(session, options);
+  const MeshPath path = PrepareMeshPath(session, options);
+  return RunDerender(session, options, *path.mesh, &path);
 }
 
 nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options,
@@ -263,7 +653,7 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
     const auto it = summary.rejected.find(reason);
     rejected[reason] = it == summary.rejected.end() ? 0 : it->second;
   }
-  return {
+  nlohmann::json sidecar = {
       {"format", "ibrdf-samples"},
       {"version", 1},
       {"session", std::filesystem::absolute(session.manifest_path).lexically_normal().string()},
@@ -288,6 +678,24 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
         {"pixel_stride", options.pixel_stride}}},
       {"timings_s", {{"total", summary.total_s}, {"decode_cpu", summary.decode_s}}},
   };
+  if (session.sample.kind == SampleSpec::Kind::kMesh) {
+    sidecar["mesh"] = {{"file", session.sample.mesh_file},
+                       {"faces", summary.mesh_faces},
+                       {"shadow_rays", summary.shadow_rays_on},
+                       {"visibility", summary.visibility_reason},
+                       {"shadow_rays_traced", summary.shadow_rays},
+                       {"shadow_tests_skipped", summary.shadow_tests_skipped}};
+    nlohmann::json& o = sidecar["options"];
+    o["mask_mixed_pixels"] = options.mask_mixed_pixels;
+    o["mixed_pixel_depth_factor"] = options.mixed_pixel_depth_factor;
+    o["max_normal_fit_rms_m"] = options.max_normal_fit_rms_m;
+    o["min_fit_neighbours"] = options.min_fit_neighbours;
+    o["shadow_ray_offset_fit_rms"] = options.shadow_ray_offset_fit_rms;
+    o["shadow_edge_deg"] = options.shadow_edge_deg;
+    o["shadow_edge_rays"] = options.shadow_edge_rays;
+    o["visibility"] = VisibilityName(options.visibility.value_or(session.sample.visibility));
+  }
+  return sidecar;
 }
 
 }  // namespace ibrdf

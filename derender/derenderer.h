@@ -1,10 +1,14 @@
-// The analytic derenderer (the paper's section 3.1): every pixel of every photo is a BRDF sample.
-// For each pixel: the viewing ray (distortion included), its hit on the sphere or cylinder, the exact
-// normal, the point-source irradiance E = I cos(theta_i) / r^2, and f = L / E per colour channel, with
-// L the pixel's linear signal divided by exposure time and gain.
+// The derenderer (the paper's section 3.1): every pixel of every photo is a BRDF sample. For each
+// pixel: the viewing ray (distortion included), its hit on the sample, the normal there, the
+// point-source irradiance E = I cos(theta_i) / r^2, and f = L / E per colour channel, with L the
+// pixel's radiance (radiance_image.h). The sample is an analytic sphere or cylinder (exact hits and
+// normals) or a scanned mesh (mesh_sample.h: Embree, normals interpolated from the scan's local-plane
+// fits), with masks for silhouette pixels, markers in front of the sample, back faces, poor normals
+// and, where the sample is not convex, shadows (docs/derender.md).
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,15 +32,48 @@ struct DerenderOptions {
   // Use every n-th pixel in x and in y (1 = all pixels).
   int pixel_stride = 1;
 
+  // Mesh samples only (docs/derender.md).
+  // Shadow rays: overrides the session's sample.visibility (auto: only where the scan's convexity
+  // report says needs_shadow_rays) when set.
+  std::optional<Visibility> visibility;
+  // Silhouette (mixed) pixels: rays through the pixel's four corners must all hit the sample, at
+  // distances within mixed_pixel_depth_factor pixel footprints of the centre's (a footprint: the
+  // centre's distance times the pixel's half-diagonal angle). At theta_e <= 80 degrees a smooth
+  // surface changes depth by at most 5.7 footprints across the pixel, so 8 catches steps only.
+  bool mask_mixed_pixels = true;
+  double mixed_pixel_depth_factor = 8.0;
+  // Normal quality from the scan's local-plane fit: a hit whose interpolated fit RMS exceeds this
+  // (metres; 0: no limit), or one of whose face's corners had fewer than min_fit_neighbours points
+  // in its fit (0 = no fit: the mesh's own normal), is rejected. Meshes without fit data pass.
+  double max_normal_fit_rms_m = 0.0005;
+  int min_fit_neighbours = 5;
+  // With shadow rays on: a shadow ray starts this many local fit RMS residuals (plus a tiny epsilon)
+  // off the surface along the normal, so scanner noise on the faces around the hit (bumps the fitted
+  // normal smooths over) does not shadow it.
+  double shadow_ray_offset_fit_rms = 3.0;
+  // Shadow edges: shadow_edge_rays extra rays to points on a disc around the light, perpendicular to
+  // the light direction, of angular radius shadow_edge_deg seen from the hit; if any is blocked the
+  // pixel lies within that angle of a shadow edge (where mesh and light-position errors decide
+  // lit or not) and is rejected. 0 rays: no test.
+  double shadow_edge_deg = 0.5;
+  int shadow_edge_rays = 8;
+
   bool Check(std::string* why) const;
 };
 
 struct DerenderSummary {
   bool success = false;           // false until the stage ran to the end
+  std::string sample;             // "sphere", "cylinder" or "mesh"
   uint64_t photos = 0;            // measurement photos (alignment-only photos are skipped)
   uint64_t pixels_examined = 0;   // pixels looked at (after the stride)
   uint64_t accepted = 0;
   RejectionCounts rejected;       // reason -> count; see RejectionReasons()
+  // Mesh samples: the mesh, whether shadow rays were traced and why, how many.
+  uint64_t mesh_faces = 0;
+  bool shadow_rays_on = false;
+  std::string visibility_reason;     // "visibility on (session)", "auto: convex (scan sidecar)" ...
+  uint64_t shadow_rays = 0;          // shadow rays traced (shadow-edge rays included)
+  uint64_t shadow_tests_skipped = 0; // pixels that would have had shadow rays, with visibility off
   double decode_s = 0.0;          // summed over threads: time to decode the photos
   double total_s = 0.0;           // wall clock
   // "derender: 1234567 samples from 20 photos in 2.1 s; rejected: off_sample 10, saturated 3"
@@ -51,23 +88,31 @@ struct DerenderResult {
 // The rejection reasons in the order they are tested, each with a one-line meaning.
 const std::vector<std::pair<std::string, std::string>>& RejectionReasons();
 
-// Derenders every photo of a session with a sphere or cylinder sample. Every photo needs a known
-// camera_from_world pose. Throws Error for a missing or mis-sized photo, a photo without a pose, or a
-// camera inside the sample.
+// Derenders every measurement photo of a session: first the white-reference light calibration where
+// the session has one (light_calibration.h), then the analytic path for a sphere or cylinder, the
+// mesh path for a scanned mesh. Every photo needs a known camera_from_world pose. Throws Error for a
+// missing or mis-sized photo, a photo without a pose, a camera inside the sample, a sample that no
+// photo sees, and (mesh) a missing or corrupt mesh file or one without normals.
+DerenderResult Derender(const Session& session, const DerenderOptions& options);
+
+// The analytic path alone, the session's light taken as stated (throws Error for a mesh sample).
 DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& options);
 
-// The per-pixel core, for one photo's radiance image (radiance_image.h; photo_index gives the pose):
-// appends accepted samples and counts rejections. `rays` holds the undistorted image-plane point
-// (x, y) of every pixel centre, row-major.
-class AnalyticSample;
+// The per-pixel core of the analytic path, for one photo's radiance image (radiance_image.h;
+// photo_index gives the pose): appends accepted samples and counts rejections. `rays` holds the
+// undistorted image-plane point (x, y) of every pixel centre, row-major. Any SampleSurface works;
+// a mesh gets none of the mesh path's masks here.
+class SampleSurface;
 struct RadianceImage;
 void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
-                   const std::vector<Eigen::Vector2f>& rays, const AnalyticSample& sample,
+                   const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
                    const DerenderOptions& options, std::vector<BrdfSample>* samples,
                    RejectionCounts* rejected);
 
 // Undistorted image-plane points of every pixel centre of the session's camera, row-major.
 std::vector<Eigen::Vector2f> PixelRays(const Camera& camera);
+// The same for the (width + 1) x (height + 1) pixel corners, row-major.
+std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera);
 
 // The sample file's sidecar: units, colour space, counts, options and the session it came from.
 nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options,

@@ -2,87 +2,319 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <map>
+#include <mutex>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "core/error.h"
+#include "core/file_util.h"
 #include "core/image_io.h"
 #include "core/logging.h"
+
+namespace fs = std::filesystem;
 
 namespace ibrdf {
 namespace {
 
-// Variance of a linear signal v (normalized units) from the camera noise model: shot noise
-// v / full_well, read noise (read / full_well)^2, and the file's quantization step through the slope
-// of the response.
-double SignalVariance(const RadiometrySpec& radiometry, double encoded, double linear) {
-  const CameraNoise& noise = *radiometry.noise;
-  double variance = std::max(linear, 0.0) / noise.full_well_e +
-                    (noise.read_noise_e / noise.full_well_e) * (noise.read_noise_e / noise.full_well_e);
-  if (noise.bits > 0) {
-    const double step = 1.0 / (std::ldexp(1.0, noise.bits) - 1.0);
-    const double slope = (radiometry.response.ToLinear(std::min(encoded + 0.5 * step, 1.0)) -
-                          radiometry.response.ToLinear(std::max(encoded - 0.5 * step, 0.0))) / step;
-    variance += (step * slope) * (step * slope) / 12.0;
+// Poses of one bracket may differ by this much (align poses each photo on its own).
+constexpr double kBracketMaxTranslation = 1e-3;  // metres
+constexpr double kBracketMaxRotation = 1e-3;     // radians
+
+// Response lookup table: nodes over [0, 1] file values, used above kTableStart (below it, where a
+// power curve bends hardest relative to its value, the response itself is evaluated).
+constexpr int kTableIntervals = 8192;
+constexpr double kTableStart = 1.0 / 64.0;
+
+bool SamePose(const Rigid3d& a, const Rigid3d& b) {
+  return a.rotation.coeffs() == b.rotation.coeffs() && a.translation == b.translation;
+}
+
+// The inverse of the flat field, 3 floats per pixel, and where it came from.
+struct FlatField {
+  std::vector<float> inverse;
+};
+
+// Reads and checks a flat-field image; cached per file (path, size, modification time) so that a
+// derender that reads every photo through ReadRadianceImage decodes it once.
+std::shared_ptr<const FlatField> LoadFlatField(const Session& session) {
+  const std::string path = ResolvePath(session.directory, session.radiometry.flat_field);
+  const std::string where = session.manifest_path + ": /radiometry/flat_field";
+  RequireFile(path, "flat-field image (" + where + ")");
+  std::string key = fs::absolute(path).lexically_normal().string() + "|" + std::to_string(fs::file_size(path)) + "|" +
+                    std::to_string(fs::last_write_time(path).time_since_epoch().count()) + "|" +
+                    std::to_string(session.camera.width) + "x" + std::to_string(session.camera.height);
+  static std::mutex mutex;
+  static std::map<std::string, std::shared_ptr<const FlatField>> cache;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    const auto it = cache.find(key);
+    if (it != cache.end()) return it->second;
   }
-  return variance;
+  const Image image = ReadImage(path);
+  if (image.width != session.camera.width || image.height != session.camera.height) {
+    ThrowError(path, "flat-field image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                         ", the camera is " + std::to_string(session.camera.width) + "x" +
+                         std::to_string(session.camera.height) + " (" + where + ")");
+  }
+  if (image.channels != 1 && image.channels < 3) {
+    ThrowError(path, "flat-field image: expected 1 (grey) or 3+ (RGB) channels, got " + std::to_string(image.channels));
+  }
+  auto flat = std::make_shared<FlatField>();
+  const size_t n = size_t(image.width) * image.height;
+  flat->inverse.resize(3 * n);
+  double centre_sum = 0.0;
+  size_t centre_count = 0;
+  for (size_t p = 0; p < n; ++p) {
+    for (int c = 0; c < 3; ++c) {
+      const float v = image.pixels[p * image.channels + (image.channels == 1 ? 0 : c)];
+      if (!(std::isfinite(v) && v > 0.0f)) {
+        ThrowError(path, "flat-field image: pixel (" + std::to_string(p % image.width) + ", " +
+                             std::to_string(p / image.width) + ") channel " + std::to_string(c) + " is " +
+                             std::to_string(v) + "; a relative sensitivity must be positive and finite");
+      }
+      flat->inverse[3 * p + c] = 1.0f / v;
+      const int x = int(p % image.width), y = int(p / image.width);
+      if (std::abs(x + 0.5 - 0.5 * image.width) < 0.05 * image.width &&
+          std::abs(y + 0.5 - 0.5 * image.height) < 0.05 * image.height) {
+        centre_sum += v;
+        ++centre_count;
+      }
+    }
+  }
+  const double centre = centre_count ? centre_sum / centre_count : 1.0;
+  if (std::abs(centre - 1.0) > 0.1) {
+    Log(1, "warning: flat-field image " + path + " averages " + std::to_string(centre) +
+               " at the image centre (expected about 1: radiance is divided by it as it is)");
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  cache[key] = flat;
+  return flat;
 }
 
 }  // namespace
 
 std::vector<std::vector<size_t>> ExposureGroups(const Session& session) {
   std::vector<std::vector<size_t>> groups;
+  std::map<int, size_t> bracket_group;  // bracket id -> group
   for (size_t i = 0; i < session.photos.size(); ++i) {
-    if (session.photos[i].role == PhotoRole::kTargets) continue;
-    groups.push_back({i});
+    const PhotoSpec& photo = session.photos[i];
+    if (photo.role == PhotoRole::kTargets) continue;
+    if (photo.bracket) {
+      const auto it = bracket_group.find(*photo.bracket);
+      if (it == bracket_group.end()) {
+        bracket_group[*photo.bracket] = groups.size();
+        groups.push_back({i});
+        continue;
+      }
+      std::vector<size_t>& group = groups[it->second];
+      const PhotoSpec& first = session.photos[group.front()];
+      if (first.camera_from_world && photo.camera_from_world) {
+        const double translation = (first.camera_from_world->translation - photo.camera_from_world->translation).norm();
+        const double rotation = first.camera_from_world->rotation.angularDistance(photo.camera_from_world->rotation);
+        if (translation > kBracketMaxTranslation || rotation > kBracketMaxRotation) {
+          ThrowError(session.manifest_path + ": /photos/" + std::to_string(i) + "/bracket",
+                     "photo " + photo.file + " is in bracket " + std::to_string(*photo.bracket) + " with photo " +
+                         first.file + " but their poses differ by " + std::to_string(translation * 1e3) + " mm and " +
+                         std::to_string(rotation * 180.0 / M_PI) + " degrees (a bracket is one camera pose)");
+        }
+      }
+      group.push_back(i);
+      continue;
+    }
+    // No bracket id: identical poses are one bracket.
+    bool joined = false;
+    if (photo.camera_from_world) {
+      for (std::vector<size_t>& group : groups) {
+        const PhotoSpec& first = session.photos[group.front()];
+        if (!first.bracket && first.camera_from_world && SamePose(*first.camera_from_world, *photo.camera_from_world)) {
+          group.push_back(i);
+          joined = true;
+          break;
+        }
+      }
+    }
+    if (!joined) groups.push_back({i});
   }
   return groups;
 }
 
-RadianceImage ReadRadianceImage(const Session& session, const std::vector<size_t>& group, double min_signal,
-                                double* decode_s) {
-  IBRDF_CHECK(group.size() == 1);
-  const size_t photo_index = group.front();
-  const PhotoSpec& photo = session.photos[photo_index];
-  const RadiometrySpec& radiometry = session.radiometry;
-  Timer timer;
-  const Image image = ReadImage(session.PhotoPath(photo_index));
-  if (decode_s) *decode_s += timer.ElapsedSeconds();
-  if (image.width != session.camera.width || image.height != session.camera.height) {
-    ThrowError(session.PhotoPath(photo_index), "is " + std::to_string(image.width) + "x" +
-                                                   std::to_string(image.height) + ", the camera is " +
-                                                   std::to_string(session.camera.width) + "x" +
-                                                   std::to_string(session.camera.height));
+struct RadianceReader::Impl {
+  RadiometrySpec radiometry;
+  std::string directory;
+  int width = 0, height = 0;
+  bool table = false;            // use the lookup table (non-linear responses)
+  std::vector<double> to_linear;  // response^-1 at kTableIntervals + 1 nodes over [0, 1]
+  std::shared_ptr<const FlatField> flat;
+
+  double ToLinear(double encoded) const {
+    if (!table || !(encoded >= kTableStart && encoded <= 1.0)) return radiometry.response.ToLinear(encoded);
+    const double x = encoded * kTableIntervals;
+    const int i = std::min(static_cast<int>(x), kTableIntervals - 1);
+    const double t = x - i;
+    return to_linear[i] + t * (to_linear[i + 1] - to_linear[i]);
+  }
+
+  // Variance of a linear signal (normalized units) from the camera noise model: shot noise
+  // signal / full_well, read noise (read / full_well)^2, and the file's quantization step through the
+  // slope of the response at the encoded value.
+  double SignalVariance(double encoded, double signal) const {
+    const CameraNoise& noise = *radiometry.noise;
+    const double read = noise.read_noise_e / noise.full_well_e;
+    double variance = std::max(signal, 0.0) / noise.full_well_e + read * read;
+    if (noise.bits > 0) {
+      const double step = 1.0 / (std::ldexp(1.0, noise.bits) - 1.0);
+      const double slope =
+          (ToLinear(std::min(encoded + 0.5 * step, 1.0)) - ToLinear(std::max(encoded - 0.5 * step, 0.0))) / step;
+      variance += (step * slope) * (step * slope) / 12.0;
+    }
+    return variance;
+  }
+};
+
+RadianceReader::RadianceReader(const Session& session) : impl_(std::make_unique<Impl>()) {
+  Impl& impl = *impl_;
+  impl.radiometry = session.radiometry;
+  impl.directory = session.directory;
+  impl.width = session.camera.width;
+  impl.height = session.camera.height;
+  impl.table = session.radiometry.response.kind != Response::Kind::kLinear;
+  if (impl.table) {
+    impl.to_linear.resize(kTableIntervals + 1);
+    for (int i = 0; i <= kTableIntervals; ++i) {
+      impl.to_linear[i] = session.radiometry.response.ToLinear(double(i) / kTableIntervals);
+    }
+  }
+  if (!session.radiometry.flat_field.empty()) impl.flat = LoadFlatField(session);
+}
+
+RadianceReader::~RadianceReader() = default;
+
+double RadianceReader::Linear(double encoded) const {
+  return impl_->ToLinear(encoded) - impl_->radiometry.black_level;
+}
+
+RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, double min_signal,
+                                   double* decode_s) const {
+  IBRDF_CHECK(!exposures.empty());
+  IBRDF_CHECK(exposures.size() < 256) << exposures.size() << " exposures";
+  const Impl& impl = *impl_;
+  const RadiometrySpec& radiometry = impl.radiometry;
+  const size_t m = exposures.size();
+  std::vector<Image> images(m);
+  std::vector<double> scale(m);  // exposure_s * gain
+  for (size_t e = 0; e < m; ++e) {
+    const std::string path = ResolvePath(impl.directory, exposures[e].file);
+    Timer timer;
+    images[e] = ReadImage(path);
+    if (decode_s) *decode_s += timer.ElapsedSeconds();
+    if (images[e].width != impl.width || images[e].height != impl.height) {
+      ThrowError(path, "is " + std::to_string(images[e].width) + "x" + std::to_string(images[e].height) +
+                           ", the camera is " + std::to_string(impl.width) + "x" + std::to_string(impl.height));
+    }
+    if (images[e].channels != 1 && images[e].channels < 3) {
+      ThrowError(path, "expected 1 (grey) or 3+ (RGB) channels, got " + std::to_string(images[e].channels));
+    }
+    scale[e] = exposures[e].exposure_s * exposures[e].gain;
   }
   RadianceImage out;
-  out.width = image.width;
-  out.height = image.height;
-  const size_t n = size_t(image.width) * image.height;
+  out.width = impl.width;
+  out.height = impl.height;
+  const size_t n = size_t(impl.width) * impl.height;
   out.radiance.resize(3 * n);
   out.sigma.assign(3 * n, 0.0f);
   out.flags.assign(n, 0);
-  const double scale = 1.0 / (photo.exposure_s * photo.gain);
-  const bool grey = image.channels == 1;
-  for (size_t p = 0; p < n; ++p) {
-    double encoded[3], linear[3];
-    bool finite = true, saturated = false;
-    for (int c = 0; c < 3; ++c) {
-      encoded[c] = image.pixels[p * image.channels + (grey ? 0 : c)];
-      finite = finite && std::isfinite(encoded[c]);
-      saturated = saturated || encoded[c] >= radiometry.saturation_level;
-      linear[c] = radiometry.response.ToLinear(encoded[c]) - radiometry.black_level;
-    }
-    uint8_t flags = 0;
-    if (!finite) flags |= kPixelNonFinite;
-    if (saturated) flags |= kPixelSaturated;
-    if (!(std::min({linear[0], linear[1], linear[2]}) >= min_signal)) flags |= kPixelBelowSignal;
-    out.flags[p] = flags;
-    for (int c = 0; c < 3; ++c) {
-      out.radiance[3 * p + c] = static_cast<float>(linear[c] * scale);
-      if (radiometry.noise && finite) {
-        out.sigma[3 * p + c] = static_cast<float>(std::sqrt(SignalVariance(radiometry, encoded[c], linear[c])) * scale);
+  if (m > 1) out.exposures_used.assign(n, 0);
+  const bool noise = radiometry.noise.has_value();
+  const float* inverse_flat = impl.flat ? impl.flat->inverse.data() : nullptr;
+
+  tbb::parallel_for(tbb::blocked_range<int>(0, impl.height), [&](const tbb::blocked_range<int>& rows) {
+    // Per exposure of the pixel being worked on.
+    std::vector<double> encoded(3 * m), radiance(3 * m);
+    std::vector<uint8_t> flags(m);
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      for (int x = 0; x < impl.width; ++x) {
+        const size_t p = size_t(y) * impl.width + x;
+        double inverse[3] = {1.0, 1.0, 1.0};
+        if (inverse_flat) {
+          for (int c = 0; c < 3; ++c) inverse[c] = inverse_flat[3 * p + c];
+        }
+        // Each exposure on its own: flags and radiance. `best` is the usable exposure with the most
+        // signal (the longest), the reference for the noise model's weights.
+        int best = -1;
+        uint8_t all_flags = 0xff;
+        for (size_t e = 0; e < m; ++e) {
+          const Image& image = images[e];
+          const float* values = &image.pixels[p * image.channels];
+          bool finite = true, saturated = false;
+          double darkest = 1e300;
+          for (int c = 0; c < 3; ++c) {
+            const double v = values[image.channels == 1 ? 0 : c];
+            encoded[3 * e + c] = v;
+            finite = finite && std::isfinite(v);
+            saturated = saturated || v >= radiometry.saturation_level;
+            const double linear = impl.ToLinear(v) - radiometry.black_level;
+            darkest = std::min(darkest, linear);
+            radiance[3 * e + c] = linear / scale[e] * inverse[c];
+          }
+          uint8_t f = 0;
+          if (!finite) f |= kPixelNonFinite;
+          if (saturated) f |= kPixelSaturated;
+          if (!(darkest >= min_signal)) f |= kPixelBelowSignal;
+          flags[e] = f;
+          all_flags &= f;
+          if (f == 0 && (best < 0 || scale[e] > scale[best])) best = int(e);
+        }
+        if (best < 0) {
+          // No usable exposure: the reasons every exposure shares, or for mixed reasons the one a
+          // longer exposure would not fix (clipping) before the one it would (the floor).
+          uint8_t f = all_flags;
+          if (f == 0) {
+            bool any_saturated = false;
+            for (size_t e = 0; e < m; ++e) any_saturated = any_saturated || (flags[e] & kPixelSaturated);
+            f = any_saturated ? kPixelSaturated : kPixelBelowSignal;
+          }
+          out.flags[p] = f;
+          for (int c = 0; c < 3; ++c) out.radiance[3 * p + c] = static_cast<float>(radiance[c]);
+          continue;
+        }
+        int used = 0;
+        for (int c = 0; c < 3; ++c) {
+          // Inverse-variance weights, the variance predicted from the reference radiance (not from
+          // each exposure's own noisy value, which would favour exposures that happened to read low).
+          const double reference = radiance[3 * best + c];
+          double weight_sum = 0.0, weighted = 0.0;
+          for (size_t e = 0; e < m; ++e) {
+            if (flags[e] != 0) continue;
+            double weight;
+            if (noise) {
+              const double to_radiance = inverse[c] / scale[e];
+              const double signal = reference / to_radiance;
+              weight = 1.0 / (impl.SignalVariance(encoded[3 * e + c], signal) * to_radiance * to_radiance);
+            } else {
+              weight = scale[e] * scale[e];  // equal signal noise: radiance variance ~ 1 / scale^2
+            }
+            weight_sum += weight;
+            weighted += weight * radiance[3 * e + c];
+            used += c == 0;
+          }
+          out.radiance[3 * p + c] = static_cast<float>(weighted / weight_sum);
+          if (noise) out.sigma[3 * p + c] = static_cast<float>(1.0 / std::sqrt(weight_sum));
+        }
+        if (m > 1) out.exposures_used[p] = static_cast<uint8_t>(used);
       }
     }
-  }
+  });
   return out;
+}
+
+RadianceImage ReadRadianceImage(const Session& session, const std::vector<size_t>& group, double min_signal,
+                                double* decode_s) {
+  std::vector<PhotoSpec> exposures;
+  for (size_t i : group) exposures.push_back(session.photos.at(i));
+  return RadianceReader(session).Read(exposures, min_signal, decode_s);
 }
 
 }  // namespace ibrdf

@@ -1,11 +1,14 @@
-// The radiometric half of derendering: a photo's file values to radiance. Each step follows the
-// session's radiometry block (docs/session-format.md): the response inverted, the black level
-// subtracted, divided by exposure time and gain; and each pixel flagged where it cannot be measured
-// (clipped, not finite, below the signal floor), with a one-sigma uncertainty from the camera's noise
-// model. The geometric half (rays, hits, normals, irradiance) lives in derenderer.cc.
+// The radiometric half of derendering: a photo's file values to radiance (docs/radiometry.md). Each
+// step follows the session's radiometry block (docs/session-format.md): the response inverted, the
+// black level subtracted, divided by exposure time and gain and by the flat field; each pixel flagged
+// where it cannot be measured (clipped, not finite, below the signal floor), with a one-sigma
+// uncertainty from the camera's noise model. The exposures of one pose (a bracket) are merged into one
+// high-dynamic-range radiance image, inverse-variance weighted. The geometric half (rays, hits,
+// normals, irradiance) lives in derenderer.cc.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,7 +20,7 @@ namespace ibrdf {
 
 // Per-pixel flags of a RadianceImage (bits; 0 = measurable).
 enum PixelFlag : uint8_t {
-  kPixelNonFinite = 1,    // a channel is NaN or infinite in the file
+  kPixelNonFinite = 1,    // a channel is NaN or infinite in the file (in every exposure of a bracket)
   kPixelSaturated = 2,    // a channel reached the saturation level (in every exposure of a bracket)
   kPixelBelowSignal = 4,  // the darkest channel's linear signal is below the floor (in every exposure)
 };
@@ -25,23 +28,53 @@ enum PixelFlag : uint8_t {
 struct RadianceImage {
   int width = 0;
   int height = 0;
-  // 3 floats per pixel, row-major: linear signal / (exposure_s * gain), in the session's radiance unit.
+  // 3 floats per pixel, row-major: linear signal / (exposure_s * gain * flat field), in the session's
+  // radiance unit; for a bracket, the inverse-variance weighted mean of its usable exposures.
   std::vector<float> radiance;
   // 3 floats per pixel: one standard deviation of radiance from the camera noise model (0 without one).
   std::vector<float> sigma;
   std::vector<uint8_t> flags;  // one per pixel, PixelFlag bits
+  // Per pixel, how many exposures of the bracket were merged (0 where flagged). Filled for brackets of
+  // more than one photo only (empty otherwise).
+  std::vector<uint8_t> exposures_used;
 
   size_t Index(int x, int y) const { return size_t(y) * width + x; }
 };
 
-// The photos to derender, grouped by pose: measurement photos sharing one camera_from_world pose
-// (an exposure bracket) form one group; every other measurement photo is a group of its own.
-// Alignment-only photos (role "targets") are in no group. Groups are ordered by their first photo.
+// The photos to derender, grouped by pose: measurement photos with the same `bracket` id form one
+// group (an exposure bracket; their poses must agree to 1 mm and 0.06 degrees); measurement photos
+// without a bracket id form one group per distinct camera_from_world (identical poses are a bracket);
+// a photo without a pose is a group of its own. Alignment-only photos (role "targets") are in no
+// group. Groups are ordered by their first photo. Throws Error naming the manifest's photo for a
+// bracket whose poses disagree.
 std::vector<std::vector<size_t>> ExposureGroups(const Session& session);
 
-// Decodes the photos of one group and turns them into one radiance image. `min_signal` is the signal
-// floor in linear normalized file units (DerenderOptions::min_signal). `decode_s`, when given, gets
-// the seconds spent decoding files. Throws Error naming the photo for an unreadable or mis-sized file.
+// The session's radiometric chain, prepared once (response lookup table, flat field) and applied to
+// any number of photos, from any number of threads.
+class RadianceReader {
+ public:
+  // Reads and checks the flat field (size against the camera, positive finite values); throws Error
+  // naming the file.
+  explicit RadianceReader(const Session& session);
+  ~RadianceReader();
+
+  // Decodes the exposures of one pose (paths resolved against the session folder) and merges them
+  // into one radiance image. `min_signal` is the signal floor in linear normalized file units
+  // (DerenderOptions::min_signal). `decode_s`, when given, gets the seconds spent decoding files added.
+  // Throws Error naming the photo for an unreadable or mis-sized file.
+  RadianceImage Read(const std::vector<PhotoSpec>& exposures, double min_signal, double* decode_s = nullptr) const;
+
+  // The linear signal of a file value (response inverted, black level subtracted), through a lookup
+  // table for values in [1/64, 1] (exact for linear responses; within 3e-5 relative otherwise).
+  double Linear(double encoded) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Decodes the photos of one group (session.photos indices) and turns them into one radiance image,
+// as RadianceReader(session).Read(...) does (the flat field is read once per process and file).
 RadianceImage ReadRadianceImage(const Session& session, const std::vector<size_t>& group, double min_signal,
                                 double* decode_s = nullptr);
 

@@ -20,6 +20,9 @@
 #include "core/radiometry.h"
 #include "align/markers.h"
 #include "derender/analytic_sample.h"
+#include "scan/ply_io.h"
+#include "derender/synthetic_radiometry.h"
+#include "derender/synthetic_targets.h"
 
 namespace fs = std::filesystem;
 
@@ -27,18 +30,35 @@ namespace ibrdf {
 namespace {
 constexpr double kDegree = M_PI / 180.0;
 
+// Where an irregular-shape session keeps its scan (relative to the session folder).
+constexpr char kScanMesh[] = "scan/mesh.ply";
+constexpr char kTruthMesh[] = "truth-mesh.ply";
+
+// The true shape a session renders: the irregular shape, or the session's own sphere or cylinder.
+std::unique_ptr<AnalyticSample> TrueSample(const SynthOptions& options, const Session& session) {
+  if (options.shape != SynthOptions::Shape::kNone) return MakeTrueShape(options);
+  return AnalyticSample::Create(session.sample);
+}
+
 // The session (camera, light, sample, poses) an options object describes, without photos on disk.
 Session BuildSession(const SynthOptions& options) {
   Session session;
   SampleSpec& sample = session.sample;
-  sample.kind = options.sample;
-  sample.center = options.origin;
-  sample.radius = options.sample_radius;
-  if (sample.kind == SampleSpec::Kind::kCylinder) {
-    sample.axis = Eigen::Vector3d::UnitZ();
-    sample.length = options.cylinder_length;
+  double bounding_radius = 0.0;
+  if (options.shape != SynthOptions::Shape::kNone) {
+    sample.kind = SampleSpec::Kind::kMesh;
+    sample.mesh_file = kScanMesh;
+    bounding_radius = MakeTrueShape(options)->BoundingRadius();
+  } else {
+    sample.kind = options.sample;
+    sample.center = options.origin;
+    sample.radius = options.sample_radius;
+    if (sample.kind == SampleSpec::Kind::kCylinder) {
+      sample.axis = Eigen::Vector3d::UnitZ();
+      sample.length = options.cylinder_length;
+    }
+    bounding_radius = AnalyticSample::Create(sample)->BoundingRadius();
   }
-  const double bounding_radius = AnalyticSample::Create(sample)->BoundingRadius();
 
   session.light.kind = Light::Kind::kPoint;
   session.light.position = options.origin + options.light_distance * Eigen::Vector3d::UnitX();
@@ -70,6 +90,8 @@ Session BuildSession(const SynthOptions& options) {
     TargetsSpec targets;
     targets.dictionary = options.target_dictionary;
     targets.reference = TargetLayout(options);
+    const SampleTargetsSpec sample_targets = SampleTargetLayout(options, nullptr);
+    if (!sample_targets.markers.empty()) targets.sample = sample_targets;
     const LightTargetsSpec light = LightTargetLayout(options, nullptr);
     if (!light.markers.empty()) targets.light = light;
     session.targets = targets;
@@ -112,11 +134,13 @@ Session BuildSession(const SynthOptions& options) {
       session.photos.push_back(photo);
     }
   }
+  ExpandBrackets(options, &session);  // radiometry hook: exposure brackets
   return session;
 }
 
 // The platform plane's height: the sample rests on it.
 double PlatformHeight(const SynthOptions& options) {
+  if (options.shape != SynthOptions::Shape::kNone) return options.origin.z() + MakeTrueShape(options)->LowestZ();
   const double below = options.sample == SampleSpec::Kind::kCylinder ? 0.5 * options.cylinder_length : options.sample_radius;
   return options.origin.z() - below;
 }
@@ -160,6 +184,17 @@ class TargetScene {
       card.background = options.target_white;
       card.markers = light_markers;
       boards_.push_back(card);
+    }
+    std::vector<TargetSpec> sample_markers;
+    SampleTargetLayout(options, &sample_markers);
+    if (!sample_markers.empty()) {
+      // The cylinder's top cap: a black disk carrying the sample's markers.
+      Board cap;
+      cap.center = options.origin + 0.5 * options.cylinder_length * Eigen::Vector3d::UnitZ();
+      cap.radius = options.sample_radius;
+      cap.background = options.target_black;
+      cap.markers = sample_markers;
+      boards_.push_back(cap);
     }
     for (Board& board : boards_) {
       for (const TargetSpec& target : board.markers) board.modules.push_back(dictionary_.Modules(target.id));
@@ -216,9 +251,8 @@ class TargetScene {
 // Composites the target boards into a photo's linear signal where the pixel centre misses the sample:
 // 4 x 4 rays per pixel, the boards' fraction of them averaged (sharp, anti-aliased marker edges).
 void CompositeTargets(const Session& session, size_t photo_index, const TargetScene& scene,
-                      const std::vector<uint8_t>& sample_mask, Image* signal) {
+                      const AnalyticSample& sample, const std::vector<uint8_t>& sample_mask, Image* signal) {
   const Camera& camera = session.camera;
-  const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
   const Rigid3d world_from_camera = session.photos[photo_index].camera_from_world->Inverse();
   const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
   const Eigen::Vector3d center = world_from_camera.translation;
@@ -231,7 +265,7 @@ void CompositeTargets(const Session& session, size_t photo_index, const TargetSc
     const double value = scene.Trace(center, direction, &t);
     if (!(value > 0.0)) return 0.0;
     SurfaceHit hit;
-    if (sample->Intersect(center, direction, &hit) && hit.t < t) return 0.0;
+    if (sample.Intersect(center, direction, &hit) && hit.t < t) return 0.0;
     return value;
   };
   // Values at the pixel corners; a pixel whose four corners agree is uniform (one value), the others
@@ -264,7 +298,83 @@ void CompositeTargets(const Session& session, size_t photo_index, const TargetSc
   });
 }
 
+// The fine truth mesh: a latitude-longitude grid of directions from the centre, each mapped to the
+// surface point along it (every shape is star-shaped about its centre), with the exact normals.
+ScanMesh TruthMesh(const ImplicitSample& shape, double spacing_m) {
+  const int rings = std::max(8, static_cast<int>(std::ceil(M_PI * shape.BoundingRadius() / spacing_m)));
+  const int segments = 2 * rings;
+  ScanMesh mesh;
+  mesh.points.resize(size_t(rings - 1) * segments + 2);
+  mesh.normals.resize(mesh.points.size());
+  auto solve = [&](size_t index, double theta, double phi) {
+    const Eigen::Vector3d u(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+    mesh.points[index] = shape.RadialPoint(u, &mesh.normals[index]);
+  };
+  solve(0, 0.0, 0.0);
+  solve(mesh.points.size() - 1, M_PI, 0.0);
+  tbb::parallel_for(1, rings, [&](int i) {
+    for (int j = 0; j < segments; ++j) {
+      solve(1 + size_t(i - 1) * segments + j, M_PI * i / rings, 2.0 * M_PI * j / segments);
+    }
+  });
+  const int south = static_cast<int>(mesh.points.size()) - 1;
+  auto at = [&](int ring, int segment) { return 1 + (ring - 1) * segments + (segment % segments); };
+  for (int j = 0; j < segments; ++j) {
+    mesh.faces.emplace_back(0, at(1, j), at(1, j + 1));
+    mesh.faces.emplace_back(south, at(rings - 1, j + 1), at(rings - 1, j));
+  }
+  for (int i = 1; i + 1 < rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      mesh.faces.emplace_back(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      mesh.faces.emplace_back(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  }
+  return mesh;
+}
+
+nlohmann::json RigidJson(const Rigid3d& transform) {
+  const Eigen::Quaterniond& q = transform.rotation;
+  return {{"rotation", {q.w(), q.x(), q.y(), q.z()}}, {"translation", ToJson(transform.translation)}};
+}
+
+Image RenderRadianceImpl(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
+                         const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask,
+                         uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance);
+
 }  // namespace
+
+const char* SynthShapeName(SynthOptions::Shape shape) {
+  switch (shape) {
+    case SynthOptions::Shape::kNone: return "none";
+    case SynthOptions::Shape::kSquash: return "squash";
+    case SynthOptions::Shape::kPot: return "pot";
+    case SynthOptions::Shape::kDent: return "dent";
+  }
+  return "none";
+}
+
+SynthOptions::Shape SynthShapeFromName(const std::string& name) {
+  for (SynthOptions::Shape shape : {SynthOptions::Shape::kNone, SynthOptions::Shape::kSquash,
+                                    SynthOptions::Shape::kPot, SynthOptions::Shape::kDent}) {
+    if (name == SynthShapeName(shape)) return shape;
+  }
+  ThrowError("synth shape", "unknown shape \"" + name + "\" (expected squash, pot or dent)");
+}
+
+std::unique_ptr<ImplicitSample> MakeTrueShape(const SynthOptions& options) {
+  switch (options.shape) {
+    case SynthOptions::Shape::kNone: return nullptr;
+    case SynthOptions::Shape::kSquash: return std::make_unique<SquashSample>(options.origin, options.squash);
+    case SynthOptions::Shape::kPot: return std::make_unique<PotSample>(options.origin, options.pot);
+    case SynthOptions::Shape::kDent: return std::make_unique<DentedSphereSample>(options.origin, options.dent);
+  }
+  return nullptr;
+}
+
+Rigid3d ScanFromWorld(const SynthOptions& options) {
+  const Eigen::Quaterniond rotation(Eigen::AngleAxisd(35.0 * kDegree, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()));
+  return Rigid3d(rotation, options.scan_offset_m * Eigen::Vector3d(0.6, -0.48, 0.64));
+}
 
 std::vector<TargetSpec> TargetLayout(const SynthOptions& options) {
   std::vector<TargetSpec> layout;
@@ -345,20 +455,44 @@ bool CameraEffects::Check(std::string* why) const {
     *why = "supersample must be 1 to 16";
     return false;
   }
+  if (!(vignetting >= 0.0 && vignetting < 0.9)) {
+    *why = "vignetting must be in [0, 0.9)";
+    return false;
+  }
   return true;
 }
 
 bool SynthOptions::Check(std::string* why) const {
   if (sample == SampleSpec::Kind::kMesh) {
-    *why = "synth renders a sphere or a cylinder";
+    *why = "synth renders a sphere or a cylinder (or, with shape, a squash, pot or dent as a mesh sample)";
     return false;
   }
   if (!(sample_radius > 0.0) || !(cylinder_length > 0.0)) {
     *why = "sample sizes must be positive";
     return false;
   }
-  const double bounding = sample == SampleSpec::Kind::kCylinder ? std::hypot(sample_radius, 0.5 * cylinder_length)
-                                                                : sample_radius;
+  double bounding = sample == SampleSpec::Kind::kCylinder ? std::hypot(sample_radius, 0.5 * cylinder_length)
+                                                          : sample_radius;
+  if (shape != Shape::kNone) {
+    if (!squash.Check(why) || !pot.Check(why) || !dent.Check(why) || !scanner.Check(why)) return false;
+    if (!targets) {
+      *why = "an irregular shape needs targets: the platform's markers register its scan to the photos";
+      return false;
+    }
+    if (!(scan_offset_m >= 0.0) || !(scan_target_noise_m >= 0.0) || !(truth_mesh_spacing_m > 0.0)) {
+      *why = "scan_offset_m and scan_target_noise_m must be >= 0, truth_mesh_spacing_m > 0";
+      return false;
+    }
+    bounding = MakeTrueShape(*this)->BoundingRadius();
+    if (!(scanner.distance_m > 1.5 * bounding)) {
+      *why = "the scanner must be well outside the sample";
+      return false;
+    }
+    if (!(truth_mesh_spacing_m < 0.1 * bounding)) {
+      *why = "truth_mesh_spacing_m must be below a tenth of the sample's size";
+      return false;
+    }
+  }
   if (!(camera_distance > 1.5 * bounding) || !(light_distance > bounding)) {
     *why = "the camera and the light must be well outside the sample";
     return false;
@@ -371,6 +505,10 @@ bool SynthOptions::Check(std::string* why) const {
     *why = "image size must be 8 to 20000 pixels a side";
     return false;
   }
+  if (!(fill_light >= 0.0 && fill_light < 1.0)) {
+    *why = "fill_light must be in [0, 1)";
+    return false;
+  }
   if (!(frame_fraction > 0.0 && frame_fraction <= 1.0) || !(exposure_target > 0.0 && exposure_target <= 1.0)) {
     *why = "frame_fraction and exposure_target must be in (0, 1]";
     return false;
@@ -380,6 +518,10 @@ bool SynthOptions::Check(std::string* why) const {
     return false;
   }
   if (targets) {
+    if (!(target_ring_radius > bounding + target_size)) {
+      *why = "targets: the marker ring must lie outside the sample";
+      return false;
+    }
     if (target_count < 1 || !(target_size > 0.0) || !(platform_radius > target_ring_radius + target_size)) {
       *why = "targets: need at least one marker, a positive size, and a platform wider than the ring";
       return false;
@@ -396,13 +538,28 @@ bool SynthOptions::Check(std::string* why) const {
       return false;
     }
   }
+  if (!radiometry.Check(why)) return false;
   return effects.Check(why);
 }
 
 Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material,
                      int supersample, std::vector<uint8_t>* hit_mask) {
-  const Camera& camera = session.camera;
   const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
+  return RenderRadianceImpl(session, photo_index, *sample, false, material, supersample, hit_mask, nullptr, Eigen::Vector3d::Zero());
+}
+
+Image RenderRadiance(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
+                     const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask) {
+  return RenderRadianceImpl(session, photo_index, truth, shadow_rays, material, supersample, hit_mask, nullptr, Eigen::Vector3d::Zero());
+}
+
+namespace {
+Image RenderRadianceImpl(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
+                         const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask,
+                         uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance) {
+  const Camera& camera = session.camera;
+  const AnalyticSample* sample = &truth;
+  std::atomic<uint64_t> shadowed{0};
   const Rigid3d world_from_camera = session.photos[photo_index].camera_from_world->Inverse();
   const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
   const Eigen::Vector3d center = world_from_camera.translation;
@@ -420,13 +577,27 @@ Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel
             const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
             SurfaceHit hit;
             if (!sample->Intersect(center, direction, &hit)) continue;
-            if (hit_mask && sx == supersample / 2 && sy == supersample / 2) {
-              (*hit_mask)[size_t(y) * camera.width + x] = 1;
+            const bool centre_ray = sx == supersample / 2 && sy == supersample / 2;
+            if (hit_mask && centre_ray) (*hit_mask)[size_t(y) * camera.width + x] = 1;
+            const LocalFrame frame = LocalFrame::FromNormal(hit.normal);
+            const Eigen::Vector3d wo = frame.ToLocal(-direction);
+            // The fill light (SynthOptions::fill_light) reaches every point, shadowed or not.
+            if (fill_irradiance.any()) {
+              radiance += weight * material.Eval(Eigen::Vector3d::UnitZ(), wo).cwiseProduct(fill_irradiance);
             }
             const Incidence incidence = IncidenceAt(session.light, hit.point, hit.normal);
             if (!incidence.lit) continue;
-            const LocalFrame frame = LocalFrame::FromNormal(hit.normal);
-            const Eigen::Vector3d f = material.Eval(frame.ToLocal(incidence.wi), frame.ToLocal(-direction));
+            if (shadow_rays) {
+              // The shadow ray starts 2 micrometres off the surface (outside the solid) and is blocked
+              // by any hit nearer than the light.
+              SurfaceHit blocker;
+              if (sample->Intersect(hit.point + 2e-6 * hit.normal, incidence.wi, &blocker) &&
+                  blocker.t < incidence.distance) {
+                if (centre_ray) ++shadowed;
+                continue;
+              }
+            }
+            const Eigen::Vector3d f = material.Eval(frame.ToLocal(incidence.wi), wo);
             radiance += weight * f.cwiseProduct(incidence.irradiance);
           }
         }
@@ -434,13 +605,79 @@ Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel
       }
     }
   });
+  if (shadowed_pixels) *shadowed_pixels += shadowed;
   return image;
 }
+}  // namespace
+
+namespace {
+// Writes an irregular shape's scan files (scan/view-N.ply in the scanner's frame), truth-mesh.ply, and
+// the mesh sample into `root`/session.json; returns the geometry's truth (truth.json "generator"."geometry").
+nlohmann::json WriteShapeFiles(const SynthOptions& options, const ImplicitSample& shape, const std::string& root,
+                               SampleSpec* sample, SynthSummary* summary) {
+  const Rigid3d scan_from_world = ScanFromWorld(options);
+  const RayCaster caster = [&shape](const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double* t,
+                                    Eigen::Vector3d* normal) {
+    SurfaceHit hit;
+    if (!shape.Intersect(origin, direction, &hit)) return false;
+    *t = hit.t;
+    *normal = hit.normal;
+    return true;
+  };
+  RangeScannerOptions scanner = options.scanner;
+  scanner.seed = options.seed;
+  const std::vector<ScanMesh> views =
+      SimulateRangeScans(caster, shape.BoundingCenter(), shape.BoundingRadius(), scanner, scan_from_world);
+  fs::create_directories(fs::path(root) / "scan");
+  sample->scan_inputs.clear();
+  for (size_t v = 0; v < views.size(); ++v) {
+    const std::string name = "scan/view-" + std::to_string(v) + ".ply";
+    WriteRangeGridPly((fs::path(root) / name).string(), views[v]);
+    ScanInputSpec input;
+    input.file = name;
+    sample->scan_inputs.push_back(input);
+    summary->scan_points += views[v].points.size();
+  }
+  summary->scan_views = static_cast<int>(views.size());
+  // The scanner's measurement of the platform's markers: their corners in its frame, with noise.
+  std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ull + 0x5CA4);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  sample->scan_targets.clear();
+  for (const TargetSpec& target : TargetLayout(options)) {
+    ScanTargetSpec measured;
+    measured.id = target.id;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d error(noise(rng), noise(rng), noise(rng));
+      measured.corners[k] = scan_from_world * target.corners[k] + options.scan_target_noise_m * error;
+    }
+    sample->scan_targets.push_back(measured);
+  }
+  WritePly((fs::path(root) / kTruthMesh).string(), TruthMesh(shape, options.truth_mesh_spacing_m));
+  const RangeScannerOptions& s = scanner;
+  return {{"shape", shape.Describe()},
+          {"truth_mesh", kTruthMesh},
+          {"scan_from_world", RigidJson(scan_from_world)},
+          {"world_from_scan", RigidJson(scan_from_world.Inverse())},
+          {"scan_target_noise_m", options.scan_target_noise_m},
+          {"scanner",
+           {{"views_around", s.views_around},
+            {"around_elevation_deg", s.around_elevation_deg},
+            {"view_above", s.view_above},
+            {"distance_m", s.distance_m},
+            {"spacing_m", s.spacing_m},
+            {"noise_m", s.noise_m},
+            {"max_view_angle_deg", s.max_view_angle_deg}}}};
+}
+}  // namespace
 
 std::string SynthSummary::BriefReport() const {
-  char buffer[160];
-  std::snprintf(buffer, sizeof(buffer), "synth: %d photos in %.2f s; %llu pixels clipped at saturation",
-                photos, total_s, static_cast<unsigned long long>(saturated_pixels));
+  char buffer[320];
+  const int n = std::snprintf(buffer, sizeof(buffer), "synth: %d photos in %.2f s; %llu pixels clipped at saturation",
+                              photos, total_s, static_cast<unsigned long long>(saturated_pixels));
+  if (scan_views > 0) {
+    std::snprintf(buffer + n, sizeof(buffer) - n, "; %llu pixels in the shape's own shadow; %d range scans, %llu points",
+                  static_cast<unsigned long long>(shadowed_pixels), scan_views, static_cast<unsigned long long>(scan_points));
+  }
   return buffer;
 }
 
@@ -458,13 +695,21 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
 
   const CameraEffects& effects = options.effects;
   std::atomic<uint64_t> saturated{0};
+  uint64_t shadowed = 0;
+  const std::unique_ptr<AnalyticSample> truth = TrueSample(options, session);
+  const bool shadow_rays = options.shape != SynthOptions::Shape::kNone;
+  // The fill light's irradiance: fill_light times the point light's at the sample's centre, head on.
+  const Eigen::Vector3d centre = truth->BoundingCenter();
+  const Eigen::Vector3d to_light = IncidenceAt(session.light, centre, Eigen::Vector3d::UnitZ()).wi;
+  const Eigen::Vector3d fill_irradiance = options.fill_light * IncidenceAt(session.light, centre, to_light).irradiance;
   ProgressBar progress("photos", session.photos.size());
   std::unique_ptr<TargetScene> scene;
   if (options.targets) scene = std::make_unique<TargetScene>(options);
   // Photos one after another; each renders and adds noise in parallel over rows.
   for (size_t i = 0; i < session.photos.size(); ++i) {
     std::vector<uint8_t> mask;
-    Image image = RenderRadiance(session, i, material, effects.supersample, &mask);
+    Image image = RenderRadianceImpl(session, i, *truth, shadow_rays, material, effects.supersample, &mask,
+                                     session.photos[i].role == PhotoRole::kMeasurement ? &shadowed : nullptr, fill_irradiance);
     // Auto-exposure: the 99th percentile of the brightest channel over the sample's pixels.
     std::vector<float> levels;
     for (size_t p = 0; p < mask.size(); ++p) {
@@ -480,46 +725,15 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
       reference = levels[k];
     }
     PhotoSpec& photo = session.photos[i];
-    photo.exposure_s = options.exposure_target / reference;
+    photo.exposure_s *= options.exposure_target / reference;  // exposure_s holds the bracket's factor (1 without)
     photo.gain = 1.0;
 
     // Radiance to linear signal, then the platform (its values are already signal).
     for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
-    if (scene) CompositeTargets(session, i, *scene, mask, &image);
-    const double levels_max = effects.bits > 0 ? std::ldexp(1.0, effects.bits) - 1.0 : 0.0;
-    std::atomic<uint64_t> clipped{0};
-    // One random stream per row, seeded from the session seed, the photo and the row: the output does
-    // not depend on the thread count.
-    tbb::parallel_for(0, image.height, [&](int y) {
-      std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ull + (uint64_t(i) << 32) + uint64_t(y));
-      std::normal_distribution<double> normal(0.0, 1.0);
-      uint64_t row_clipped = 0;
-      for (int x = 0; x < image.width; ++x) {
-        bool pixel_clipped = false;
-        for (int c = 0; c < 3; ++c) {
-          double v = image.at(x, y, c);  // linear signal
-          if (effects.shot_noise && v > 0.0) {
-            const double electrons = v * effects.full_well_e;
-            const double noisy = electrons < 1000.0
-                                     ? double(std::poisson_distribution<long>(electrons)(rng))
-                                     : electrons + std::sqrt(electrons) * normal(rng);
-            v = noisy / effects.full_well_e;
-          }
-          if (effects.read_noise) v += effects.read_noise_e / effects.full_well_e * normal(rng);
-          v = std::max(0.0, v + effects.black_level);
-          if (effects.clip && v >= 1.0) {
-            v = 1.0;
-            pixel_clipped = true;
-          }
-          if (effects.srgb) v = LinearToSrgb(v);
-          if (effects.bits > 0) v = std::round(std::min(v, 1.0) * levels_max) / levels_max;
-          image.at(x, y, c) = static_cast<float>(v);
-        }
-        row_clipped += pixel_clipped;
-      }
-      clipped += row_clipped;
-    });
-    saturated += clipped;
+    if (scene) CompositeTargets(session, i, *scene, *truth, mask, &image);
+    ApplyVignetting(session.camera, effects.vignetting, &image);
+    // The sensor (synthetic_radiometry.h): one random stream per (seed, photo, row).
+    saturated += SimulateSensor(effects, options.seed, i, &image);
     const PixelFormat format = effects.bits == 0   ? PixelFormat::kFloat
                                : effects.bits <= 8 ? PixelFormat::kUint8
                                                    : PixelFormat::kUint16;
@@ -528,14 +742,23 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   }
   progress.Finish();
 
+  WriteSynthCalibration(options, directory.temporary_path(), &session);  // radiometry hook: flat field, white reference
+  // Irregular shapes: the range scan, the truth mesh, and the mesh sample's scan inputs and targets
+  // (the sample's file, scan/mesh.ply, is the scan stage's output from those inputs).
+  const nlohmann::json shape_truth = options.shape != SynthOptions::Shape::kNone
+                                         ? WriteShapeFiles(options, static_cast<const ImplicitSample&>(*truth),
+                                                           directory.temporary_path(), &session.sample, &summary)
+                                         : nlohmann::json();
+  if (!shape_truth.is_null()) summary.shadowed_pixels = shadowed;
   session.Save((fs::path(directory.temporary_path()) / "session.json").string());
-  nlohmann::json truth = {
+  nlohmann::json truth_json = {
       {"format", "ibrdf-truth"},
       {"version", 1},
       {"material_name", material_name},
       {"material", material.ToJson()},
       {"generator",
-       {{"sample", SampleKindName(options.sample)},
+       {{"sample", options.shape != SynthOptions::Shape::kNone ? SynthShapeName(options.shape)
+                                                               : SampleKindName(options.sample)},
         {"sample_radius", options.sample_radius},
         {"cylinder_length", options.cylinder_length},
         {"origin", ToJson(options.origin)},
@@ -548,6 +771,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
         {"width", options.width},
         {"height", options.height},
         {"exposure_target", options.exposure_target},
+        {"fill_light", options.fill_light},
         {"seed", options.seed},
         {"targets", options.targets},
         {"light_target_photos", options.targets ? options.light_target_photos : 0},
@@ -560,9 +784,16 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
           {"srgb", effects.srgb},
           {"clip", effects.clip},
           {"black_level", effects.black_level},
-          {"supersample", effects.supersample}}}}},
+          {"supersample", effects.supersample},
+          {"vignetting", effects.vignetting}}},
+        {"radiometry",
+         {{"brackets", options.radiometry.brackets},
+          {"bracket_step_ev", options.radiometry.bracket_step_ev},
+          {"light_unknown", options.radiometry.light_unknown},
+          {"light_intensity", ToJson(options.light_intensity)}}}}},
   };
-  WriteJsonFile((fs::path(directory.temporary_path()) / "truth.json").string(), truth);
+  if (!shape_truth.is_null()) truth_json["generator"]["geometry"] = shape_truth;
+  WriteJsonFile((fs::path(directory.temporary_path()) / "truth.json").string(), truth_json);
   directory.Commit();
   summary.photos = options.num_photos;
   summary.saturated_pixels = saturated;

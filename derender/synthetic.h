@@ -1,10 +1,13 @@
 // Synthetic measurement sessions with known truth (COLMAP's scene/synthetic.h in spirit): a forward
 // renderer for the analytic sphere and cylinder under one point light, photographed from camera
 // positions on an arc from beside the light to opposite it (the paper's Figures 3 and 4), with the
-// camera effects of a real sensor that can each be switched off.
+// camera effects of a real sensor that can each be switched off. Irregular true shapes (a squash, a
+// clay pot, a dented sphere: derender/synthetic_shapes.h) are rendered exactly, with shadow rays, on
+// the target platform, and written as a mesh sample measured by a simulated range scanner (docs/synth.md).
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include <Eigen/Core>
@@ -12,6 +15,9 @@
 #include "core/brdf_model.h"
 #include "core/image_io.h"
 #include "core/session.h"
+#include "derender/synthetic_shapes.h"
+#include "scan/synthetic_scan.h"
+#include "derender/synthetic_radiometry.h"
 
 namespace ibrdf {
 
@@ -26,6 +32,9 @@ struct CameraEffects {
   bool clip = true;              // clip at the saturation level (1.0)
   double black_level = 0.0;      // offset added to the linear signal (normalized units)
   int supersample = 1;           // n x n rays per pixel, averaged (1 = the pixel centre only)
+  // Vignetting: the fraction of light lost at the image corners (cos^4 law, synthetic_radiometry.h);
+  // with it on, the session carries the matching flat-field image. 0 = none.
+  double vignetting = 0.0;
 
   // Every effect off: float EXR of the exact pixel-centre radiance (clipping stays on: a real sensor
   // saturates, and the derenderer rejects what clipped).
@@ -58,7 +67,14 @@ struct SynthOptions {
   double k1 = -0.08, k2 = 0.02, p1 = 0.0005, p2 = -0.0003;
   // Auto-exposure: the 99th percentile of the sample's pixels (brightest channel) lands here.
   double exposure_target = 0.8;
+  // A second light the derenderer does not model: irradiance of this fraction of the point light's (at
+  // the sample's centre, normal incidence) arriving along every surface point's normal, shadowed or not.
+  // A stand-in for room light and interreflections, which reach into self-shadows (the visibility test
+  // of the derender issue); 0 = darkness apart from the one light.
+  double fill_light = 0.0;
   CameraEffects effects;
+  // Exposure brackets and an unknown light with its white reference (synthetic_radiometry.h).
+  SynthRadiometryOptions radiometry;
   uint64_t seed = 1;
 
   // Coded targets (the align stage's input): a dark platform under the sample carrying a ring of ArUco
@@ -87,14 +103,51 @@ struct SynthOptions {
   int light_marker_count = 2;
   double light_marker_size = 0.06;  // metres, printed side (border included)
   double light_card_drop = 0.08;    // metres, light to the markers' centres, straight down
+  // Markers on a cylinder's top end cap (targets on, sample cylinder; derender/synthetic_targets.h):
+  // their count (0: none), first id, printed side and their centres' distance from the axis.
+  int sample_marker_count = 3;
+  int sample_marker_first_id = 30;
+  double sample_marker_size = 0.018;
+  double sample_marker_radius = 0.02;
+
+  // Irregular true shapes: kNone renders the analytic `sample` above; the others render the shape
+  // (centred at `origin`, resting on the platform, so `targets` must be on) and write a session whose
+  // sample is kind "mesh": scan/view-N.ply range grids from a simulated scanner in the scanner's own
+  // frame, the platform markers' corners as the scanner measured them (`scan_targets`), and
+  // truth-mesh.ply, the true surface in the world frame with exact normals.
+  enum class Shape { kNone, kSquash, kPot, kDent };
+  Shape shape = Shape::kNone;
+  SquashParams squash;
+  PotParams pot;
+  DentParams dent;
+  RangeScannerOptions scanner;      // the simulated range scan's views, spacing and noise
+  // The scanner's frame: p_scan = R p_world + t, R a 35-degree turn about (1, 2, 3) and t of this length
+  // along (0.6, -0.48, 0.64) (scanner coordinates are often far from the world's origin).
+  double scan_offset_m = 2.0;
+  double scan_target_noise_m = 5e-5;  // the scanner's error on each marker-corner coordinate, one sigma
+  double truth_mesh_spacing_m = 5e-4; // truth-mesh.ply: surface sampling at the equator, metres
 
   bool Check(std::string* why) const;
 };
+
+// "none", "squash", "pot", "dent"; and back (throws Error naming the value otherwise).
+const char* SynthShapeName(SynthOptions::Shape shape);
+SynthOptions::Shape SynthShapeFromName(const std::string& name);
+
+// The true shape of an irregular-shape session (centred at options.origin); null for kNone.
+std::unique_ptr<ImplicitSample> MakeTrueShape(const SynthOptions& options);
+
+// The scanner's frame of an irregular-shape session (see SynthOptions::scan_offset_m).
+Rigid3d ScanFromWorld(const SynthOptions& options);
 
 // Renders the ideal (noise-free, unclipped) radiance image of one photo; radiance is 0 off the sample.
 // `hit_mask` (optional) gets 1 where the pixel centre sees the sample.
 Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material,
                      int supersample, std::vector<uint8_t>* hit_mask);
+// The same for a given true shape; with `shadow_rays` a hit is lit only where the segment to the light
+// is free of the shape (non-convex truths cast shadows on themselves).
+Image RenderRadiance(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
+                     const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask);
 
 // The reference markers' corners of a target session (empty when options.targets is off).
 std::vector<TargetSpec> TargetLayout(const SynthOptions& options);
@@ -109,6 +162,9 @@ struct SynthSummary {
   bool success = false;
   int photos = 0;
   uint64_t saturated_pixels = 0;  // pixels with a clipped channel
+  uint64_t shadowed_pixels = 0;   // sample pixels facing the light but in the shape's own shadow
+  int scan_views = 0;             // irregular shapes: range grids written
+  uint64_t scan_points = 0;       // their points
   double total_s = 0.0;
   std::string BriefReport() const;
 };

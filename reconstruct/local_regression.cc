@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <mutex>
 #include <random>
 
@@ -56,6 +57,10 @@ struct NormalEquations {
   int64_t exclude = -1;
   const float* exclude_xyz = nullptr;
   const float* exclude_value = nullptr;
+  // Generalized cross-validation: the point holding the sample whose leverage is wanted; its weight times
+  // basis, summed over mirror images, goes to self_basis.
+  int64_t self = -1;
+  double self_basis[kMaxCoefficients] = {};
   float query[3] = {0, 0, 0};
   Mirror mirror{1, 1};
   float radius = 1.0f;  // of the support in scaled units (the growth factor)
@@ -118,6 +123,9 @@ struct NormalEquations {
       b[i][1] += wb * mean[1];
       b[i][2] += wb * mean[2];
     }
+    if (static_cast<int64_t>(index) == self) {
+      for (int i = 0; i < kMaxCoefficients; ++i) self_basis[i] += w * basis[i];
+    }
     sum_w += nw;
     sum_w2 += nw2;
     count += static_cast<uint32_t>(n);
@@ -128,6 +136,7 @@ struct NormalEquations {
     for (auto& row : a) std::fill(std::begin(row), std::end(row), 0.0);
     for (auto& row : a2) std::fill(std::begin(row), std::end(row), 0.0);
     for (auto& row : b) std::fill(std::begin(row), std::end(row), 0.0);
+    std::fill(std::begin(self_basis), std::end(self_basis), 0.0);
     sum_w = sum_w2 = 0.0;
     count = points = 0;
   }
@@ -206,6 +215,11 @@ bool LocalRegressionOptions::Check(std::string* why) const {
     return false;
   }
   return true;
+}
+
+bool InMeasuredDomain(const Estimate& e) {
+  return (e.status == EstimateStatus::kFull || e.status == EstimateStatus::kReducedDegree) &&
+         e.centroid_offset <= kMeasuredDomainMaxCentroidOffset;
 }
 
 void ReliabilityCounts::Add(const Estimate& e) {
@@ -381,9 +395,10 @@ Estimate LocalRegression::Evaluate(const HalfDiffAngles& angles) const {
   return EvaluateAt(RegressionCoordinates(angles));
 }
 
-Estimate LocalRegression::EvaluateAt(const Eigen::Vector3d& uvw_in, int64_t exclude) const {
+Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, int64_t self, double* leverage) const {
   const Impl& impl = *impl_;
   Estimate estimate;
+  if (leverage) *leverage = 0.0;
   if (size() == 0 || !uvw_in.allFinite()) return estimate;
   double u = uvw_in[0], v = uvw_in[1];
   impl.Fold(&u, &v);
@@ -401,6 +416,7 @@ Estimate LocalRegression::EvaluateAt(const Eigen::Vector3d& uvw_in, int64_t excl
     eq.exclude_xyz = &impl.sample_xyz[3 * size_t(exclude)];
     eq.exclude_value = &impl.sample_values[3 * size_t(exclude)];
   }
+  if (self >= 0 && size_t(self) < size()) eq.self = impl.sample_point[size_t(self)];
   const nanoflann::SearchParams params(32, 0.0f, false);
   float growth = 1.0f;
   for (;;) {
@@ -424,14 +440,18 @@ Estimate LocalRegression::EvaluateAt(const Eigen::Vector3d& uvw_in, int64_t excl
 
   estimate.neighbors = eq.count;
   estimate.growth = growth;
+  estimate.centroid_offset = static_cast<float>(
+      growth * std::sqrt(eq.a[0][1] * eq.a[0][1] + eq.a[0][2] * eq.a[0][2] + eq.a[0][3] * eq.a[0][3]) / eq.sum_w);
   estimate.effective_samples = static_cast<float>(eq.sum_w * eq.sum_w / eq.sum_w2);
   for (int degree = options_.degree; degree >= 0; --degree) {
     const int m = kCoefficients[degree];
     Eigen::Vector3d value;
     double rcond = 1.0;
     double fit_samples = eq.sum_w * eq.sum_w / eq.sum_w2;
+    double self_weight = 0.0;  // l_ii: the weight of sample `self` in this degree's estimate
     if (degree == 0) {
       value = Eigen::Vector3d(eq.b[0][0], eq.b[0][1], eq.b[0][2]) / eq.sum_w;
+      self_weight = eq.self_basis[0] / eq.sum_w;
     } else {
       if (estimate.effective_samples < options_.min_samples_per_coefficient * m) continue;
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a(m, m);
@@ -458,6 +478,7 @@ Estimate LocalRegression::EvaluateAt(const Eigen::Vector3d& uvw_in, int64_t excl
       const double variance = g.dot(a2 * g);
       if (!(variance > 0.0) || 1.0 / variance < options_.min_fit_samples) continue;
       fit_samples = 1.0 / variance;
+      for (int i = 0; i < m; ++i) self_weight += eq.self_basis[i] * g[i];
       const auto coefficients = ldlt.solve(b).eval();
       value = coefficients.row(0).transpose();
       // An estimate far outside the range of the values it was fitted to is an extrapolation along a
@@ -475,6 +496,7 @@ Estimate LocalRegression::EvaluateAt(const Eigen::Vector3d& uvw_in, int64_t excl
     estimate.rcond = static_cast<float>(rcond);
     estimate.effective_samples = static_cast<float>(fit_samples);
     estimate.degree = static_cast<int8_t>(degree);
+    if (leverage) *leverage = self_weight;
     break;
   }
   if (estimate.degree < 0) return Estimate();  // cannot happen: degree 0 is always finite here
@@ -510,59 +532,51 @@ std::vector<Estimate> LocalRegression::EvaluateMany(const std::vector<Eigen::Vec
   return estimates;
 }
 
-double LocalRegression::LeaveOneOutRelativeRms(size_t count, uint64_t seed) const {
+CrossValidationScore LocalRegression::CrossValidate(size_t count, uint64_t seed) const {
+  CrossValidationScore score;
   const size_t n = size();
-  if (n == 0) return 0.0;
+  if (n == 0) return score;
   count = std::min(count, n);
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<size_t> pick(0, n - 1);
   std::vector<size_t> indices(count);
   for (size_t& index : indices) index = pick(rng);
-  std::vector<double> sums(count, 0.0);
+  // Per scored sample: squared leave-one-out residual, squared ordinary residual (summed over channels)
+  // and leverage.
+  std::vector<Eigen::Vector3d> sums(count);
   const Impl& impl = *impl_;
+  const double floor = options_.log_floor;
+  auto residual = [&](double estimate, double stored) {
+    if (options_.log_space) return std::log(std::max(estimate, floor)) - stored;
+    return (estimate - stored) / std::max(std::abs(stored), 1e-4);
+  };
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 64), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t k = range.begin(); k != range.end(); ++k) {
       const size_t i = indices[k];
       const float* p = &impl.sample_xyz[3 * i];
       const Eigen::Vector3d uvw(p[0] / impl.scale_h, p[1] / impl.scale_h, p[2] / impl.scale_d);
-      const Estimate e = EvaluateAt(uvw, static_cast<int64_t>(i));
-      double sum = 0.0;
+      const Estimate out = Fit(uvw, static_cast<int64_t>(i), -1, nullptr);
+      double leverage = 0.0;
+      const Estimate in = Fit(uvw, -1, static_cast<int64_t>(i), &leverage);
+      Eigen::Vector3d s = Eigen::Vector3d::Zero();
       for (int c = 0; c < 3; ++c) {
-        const double f =
-            options_.log_space ? std::exp(impl.sample_values[3 * i + c]) : impl.sample_values[3 * i + c];
-        const double rel = (e.value[c] - f) / std::max(std::abs(f), 1e-4);
-        sum += rel * rel;
+        const double stored = impl.sample_values[3 * i + c];
+        s[0] += std::pow(residual(out.value[c], stored), 2);
+        s[1] += std::pow(residual(in.value[c], stored), 2);
       }
-      sums[k] = sum;
+      s[2] = leverage;
+      sums[k] = s;
     }
   });
-  double total = 0.0;
-  for (double s : sums) total += s;
-  return std::sqrt(total / (3.0 * count));
-}
-
-LocalRegressionOptions SelectBandwidth(const std::vector<BrdfSample>& samples, const LocalRegressionOptions& base,
-                                       const std::vector<double>& radius_h_deg,
-                                       const std::vector<double>& radius_d_deg, size_t loo_samples,
-                                       std::vector<Eigen::Vector3d>* scores) {
-  IBRDF_CHECK(!radius_h_deg.empty() && !radius_d_deg.empty());
-  LocalRegressionOptions best = base;
-  double best_score = std::numeric_limits<double>::infinity();
-  for (double rh : radius_h_deg) {
-    for (double rd : radius_d_deg) {
-      LocalRegressionOptions options = base;
-      options.radius_h_deg = rh;
-      options.radius_d_deg = rd;
-      const LocalRegression regression(samples, options);
-      const double score = regression.LeaveOneOutRelativeRms(loo_samples);
-      if (scores) scores->emplace_back(rh, rd, score);
-      if (score < best_score) {
-        best_score = score;
-        best = options;
-      }
-    }
-  }
-  return best;
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& s : sums) total += s;
+  score.points = count;
+  score.loo_rms = std::sqrt(total[0] / (3.0 * count));
+  score.residual_rms = std::sqrt(total[1] / (3.0 * count));
+  score.mean_leverage = total[2] / double(count);
+  score.gcv_rms = score.mean_leverage < 1.0 ? score.residual_rms / (1.0 - score.mean_leverage)
+                                            : std::numeric_limits<double>::infinity();
+  return score;
 }
 
 }  // namespace ibrdf

@@ -96,11 +96,38 @@ struct Estimate {
   float effective_samples = 0.0f;
   float rcond = 0.0f;              // reciprocal condition estimate of the normal matrix used
   float growth = 1.0f;             // factor applied to the radii (1 = as given)
+  // Distance from the query to the weighted centroid of the samples in its kernel, in kernel radii (as
+  // given, before growth). Inside sampled territory it is small; a query beside a single sheet (a
+  // cylinder's incidence plane) or beyond the edge of the data is an extrapolation and has a large one.
+  float centroid_offset = 0.0f;
   uint32_t neighbors = 0;          // samples with non-zero weight (mirrored images included)
   int8_t degree = -1;              // degree used; -1 when unsupported
   EstimateStatus status = EstimateStatus::kUnsupported;
   bool clamped = false;            // a negative estimate was clamped to 0
 };
+
+// Cross-validation figures of one fit, each averaged over a subset of the samples and the 3 channels.
+// Residuals are taken in the fitting space: r_i = log f^(x_i) - log f_i with log values (about the
+// relative error), (f^(x_i) - f_i) / max(f_i, 1e-4) with linear values.
+struct CrossValidationScore {
+  size_t points = 0;           // samples scored
+  // Leave-one-out: RMS of the residual of the fit without sample i, at x_i.
+  double loo_rms = 0.0;
+  // RMS of the ordinary residual (sample i in the fit).
+  double residual_rms = 0.0;
+  // Mean leverage, the mean of the hat matrix's diagonal l_ii = dF^(x_i)/df_i (the weight of sample i in
+  // the estimate at its own position): tr(L) / n, estimated on the subset.
+  double mean_leverage = 0.0;
+  // Generalized cross-validation (Craven and Wahba 1979), as a root mean square:
+  // sqrt(GCV) = residual_rms / (1 - tr(L) / n), i.e. GCV = n sum r_i^2 / (n - tr L)^2.
+  double gcv_rms = 0.0;
+};
+
+// The measured domain of an error figure: estimates that neither had to grow their support nor lie
+// farther than this from the centroid of their samples (in kernel radii): interpolations, not
+// extrapolations (docs/reconstruct.md, "Measured domain").
+constexpr double kMeasuredDomainMaxCentroidOffset = 0.5;
+bool InMeasuredDomain(const Estimate& e);
 
 // Counts of evaluations by status, for summaries ("how many evaluations fell back").
 struct ReliabilityCounts {
@@ -130,13 +157,15 @@ class LocalRegression {
   Estimate Evaluate(const HalfDiffAngles& angles) const;
   // At regression coordinates (u, v, w); `exclude` is a sample index left out of the fit (for
   // leave-one-out), or -1.
-  Estimate EvaluateAt(const Eigen::Vector3d& uvw, int64_t exclude = -1) const;
+  Estimate EvaluateAt(const Eigen::Vector3d& uvw, int64_t exclude = -1) const {
+    return Fit(uvw, exclude, -1, nullptr);
+  }
   // Many points, TBB-parallel; `counts` (optional) gets their reliability counts.
   std::vector<Estimate> EvaluateMany(const std::vector<Eigen::Vector3d>& uvw, ReliabilityCounts* counts) const;
 
-  // Leave-one-out cross-validation score at `count` samples chosen with a fixed seed: the root mean
-  // square of (f_loo - f) / max(f, floor) over samples and channels.
-  double LeaveOneOutRelativeRms(size_t count, uint64_t seed = 1) const;
+  // Cross-validation scores at `count` samples chosen with a fixed seed (for bandwidth selection,
+  // reconstruct/bandwidth_selection.h); the left-out sample is taken out of its bin exactly.
+  CrossValidationScore CrossValidate(size_t count, uint64_t seed = 1) const;
 
   size_t size() const;            // samples used
   size_t points() const;          // points in the kd-tree: occupied bins (or samples without binning)
@@ -144,18 +173,14 @@ class LocalRegression {
   const LocalRegressionOptions& options() const { return options_; }
 
  private:
+  // The fit at `uvw` without sample `exclude` (-1: none); `leverage` (optional) gets the weight of sample
+  // `self` in the estimate (0 when it is not in the kernel).
+  Estimate Fit(const Eigen::Vector3d& uvw, int64_t exclude, int64_t self, double* leverage) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   LocalRegressionOptions options_;
   uint64_t skipped_ = 0;
 };
-
-// Bandwidth selection by leave-one-out cross-validation: each candidate pair of radii is scored with
-// LeaveOneOutRelativeRms on `loo_samples` samples; the best options are returned and every score is
-// appended to `scores` (radius_h_deg, radius_d_deg, score) when given.
-LocalRegressionOptions SelectBandwidth(const std::vector<BrdfSample>& samples, const LocalRegressionOptions& base,
-                                       const std::vector<double>& radius_h_deg,
-                                       const std::vector<double>& radius_d_deg, size_t loo_samples,
-                                       std::vector<Eigen::Vector3d>* scores = nullptr);
 
 }  // namespace ibrdf

@@ -128,7 +128,7 @@ std::string TabulateSummary::BriefReport() const {
 }
 
 MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions& options, TabulateSummary* summary,
-                       std::vector<float>* effective_samples) {
+                       std::vector<float>* effective_samples, std::vector<uint8_t>* measured_domain) {
   std::string why;
   if (!options.Check(&why)) ThrowError("tabulate options", why);
   Timer timer;
@@ -160,6 +160,7 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
   const std::vector<Estimate> estimates = regression.EvaluateMany(points, &local.reliability);
   local.evaluations = points.size();
   if (effective_samples) effective_samples->assign(kMerlCells, 0.0f);
+  if (measured_domain) measured_domain->assign(kMerlCells, 0);
   for (size_t p = 0; p < cells.size(); ++p) {
     const Estimate& e = estimates[p];
     const size_t flat = cells[p];
@@ -177,6 +178,7 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
       } else {
         table.SetCell(target, e.value);
         ++local.cells_measured;
+        if (measured_domain) (*measured_domain)[target] = InMeasuredDomain(e) ? 1 : 0;
         if (effective_samples) (*effective_samples)[target] = e.effective_samples;
       }
     }

@@ -8,6 +8,7 @@
 // hold -1, as the MERL data marks unmeasured cells with negative values.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -80,9 +81,12 @@ struct TabulateSummary {
 
 // Evaluates the regression at every cell centre of the MERL grid (TBB-parallel). With bilateral
 // folding, cells k and 179 - k share one evaluation. `effective_samples` (optional) gets each cell's
-// effective sample count (kMerlCells floats, 0 where unmeasured).
+// effective sample count (kMerlCells floats, 0 where unmeasured); `measured_domain` (optional) 1 for
+// each cell in the measured domain (InMeasuredDomain: tabulated, support not grown, not an
+// extrapolation), 0 elsewhere.
 MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions& options, TabulateSummary* summary,
-                       std::vector<float>* effective_samples = nullptr);
+                       std::vector<float>* effective_samples = nullptr,
+                       std::vector<uint8_t>* measured_domain = nullptr);
 
 // The table as a float64 array of shape (90, 90, 180, 3) in 1/sr (-1 where unmeasured), for .npy.
 std::vector<double> MerlToArray(const MerlTable& table);

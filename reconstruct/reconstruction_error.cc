@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/error.h"
+
 namespace ibrdf {
 namespace {
 
@@ -82,7 +84,7 @@ ReconstructionError CompareRegressionWithTruth(const LocalRegression& regression
   Accumulator accumulator;
   for (size_t i = 0; i < cells.size(); ++i) {
     const Estimate& e = estimates[i];
-    if (e.status == EstimateStatus::kGrown || e.status == EstimateStatus::kUnsupported) {
+    if (!InMeasuredDomain(e)) {
       accumulator.Outside();
       continue;
     }
@@ -91,10 +93,13 @@ ReconstructionError CompareRegressionWithTruth(const LocalRegression& regression
   return accumulator.Finish();
 }
 
-ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfModel& truth, double max_theta_deg) {
+ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfModel& truth, double max_theta_deg,
+                                          const std::vector<uint8_t>* measured_domain) {
+  IBRDF_CHECK(!measured_domain || measured_domain->size() == kMerlCells);
   Accumulator accumulator;
   for (const Cell& cell : Cells(max_theta_deg, 1)) {
-    if (!table.Measured(cell.flat)) {
+    const bool outside_domain = measured_domain && !(*measured_domain)[cell.flat];
+    if (!table.Measured(cell.flat) || outside_domain) {
       accumulator.Outside();
       continue;
     }

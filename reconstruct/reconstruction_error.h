@@ -1,10 +1,13 @@
 // A reconstructed BRDF against a known true BRDF (synthetic sessions): relative RMS error over the MERL
 // cell centres of the measured domain, theta_i and theta_e up to a limit (80 degrees, the derenderer's
-// grazing limit) and with samples within the kernel (estimates that had to grow their support, i.e.
-// configurations the session never photographed, are counted but not scored).
+// grazing limit) where the estimate interpolates its samples (InMeasuredDomain: estimates that had to
+// grow their support, or that extrapolate beside a single sheet or beyond the data's edge, are counted
+// but not scored).
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <nlohmann/json_fwd.hpp>
@@ -28,8 +31,10 @@ struct ReconstructionError {
 // Evaluates the regression at every `stride`-th cell centre (in each index) with theta up to the limit.
 ReconstructionError CompareRegressionWithTruth(const LocalRegression& regression, const BrdfModel& truth,
                                                double max_theta_deg = 80.0, int stride = 1);
-// The same over a tabulated MERL table (unmeasured cells count as outside).
-ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfModel& truth, double max_theta_deg = 80.0);
+// The same over a tabulated MERL table: unmeasured cells count as outside, and so do cells outside
+// `measured_domain` (from TabulateMerl) when it is given; without it every tabulated cell is scored.
+ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfModel& truth, double max_theta_deg = 80.0,
+                                          const std::vector<uint8_t>* measured_domain = nullptr);
 
 nlohmann::json ToJson(const ReconstructionError& error);
 

@@ -312,6 +312,7 @@ ScanMesh ReadPly(const std::string& path) {
     const bool is_face = element.name == "face";
     const bool is_grid = element.name == "range_grid";
     int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ilist = -1;
+    int iquality = -1, ineighbours = -1, ihull = -1;  // the scan stage's fit quality (WritePly)
     if (is_vertex) {
       if (!mesh.points.empty()) ThrowError(path, "more than one vertex element");
       ix = FindProperty(element, "x");
@@ -322,6 +323,9 @@ ScanMesh ReadPly(const std::string& path) {
       iny = FindProperty(element, "ny");
       inz = FindProperty(element, "nz");
       if (!(inx >= 0 && iny >= 0 && inz >= 0)) inx = iny = inz = -1;
+      iquality = FindProperty(element, "quality");
+      ineighbours = FindProperty(element, "fit_neighbours");
+      ihull = FindProperty(element, "hull_distance");
       if (element.count > 500000000ull) ThrowError(path, "implausible vertex count " + std::to_string(element.count));
       mesh.points.reserve(element.count);
       if (inx >= 0) mesh.normals.reserve(element.count);
@@ -348,7 +352,7 @@ ScanMesh ReadPly(const std::string& path) {
       mesh.grid.cell_point.assign(element.count, -1);
     }
 
-    double values[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
+    double values[3] = {0, 0, 0}, normal[3] = {0, 0, 0}, quality = 0, neighbours = 0, hull = 0;
     std::vector<int> list;
     for (uint64_t i = 0; i < element.count; ++i) {
       if (!reader.BeginInstance()) {
@@ -372,6 +376,9 @@ ScanMesh ReadPly(const std::string& path) {
           if (ip == inx) normal[0] = value;
           if (ip == iny) normal[1] = value;
           if (ip == inz) normal[2] = value;
+          if (ip == iquality) quality = value;
+          if (ip == ineighbours) neighbours = value;
+          if (ip == ihull) hull = value;
           continue;
         }
         double count = 0.0;
@@ -393,6 +400,9 @@ ScanMesh ReadPly(const std::string& path) {
       if (is_vertex) {
         mesh.points.emplace_back(values[0], values[1], values[2]);
         if (inx >= 0) mesh.normals.emplace_back(normal[0], normal[1], normal[2]);
+        if (iquality >= 0) mesh.fit_rms_m.push_back(static_cast<float>(quality));
+        if (ineighbours >= 0) mesh.fit_neighbours.push_back(static_cast<int>(neighbours));
+        if (ihull >= 0) mesh.hull_distance_m.push_back(static_cast<float>(hull));
       } else if (is_face) {
         if (list.size() < 3) {
           ThrowError(path, "face " + std::to_string(i) + " has " + std::to_string(list.size()) + " vertices (at least 3 needed)");

@@ -90,7 +90,9 @@ TEST(Align, PhotoWithTooFewMarkersIsDroppedWithAReason) {
     const AlignResult result = AlignSession(session, options);
     for (const ImageAlignment& image : result.images) {
       if (!image.used) {
-        EXPECT_NE(image.dropped_reason.find("reference markers"), std::string::npos);
+        EXPECT_TRUE(image.dropped_reason.find("markers seen") != std::string::npos ||
+                    image.dropped_reason.find("poorly determined") != std::string::npos)
+            << image.dropped_reason;
       }
     }
   } catch (const Error& e) {

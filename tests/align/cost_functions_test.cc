@@ -5,6 +5,7 @@
 
 #include "align/cost_functions/marker_corner_error.h"
 #include "align/cost_functions/reprojection_error.h"
+#include "align/cost_functions/rigid_point_error.h"
 #include "align/cost_functions/sphere_tangent_error.h"
 
 namespace ibrdf {
@@ -74,6 +75,30 @@ TEST(SphereTangentError, DistanceMinusRadiusAndGradientsCheck) {
   ceres::GradientChecker checker(cost.get(), static_cast<const std::vector<const ceres::Manifold*>*>(nullptr), numeric);
   ceres::GradientChecker::ProbeResults results;
   std::vector<double*> parameters = {center, &radius};
+  EXPECT_TRUE(checker.Probe(parameters.data(), 1e-6, &results)) << results.error_log;
+}
+
+// A body point through the body's pose: zero at its true world position, the offset otherwise.
+TEST(RigidPointError, OffsetFromTheMovedPointAndGradientsCheck) {
+  double rotation[3] = {0.2, -0.1, 0.7};
+  double translation[3] = {0.01, 0.05, -0.02};
+  const Eigen::Vector3d p_in_body(0.02, -0.01, 0.015);
+  const double p[3] = {p_in_body.x(), p_in_body.y(), p_in_body.z()};
+  double moved[3];
+  ceres::AngleAxisRotatePoint(rotation, p, moved);
+  const Eigen::Vector3d p_in_world(moved[0] + translation[0], moved[1] + translation[1], moved[2] + translation[2]);
+  double residual[3];
+  RigidPointError(p_in_body, p_in_world)(rotation, translation, residual);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(residual[k], 0.0, 1e-15);
+  RigidPointError(p_in_body, p_in_world + Eigen::Vector3d(1e-3, -2e-3, 0.0))(rotation, translation, residual);
+  EXPECT_NEAR(residual[0], -1e-3, 1e-15);
+  EXPECT_NEAR(residual[1], 2e-3, 1e-15);
+
+  std::unique_ptr<ceres::CostFunction> cost(RigidPointError::Create(p_in_body, p_in_world + Eigen::Vector3d(1e-3, 0, 0)));
+  ceres::NumericDiffOptions numeric;
+  ceres::GradientChecker checker(cost.get(), static_cast<const std::vector<const ceres::Manifold*>*>(nullptr), numeric);
+  ceres::GradientChecker::ProbeResults results;
+  std::vector<double*> parameters = {rotation, translation};
   EXPECT_TRUE(checker.Probe(parameters.data(), 1e-6, &results)) << results.error_log;
 }
 

@@ -2,7 +2,10 @@
 #include "derender/synthetic.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <limits>
+#include <random>
 #include <fstream>
 #include <sstream>
 
@@ -10,7 +13,11 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/json_reader.h"
+#include "core/file_util.h"
 #include "core/session.h"
+#include "derender/synthetic_shapes.h"
+#include "scan/ply_io.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -147,6 +154,206 @@ TEST(Synth, ExistingOutputIsNotReplacedWithoutOverwrite) {
   MakeSession(dir / "s", options, material);
   EXPECT_THROW(WriteSyntheticSession(options, material, "test", dir / "s", /*overwrite=*/false), Error);
   EXPECT_TRUE(std::filesystem::exists(dir / "s/session.json"));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Irregular true shapes (synthetic_shapes.h) and their sessions.
+
+std::vector<std::unique_ptr<ImplicitSample>> AllShapes(const Eigen::Vector3d& center) {
+  std::vector<std::unique_ptr<ImplicitSample>> shapes;
+  shapes.push_back(std::make_unique<SquashSample>(center, SquashParams()));
+  shapes.push_back(std::make_unique<PotSample>(center, PotParams()));
+  shapes.push_back(std::make_unique<DentedSphereSample>(center, DentParams()));
+  return shapes;
+}
+
+Eigen::Vector3d RandomUnit(std::mt19937_64& rng) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+}
+
+TEST(SynthShapes, DefaultParametersAreValid) {
+  std::string why;
+  EXPECT_TRUE(SquashParams().Check(&why)) << why;
+  EXPECT_TRUE(PotParams().Check(&why)) << why;
+  EXPECT_TRUE(DentParams().Check(&why)) << why;
+  DentParams bad;
+  bad.depth = 1.0;
+  EXPECT_FALSE(bad.Check(&why));
+  EXPECT_THROW(DentedSphereSample(Eigen::Vector3d::Zero(), bad), Error);
+  SynthOptions options;
+  options.shape = SynthOptions::Shape::kSquash;
+  EXPECT_FALSE(options.Check(&why));  // needs targets
+  options.targets = true;
+  EXPECT_TRUE(options.Check(&why)) << why;
+}
+
+// The analytic gradient (the normal) against central differences of F, near the surface.
+TEST(SynthShapes, NormalsAreTheGradient) {
+  std::mt19937_64 rng(5);
+  for (const auto& shape : AllShapes(Eigen::Vector3d::Zero())) {
+    for (int i = 0; i < 500; ++i) {
+      Eigen::Vector3d normal;
+      const Eigen::Vector3d p = shape->RadialPoint(RandomUnit(rng), &normal) + 1e-4 * RandomUnit(rng);
+      Eigen::Vector3d gradient, numeric;
+      shape->Evaluate(p, &gradient);
+      const double h = 1e-7;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(k);
+        numeric[k] = (shape->Evaluate(p + step, nullptr) - shape->Evaluate(p - step, nullptr)) / (2 * h);
+      }
+      ASSERT_LT((gradient - numeric).norm(), 1e-5 * gradient.norm()) << shape->Describe().dump() << " at " << p.transpose();
+      ASSERT_LE(gradient.norm(), shape->Lipschitz() * (1.0 + 1e-12));
+    }
+  }
+}
+
+// Random rays: a reported hit lies on the surface (|F| < 1e-12 m), and a march in 20-micrometre steps
+// finds no earlier crossing; a miss has no crossing deeper than the stated tolerance anywhere.
+TEST(SynthShapes, HitsAreOnTheSurfaceAndFirstAndMissesAreMisses) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const Eigen::Vector3d center(1e4, -2e3, 50.0);  // far from the origin
+  for (const auto& shape : AllShapes(center)) {
+    const double radius = shape->BoundingRadius();
+    int hits = 0, misses = 0;
+    for (int i = 0; i < 300; ++i) {
+      const Eigen::Vector3d origin = center + 3.0 * radius * RandomUnit(rng);
+      const Eigen::Vector3d aim = center + 1.1 * radius * std::cbrt(uniform(rng)) * RandomUnit(rng);
+      const Eigen::Vector3d direction = (aim - origin).normalized();
+      SurfaceHit hit;
+      const bool found = shape->Intersect(origin, direction, &hit);
+      const double end = found ? hit.t : 5.0 * radius;
+      double lowest = std::numeric_limits<double>::infinity();
+      for (double t = 0.0; t < end - 2e-5; t += 2e-5) {
+        lowest = std::min(lowest, shape->Evaluate(origin - center + t * direction, nullptr));
+      }
+      ASSERT_GT(lowest, -shape->Lipschitz() * ImplicitSample::kMinStep) << shape->Describe().dump();
+      if (found) {
+        ++hits;
+        // The hit point is stored in world coordinates 10 km out (a double's step there is 2e-12 m).
+        ASSERT_LT(std::abs(shape->Evaluate(hit.point - center, nullptr)), 1e-10);
+        ASSERT_NEAR(hit.normal.norm(), 1.0, 1e-12);
+        ASSERT_GT(hit.t, 0.0);
+      } else {
+        ++misses;
+      }
+    }
+    EXPECT_GT(hits, 100);
+    EXPECT_GT(misses, 10);
+  }
+}
+
+// Grazing rays along the tangent plane at a convex point: 10 micrometres inside is a hit near the
+// point, 10 micrometres outside a miss.
+TEST(SynthShapes, ThinGrazingHitsAreFound) {
+  std::mt19937_64 rng(11);
+  for (const auto& shape : AllShapes(Eigen::Vector3d::Zero())) {
+    if (shape->Describe()["shape"] == "dent") continue;  // not convex
+    for (int i = 0; i < 100; ++i) {
+      Eigen::Vector3d normal;
+      const Eigen::Vector3d p = shape->RadialPoint(RandomUnit(rng), &normal);
+      const Eigen::Vector3d tangent = normal.cross(RandomUnit(rng)).normalized();
+      const Eigen::Vector3d start = p - 3.0 * shape->BoundingRadius() * tangent;
+      SurfaceHit hit;
+      ASSERT_TRUE(shape->Intersect(start - 1e-5 * normal, tangent, &hit)) << p.transpose();
+      EXPECT_FALSE(shape->Intersect(start + 1e-5 * normal, tangent, &hit)) << p.transpose();
+    }
+  }
+}
+
+TEST(SynthShapes, SizesAndRestingPoint) {
+  const SquashSample squash(Eigen::Vector3d::Zero(), SquashParams());
+  EXPECT_GT(2.0 * squash.BoundingRadius(), 0.08);
+  EXPECT_LT(2.0 * squash.BoundingRadius(), 0.11);
+  // The lowest point: no surface point below it, and one within a micrometre of it.
+  std::mt19937_64 rng(3);
+  double lowest = 0.0;
+  for (int i = 0; i < 20000; ++i) lowest = std::min(lowest, squash.RadialPoint(RandomUnit(rng), nullptr).z());
+  EXPECT_LE(squash.LowestZ(), lowest + 1e-6);
+  EXPECT_GT(squash.LowestZ(), lowest - 2e-4);
+  const PotSample pot(Eigen::Vector3d::Zero(), PotParams());
+  EXPECT_NEAR(pot.RadialPoint(-Eigen::Vector3d::UnitZ(), nullptr).z(), pot.LowestZ(), 1e-12);
+  Eigen::Vector3d normal;
+  const Eigen::Vector3d side = pot.RadialPoint(Eigen::Vector3d::UnitX(), &normal);  // on the cylinder
+  EXPECT_NEAR(side.x(), PotParams().body_radius + PotParams().fillet, 1e-12);
+  EXPECT_LT((normal - Eigen::Vector3d::UnitX()).norm(), 1e-12);
+}
+
+SynthOptions SmallShapeSession(SynthOptions::Shape shape) {
+  SynthOptions options;
+  options.shape = shape;
+  options.targets = true;
+  options.camera_elevation_deg = 45.0;
+  options.num_photos = 3;
+  options.width = 200;
+  options.height = 150;
+  options.effects = CameraEffects::None();
+  options.scanner.spacing_m = 0.003;
+  options.scanner.views_around = 4;
+  options.scan_offset_m = 1e4;
+  options.truth_mesh_spacing_m = 0.004;
+  return options;
+}
+
+// The dent shadows itself under the side light (true self-shadows in its photos); the convex pot does
+// not.
+TEST(SynthShapes, DentCastsAShadowOnItself) {
+  ScratchDir dir;
+  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
+  const SynthSummary dent =
+      WriteSyntheticSession(SmallShapeSession(SynthOptions::Shape::kDent), material, "test", dir / "dent", false);
+  EXPECT_GT(dent.shadowed_pixels, 30u);
+  const SynthSummary pot =
+      WriteSyntheticSession(SmallShapeSession(SynthOptions::Shape::kPot), material, "test", dir / "pot", false);
+  EXPECT_EQ(pot.shadowed_pixels, 0u);
+}
+
+// A squash session: a mesh sample with range grids in the scanner's frame (10 km out) that lie on the
+// true surface once mapped back, the markers as the scanner saw them, and the truth mesh.
+TEST(SynthShapes, ShapeSessionHasScansTargetsAndTruth) {
+  ScratchDir dir;
+  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
+  const SynthOptions options = SmallShapeSession(SynthOptions::Shape::kSquash);
+  const SynthSummary summary = WriteSyntheticSession(options, material, "test", dir / "s", false);
+  EXPECT_EQ(summary.scan_views, 5);
+  const Session session = Session::Load(dir / "s");
+  ASSERT_EQ(session.sample.kind, SampleSpec::Kind::kMesh);
+  EXPECT_EQ(session.sample.mesh_file, "scan/mesh.ply");
+  ASSERT_EQ(session.sample.scan_inputs.size(), 5u);
+  ASSERT_TRUE(session.targets.has_value());
+  ASSERT_EQ(session.sample.scan_targets.size(), session.targets->reference.size());
+  const Rigid3d scan_from_world = ScanFromWorld(options);
+  for (size_t i = 0; i < session.sample.scan_targets.size(); ++i) {
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d world = scan_from_world.Inverse() * session.sample.scan_targets[i].corners[k];
+      EXPECT_LT((world - session.targets->reference[i].corners[k]).norm(), 6 * options.scan_target_noise_m);
+    }
+  }
+  const std::unique_ptr<ImplicitSample> truth = MakeTrueShape(options);
+  const Rigid3d world_from_scan = scan_from_world.Inverse();
+  size_t points = 0;
+  for (const ScanInputSpec& input : session.sample.scan_inputs) {
+    const ScanMesh view = ReadPly(ResolvePath(session.directory, input.file));
+    ASSERT_FALSE(view.grid.Empty());
+    EXPECT_GT(view.points.front().norm(), 9e3);  // scanner coordinates
+    for (const Eigen::Vector3d& p : view.points) {
+      // Range noise of 0.1 mm along the ray: within 6 sigma of the surface.
+      ASSERT_LT(std::abs(truth->Evaluate(world_from_scan * p - options.origin, nullptr)), 6e-4);
+    }
+    points += view.points.size();
+  }
+  EXPECT_EQ(points, summary.scan_points);
+  const ScanMesh mesh = ReadPly(dir / "s/truth-mesh.ply");
+  ASSERT_EQ(mesh.normals.size(), mesh.points.size());
+  for (size_t i = 0; i < mesh.points.size(); i += 7) {
+    Eigen::Vector3d gradient;
+    EXPECT_LT(std::abs(truth->Evaluate(mesh.points[i] - options.origin, &gradient)), 1e-12);
+    EXPECT_LT((mesh.normals[i] - gradient.normalized()).norm(), 1e-6);
+  }
+  const nlohmann::json truth_json = ReadJsonFile(dir / "s/truth.json");
+  EXPECT_EQ(truth_json["generator"]["geometry"]["shape"]["shape"], "squash");
+  EXPECT_EQ(truth_json["generator"]["sample"], "squash");
 }
 
 }  // namespace

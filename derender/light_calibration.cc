@@ -1,0 +1,208 @@
+#include "derender/light_calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.h"
+#include "core/file_util.h"
+#include "core/light.h"
+#include "derender/radiance_image.h"
+
+namespace ibrdf {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+double Median(std::vector<double>* values) {
+  const size_t k = values->size() / 2;
+  std::nth_element(values->begin(), values->begin() + k, values->end());
+  double median = (*values)[k];
+  if (values->size() % 2 == 0) median = 0.5 * (median + *std::max_element(values->begin(), values->begin() + k));
+  return median;
+}
+
+// The pixel box holding the image of a disc (centre, normal, radius), with a 2-pixel margin; the
+// whole image where part of the disc is behind the camera.
+void DiscBox(const Camera& camera, const Rigid3d& camera_from_world, const Eigen::Vector3d& center,
+             const Eigen::Vector3d& normal, double radius, int box[4]) {
+  box[0] = 0, box[1] = 0, box[2] = camera.width, box[3] = camera.height;
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  constexpr int kPoints = 64;
+  for (int k = 0; k < kPoints; ++k) {
+    const double angle = 2.0 * M_PI * k / kPoints;
+    // The 64-gon's vertices on a circle 1 % wider contain the disc.
+    const Eigen::Vector3d p = camera_from_world * (center + 1.01 * radius * (std::cos(angle) * u + std::sin(angle) * v));
+    if (!(p.z() > 1e-6)) return;
+    const Eigen::Vector2d pixel = camera.ImageFromCamera(p);
+    if (!pixel.allFinite()) return;
+    x0 = std::min(x0, pixel.x()), x1 = std::max(x1, pixel.x());
+    y0 = std::min(y0, pixel.y()), y1 = std::max(y1, pixel.y());
+  }
+  box[0] = std::clamp(static_cast<int>(std::floor(x0)) - 2, 0, camera.width);
+  box[1] = std::clamp(static_cast<int>(std::floor(y0)) - 2, 0, camera.height);
+  box[2] = std::clamp(static_cast<int>(std::ceil(x1)) + 2, 0, camera.width);
+  box[3] = std::clamp(static_cast<int>(std::ceil(y1)) + 2, 0, camera.height);
+}
+
+}  // namespace
+
+bool LightCalibrationOptions::Check(std::string* why) const {
+  if (!(interior_fraction > 0.0 && interior_fraction <= 1.0)) {
+    *why = "interior_fraction must be in (0, 1]";
+    return false;
+  }
+  if (!(min_signal >= 0.0)) {
+    *why = "min_signal must not be negative";
+    return false;
+  }
+  if (!(max_saturated_fraction >= 0.0 && max_saturated_fraction < 1.0)) {
+    *why = "max_saturated_fraction must be in [0, 1)";
+    return false;
+  }
+  if (min_pixels < 1) {
+    *why = "min_pixels must be at least 1";
+    return false;
+  }
+  if (!(max_theta_deg > 0.0 && max_theta_deg < 90.0)) {
+    *why = "max_theta_deg must be in (0, 90)";
+    return false;
+  }
+  return true;
+}
+
+std::string LightCalibrationReport::BriefReport() const {
+  if (!calibrated) return "light calibration: none (the session has no white reference; its light intensity is used as stated)";
+  char buffer[512];
+  std::snprintf(buffer, sizeof(buffer),
+                "light calibration: white reference, %d photos, %llu of %llu interior pixels in %.2f s: "
+                "intensity (%.6g, %.6g, %.6g) -> (%.6g, %.6g, %.6g), spread %.2f %%, %.2f %%, %.2f %%; rejected: ",
+                photos, static_cast<unsigned long long>(pixels_used), static_cast<unsigned long long>(interior_pixels),
+                total_s, stated_intensity[0], stated_intensity[1], stated_intensity[2], calibrated_intensity[0],
+                calibrated_intensity[1], calibrated_intensity[2], 100.0 * spread[0], 100.0 * spread[1],
+                100.0 * spread[2]);
+  return buffer + FormatCounts(rejected);
+}
+
+Session ApplyLightCalibration(const Session& session, LightCalibrationReport* report,
+                              const LightCalibrationOptions& options) {
+  IBRDF_CHECK(report != nullptr);
+  Timer timer;
+  *report = LightCalibrationReport();
+  report->stated_intensity = session.light.intensity;
+  Session calibrated = session;
+  if (!session.calibration || !session.calibration->white_reference) {
+    report->calibrated_intensity = session.light.intensity;
+    report->success = true;
+    return calibrated;
+  }
+  std::string why;
+  if (!options.Check(&why)) ThrowError("light calibration options", why);
+  const WhiteReferenceSpec& white = *session.calibration->white_reference;
+  const std::string where = session.manifest_path + ": /calibration/white_reference";
+  const double radius = 0.5 * options.interior_fraction * white.size;
+  const double cos_max = std::cos(options.max_theta_deg * kDegree);
+  // The light with unit intensity: its irradiance per unit of intensity at each point.
+  Light unit_light = session.light;
+  unit_light.intensity = Eigen::Vector3d::Ones();
+  {
+    const Incidence incidence = IncidenceAt(unit_light, white.center, white.normal);
+    if (!incidence.lit) ThrowError(where, "the white reference faces away from the light (check its normal)");
+  }
+
+  const RadianceReader reader(session);
+  std::vector<double> estimates[3];
+  for (size_t k = 0; k < white.photos.size(); ++k) {
+    const PhotoSpec& photo = white.photos[k];
+    const std::string photo_where = where + "/photos/" + std::to_string(k);
+    const std::string path = ResolvePath(session.directory, photo.file);
+    if (!photo.camera_from_world) ThrowError(photo_where, "white-reference photo " + photo.file + " has no camera_from_world pose");
+    const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
+    const Eigen::Vector3d camera_center = world_from_camera.translation;
+    if ((camera_center - white.center).dot(white.normal) <= 0.0) {
+      ThrowError(photo_where, "the camera of " + photo.file + " is behind the white reference");
+    }
+    const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
+    const RadianceImage image = reader.Read({photo}, options.min_signal);
+    int box[4];
+    DiscBox(session.camera, *photo.camera_from_world, white.center, white.normal, radius, box);
+    uint64_t interior = 0, saturated = 0;
+    for (int y = box[1]; y < box[3]; ++y) {
+      for (int x = box[0]; x < box[2]; ++x) {
+        const Eigen::Vector2d xy = session.camera.CamPlaneFromImage(Eigen::Vector2d(x + 0.5, y + 0.5));
+        const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+        const double cos_e = -direction.dot(white.normal);
+        if (!(cos_e > 0.0)) continue;
+        const double t = (white.center - camera_center).dot(white.normal) / -cos_e;
+        if (!(t > 0.0)) continue;
+        const Eigen::Vector3d point = camera_center + t * direction;
+        if ((point - white.center).norm() > radius) continue;
+        ++interior;
+        const size_t p = image.Index(x, y);
+        const uint8_t flags = image.flags[p];
+        if (flags & kPixelNonFinite) {
+          ++report->rejected["non_finite"];
+          continue;
+        }
+        if (flags & kPixelSaturated) {
+          ++saturated;
+          ++report->rejected["saturated"];
+          continue;
+        }
+        if (flags & kPixelBelowSignal) {
+          ++report->rejected["below_signal"];
+          continue;
+        }
+        const Incidence incidence = IncidenceAt(unit_light, point, white.normal);
+        if (!(cos_e >= cos_max) || !(incidence.cos_theta >= cos_max)) {
+          ++report->rejected["grazing"];
+          continue;
+        }
+        ++report->pixels_used;
+        for (int c = 0; c < 3; ++c) {
+          // L = rho / pi * I * e, with e the irradiance per unit intensity.
+          estimates[c].push_back(M_PI * image.radiance[3 * p + c] / (white.reflectance[c] * incidence.irradiance[c]));
+        }
+      }
+    }
+    report->interior_pixels += interior;
+    if (interior > 0 && double(saturated) > options.max_saturated_fraction * double(interior)) {
+      char percent[32];
+      std::snprintf(percent, sizeof(percent), "%.1f %%", 100.0 * double(saturated) / double(interior));
+      ThrowError(path, "the white reference is saturated: " + std::to_string(saturated) + " of its " +
+                           std::to_string(interior) + " interior pixels (" + percent +
+                           ") are clipped; photograph it with a shorter exposure (" + photo_where + ")");
+    }
+  }
+  if (report->interior_pixels < uint64_t(options.min_pixels)) {
+    ThrowError(where, "the white reference is not in view: its interior covers " +
+                          std::to_string(report->interior_pixels) + " pixel centres in " +
+                          std::to_string(white.photos.size()) + " photos (at least " +
+                          std::to_string(options.min_pixels) + " needed; check center, normal, size and the photos' poses)");
+  }
+  if (report->pixels_used < uint64_t(options.min_pixels)) {
+    ThrowError(where, "only " + std::to_string(report->pixels_used) + " of the white reference's " +
+                          std::to_string(report->interior_pixels) + " interior pixels are measurable (rejected: " +
+                          FormatCounts(report->rejected) + "); at least " + std::to_string(options.min_pixels) +
+                          " needed");
+  }
+  for (int c = 0; c < 3; ++c) {
+    const double median = Median(&estimates[c]);
+    if (!(median > 0.0 && std::isfinite(median))) {
+      ThrowError(where, "the white reference gives no positive light intensity in channel " + std::to_string(c));
+    }
+    std::vector<double> deviations(estimates[c].size());
+    for (size_t i = 0; i < deviations.size(); ++i) deviations[i] = std::abs(estimates[c][i] - median);
+    report->calibrated_intensity[c] = median;
+    report->spread[c] = 1.4826 * Median(&deviations) / median;
+  }
+  calibrated.light.intensity = report->calibrated_intensity;
+  report->photos = static_cast<int>(white.photos.size());
+  report->calibrated = true;
+  report->total_s = timer.ElapsedSeconds();
+  report->success = true;
+  return calibrated;
+}
+
+}  // namespace ibrdf

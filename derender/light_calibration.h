@@ -1,0 +1,62 @@
+// The light's intensity from a white reference (the paper's section 3.1: a Spectralon target
+// photographed under the measurement light). A flat Lambertian target of known albedo rho at a known
+// pose reflects radiance L = rho / pi * E, with E = I cos(theta_i) / r^2 for a point light (E = I
+// cos(theta_i) for a directional one), so every pixel on it gives I = pi L r^2 / (rho cos(theta_i)) in
+// the session's radiance unit: the camera's sensitivity and the light's power are calibrated together.
+// The estimate is the median over the target's interior, in every white-reference photo.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "core/logging.h"
+#include "core/session.h"
+
+namespace ibrdf {
+
+struct LightCalibrationOptions {
+  // The interior used: a disc of this fraction of the target's size (the side of a square target,
+  // the diameter of a round one) around its centre; the rim is left out (mixed pixels, pose error).
+  double interior_fraction = 0.8;
+  // Signal floor, linear normalized file units (as DerenderOptions::min_signal).
+  double min_signal = 0.002;
+  // A photo whose interior has more than this fraction of clipped pixels is refused as saturated.
+  double max_saturated_fraction = 0.01;
+  // Measurable interior pixels needed over all photos together.
+  int min_pixels = 25;
+  // Interior pixels seen or lit more obliquely than this are not used (degrees).
+  double max_theta_deg = 80.0;
+
+  bool Check(std::string* why) const;
+};
+
+struct LightCalibrationReport {
+  bool success = false;     // false until the step ran
+  bool calibrated = false;  // false where the session has no white reference (the light is unchanged)
+  int photos = 0;           // white-reference photos
+  Eigen::Vector3d stated_intensity = Eigen::Vector3d::Zero();      // the session's light intensity
+  Eigen::Vector3d calibrated_intensity = Eigen::Vector3d::Zero();  // the white reference's
+  uint64_t interior_pixels = 0;  // pixel centres on the target's interior, over all photos
+  uint64_t pixels_used = 0;
+  RejectionCounts rejected;      // non_finite, saturated, below_signal, grazing
+  // Per channel, the robust relative spread of the per-pixel estimates (1.4826 MAD / median): noise
+  // plus any unevenness (a wrong pose or reflectance shows here).
+  Eigen::Vector3d spread = Eigen::Vector3d::Zero();
+  double total_s = 0.0;
+  // "light calibration: white reference, 2 photos, 4210 pixels: intensity (1, 1, 1) -> (0.41, ...)"
+  std::string BriefReport() const;
+};
+
+// The session with its light's intensity replaced by the white reference's measurement, when the
+// session has one (calibration.white_reference); otherwise the session unchanged. The white-reference
+// photos go through the same radiometric chain as the measurement photos (radiance_image.h: response,
+// black level, exposure and gain, flat field). Throws Error naming the photo for a target that is
+// saturated (more than max_saturated_fraction of its interior clipped), and naming the manifest's
+// white_reference for a target that no photo sees, a photo without a pose, a target facing away from
+// the light or the camera, or too few measurable pixels.
+Session ApplyLightCalibration(const Session& session, LightCalibrationReport* report,
+                              const LightCalibrationOptions& options = LightCalibrationOptions());
+
+}  // namespace ibrdf

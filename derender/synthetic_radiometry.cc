@@ -1,0 +1,230 @@
+#include "derender/synthetic_radiometry.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include <tbb/parallel_for.h>
+
+#include "core/error.h"
+#include "core/light.h"
+#include "core/radiometry.h"
+#include "derender/synthetic.h"
+
+namespace fs = std::filesystem;
+
+namespace ibrdf {
+
+bool SynthRadiometryOptions::Check(std::string* why) const {
+  if (brackets < 1 || brackets > 16) {
+    *why = "brackets must be 1 to 16";
+    return false;
+  }
+  if (!(bracket_step_ev > 0.0 && bracket_step_ev <= 8.0)) {
+    *why = "bracket_step_ev must be in (0, 8]";
+    return false;
+  }
+  if (!(white_reflectance > 0.0 && white_reflectance <= 1.0) || !(white_size > 0.0)) {
+    *why = "the white reference needs a reflectance in (0, 1] and a positive size";
+    return false;
+  }
+  if (!(white_exposure_scale > 0.0)) {
+    *why = "white_exposure_scale must be positive";
+    return false;
+  }
+  return true;
+}
+
+double VignettingAt(const Camera& camera, double strength, double x, double y) {
+  if (strength <= 0.0) return 1.0;
+  const double cx = camera.PrincipalX(), cy = camera.PrincipalY();
+  const double corner2 = std::max(cx * cx, (camera.width - cx) * (camera.width - cx)) +
+                         std::max(cy * cy, (camera.height - cy) * (camera.height - cy));
+  const double r2 = ((x - cx) * (x - cx) + (y - cy) * (y - cy)) / corner2;
+  const double tan2 = 1.0 / std::sqrt(1.0 - strength) - 1.0;  // cos^4(a) = 1 - strength
+  const double q = 1.0 + r2 * tan2;
+  return 1.0 / (q * q);
+}
+
+void ApplyVignetting(const Camera& camera, double strength, Image* signal) {
+  if (strength <= 0.0) return;
+  tbb::parallel_for(0, signal->height, [&](int y) {
+    for (int x = 0; x < signal->width; ++x) {
+      const float v = static_cast<float>(VignettingAt(camera, strength, x + 0.5, y + 0.5));
+      for (int c = 0; c < signal->channels; ++c) signal->at(x, y, c) *= v;
+    }
+  });
+}
+
+uint64_t SimulateSensor(const CameraEffects& effects, uint64_t seed, uint64_t stream, Image* signal) {
+  Image& image = *signal;
+  const double levels_max = effects.bits > 0 ? std::ldexp(1.0, effects.bits) - 1.0 : 0.0;
+  std::atomic<uint64_t> clipped{0};
+  tbb::parallel_for(0, image.height, [&](int y) {
+    std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + (stream << 32) + uint64_t(y));
+    std::normal_distribution<double> normal(0.0, 1.0);
+    uint64_t row_clipped = 0;
+    for (int x = 0; x < image.width; ++x) {
+      bool pixel_clipped = false;
+      for (int c = 0; c < image.channels; ++c) {
+        double v = image.at(x, y, c);  // linear signal
+        if (effects.shot_noise && v > 0.0) {
+          const double electrons = v * effects.full_well_e;
+          const double noisy = electrons < 1000.0 ? double(std::poisson_distribution<long>(electrons)(rng))
+                                                  : electrons + std::sqrt(electrons) * normal(rng);
+          v = noisy / effects.full_well_e;
+        }
+        if (effects.read_noise) v += effects.read_noise_e / effects.full_well_e * normal(rng);
+        v = std::max(0.0, v + effects.black_level);
+        if (effects.clip && v >= 1.0) {
+          v = 1.0;
+          pixel_clipped = true;
+        }
+        if (effects.srgb) v = LinearToSrgb(v);
+        if (effects.bits > 0) v = std::round(std::min(v, 1.0) * levels_max) / levels_max;
+        image.at(x, y, c) = static_cast<float>(v);
+      }
+      row_clipped += pixel_clipped;
+    }
+    clipped += row_clipped;
+  });
+  return clipped;
+}
+
+void ExpandBrackets(const SynthOptions& options, Session* session) {
+  const SynthRadiometryOptions& radiometry = options.radiometry;
+  if (radiometry.brackets <= 1) return;
+  std::vector<PhotoSpec> photos;
+  int pose = 0;
+  for (const PhotoSpec& photo : session->photos) {
+    if (photo.role != PhotoRole::kMeasurement) {
+      photos.push_back(photo);
+      continue;
+    }
+    const fs::path file(photo.file);
+    for (int k = 0; k < radiometry.brackets; ++k) {
+      PhotoSpec exposure = photo;
+      exposure.file = (file.parent_path() / (file.stem().string() + "-e" + std::to_string(k) + file.extension().string())).string();
+      exposure.bracket = pose;
+      exposure.exposure_s = std::exp2(-radiometry.bracket_step_ev * k);
+      photos.push_back(exposure);
+    }
+    ++pose;
+  }
+  session->photos = photos;
+}
+
+namespace {
+
+// The white reference's ideal radiance image: a square of side `size` centred at `center` with normal
+// `normal`, Lambertian of albedo rho, under the session's light; 0 elsewhere. `mask` gets 1 where a
+// pixel centre sees it.
+Image RenderWhiteReference(const Session& session, const Rigid3d& camera_from_world, const WhiteReferenceSpec& white,
+                           int supersample, std::vector<uint8_t>* mask) {
+  const Camera& camera = session.camera;
+  const Rigid3d world_from_camera = camera_from_world.Inverse();
+  const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
+  const Eigen::Vector3d center = world_from_camera.translation;
+  const Eigen::Vector3d u = white.normal.unitOrthogonal(), v = white.normal.cross(u);
+  Image image(camera.width, camera.height, 3);
+  mask->assign(size_t(camera.width) * camera.height, 0);
+  const double weight = 1.0 / (supersample * supersample);
+  tbb::parallel_for(0, camera.height, [&](int y) {
+    for (int x = 0; x < camera.width; ++x) {
+      Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
+      for (int sy = 0; sy < supersample; ++sy) {
+        for (int sx = 0; sx < supersample; ++sx) {
+          const Eigen::Vector2d xy = camera.CamPlaneFromImage(
+              Eigen::Vector2d(x + (sx + 0.5) / supersample, y + (sy + 0.5) / supersample));
+          const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+          const double denominator = direction.dot(white.normal);
+          if (!(denominator < 0.0)) continue;
+          const double t = (white.center - center).dot(white.normal) / denominator;
+          if (!(t > 0.0)) continue;
+          const Eigen::Vector3d offset = center + t * direction - white.center;
+          if (std::abs(offset.dot(u)) > 0.5 * white.size || std::abs(offset.dot(v)) > 0.5 * white.size) continue;
+          if (sx == supersample / 2 && sy == supersample / 2) (*mask)[size_t(y) * camera.width + x] = 1;
+          const Incidence incidence = IncidenceAt(session.light, white.center + offset, white.normal);
+          if (!incidence.lit) continue;
+          radiance += weight / M_PI * white.reflectance.cwiseProduct(incidence.irradiance);
+        }
+      }
+      for (int c = 0; c < 3; ++c) image.at(x, y, c) = static_cast<float>(radiance[c]);
+    }
+  });
+  return image;
+}
+
+}  // namespace
+
+void WriteSynthCalibration(const SynthOptions& options, const std::string& directory, Session* session) {
+  const CameraEffects& effects = options.effects;
+  const SynthRadiometryOptions& radiometry = options.radiometry;
+  if (effects.vignetting > 0.0) {
+    // The flat field a lab gets from many photos of a uniform diffuser at half of full scale, averaged
+    // (64 frames): the vignetting with what remains of the shot noise.
+    const Camera& camera = session->camera;
+    Image flat(camera.width, camera.height, 3);
+    const double noise = effects.shot_noise ? 1.0 / std::sqrt(0.5 * effects.full_well_e * 64.0) : 0.0;
+    tbb::parallel_for(0, camera.height, [&](int y) {
+      std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ull + 0xF1A7F1E1Dull + uint64_t(y));
+      std::normal_distribution<double> normal(0.0, 1.0);
+      for (int x = 0; x < camera.width; ++x) {
+        const double v = VignettingAt(camera, effects.vignetting, x + 0.5, y + 0.5);
+        for (int c = 0; c < 3; ++c) flat.at(x, y, c) = static_cast<float>(v * (1.0 + noise * normal(rng)));
+      }
+    });
+    session->radiometry.flat_field = "flat_field.exr";
+    WriteImage((fs::path(directory) / session->radiometry.flat_field).string(), flat, PixelFormat::kFloat);
+  }
+  if (radiometry.light_unknown) {
+    const PhotoSpec* first = nullptr;
+    for (const PhotoSpec& photo : session->photos) {
+      if (photo.role == PhotoRole::kMeasurement && photo.camera_from_world) {
+        first = &photo;
+        break;
+      }
+    }
+    IBRDF_CHECK(first != nullptr);
+    WhiteReferenceSpec white;
+    white.reflectance = Eigen::Vector3d::Constant(radiometry.white_reflectance);
+    white.center = session->sample.center;
+    white.size = radiometry.white_size;
+    const Eigen::Vector3d camera_center = first->camera_from_world->Inverse().translation;
+    const Eigen::Vector3d to_light = session->light.kind == Light::Kind::kPoint
+                                         ? (session->light.position - white.center).normalized()
+                                         : session->light.direction.normalized();
+    white.normal = (to_light + (camera_center - white.center).normalized()).normalized();
+    std::vector<uint8_t> mask;
+    Image image = RenderWhiteReference(*session, *first->camera_from_world, white, effects.supersample, &mask);
+    std::vector<float> levels;
+    for (size_t p = 0; p < mask.size(); ++p) {
+      if (mask[p]) levels.push_back(std::max({image.pixels[3 * p], image.pixels[3 * p + 1], image.pixels[3 * p + 2]}));
+    }
+    IBRDF_CHECK(!levels.empty()) << "the white reference is out of view";
+    const size_t k = static_cast<size_t>(0.99 * (levels.size() - 1));
+    std::nth_element(levels.begin(), levels.begin() + k, levels.end());
+    PhotoSpec photo;
+    photo.file = std::string("calibration/white-000.") + (effects.bits == 0 ? "exr" : "png");
+    photo.camera_from_world = first->camera_from_world;
+    photo.exposure_s = radiometry.white_exposure_scale * options.exposure_target / levels[k];
+    photo.gain = 1.0;
+    for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
+    ApplyVignetting(session->camera, effects.vignetting, &image);
+    SimulateSensor(effects, options.seed, 0xFFFFull, &image);
+    fs::create_directories(fs::path(directory) / "calibration");
+    const PixelFormat format = effects.bits == 0 ? PixelFormat::kFloat
+                               : effects.bits <= 8 ? PixelFormat::kUint8
+                                                   : PixelFormat::kUint16;
+    WriteImage((fs::path(directory) / photo.file).string(), image, format);
+    white.photos.push_back(photo);
+    CalibrationSpec calibration;
+    calibration.white_reference = white;
+    session->calibration = calibration;
+    session->light.intensity = Eigen::Vector3d::Ones();
+  }
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,66 @@
+// The radiometric side of synthetic sessions (docs/radiometry.md): the sensor (shot and read noise,
+// black level, clipping, response, quantization), vignetting and its flat-field image, exposure
+// brackets, and the white-reference photo that calibrates an unknown light. Called from
+// WriteSyntheticSession (synthetic.cc) at a few marked hooks.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "core/camera.h"
+#include "core/image_io.h"
+#include "core/session.h"
+
+namespace ibrdf {
+
+struct CameraEffects;
+struct SynthOptions;
+
+// Exposure brackets and the light's calibration in a synthetic session.
+struct SynthRadiometryOptions {
+  // Exposures per camera pose: the auto-exposure and brackets - 1 shorter ones, each bracket_step_ev
+  // stops below the one before (the highlights a single exposure clips), all with the pose's
+  // `bracket` id. 1: no brackets.
+  int brackets = 1;
+  double bracket_step_ev = 2.0;
+  // The session states a unit light intensity (1, 1, 1) instead of the true one and carries a white
+  // reference (calibration.white_reference) that recovers it: one photo of a flat target of albedo
+  // white_reflectance and side white_size at the sample's centre (the sample taken away), facing
+  // between the light and the first camera, from the first camera's pose.
+  bool light_unknown = false;
+  double white_reflectance = 0.99;
+  double white_size = 0.05;  // metres
+  // The white-reference photo's exposure relative to its auto-exposure (> 1.25 clips the target).
+  double white_exposure_scale = 1.0;
+
+  bool Check(std::string* why) const;
+};
+
+// Relative sensitivity of a pixel (col + 0.5, row + 0.5 at its centre) under natural vignetting of
+// the given strength: cos^4 of an effective field angle that grows with the distance r from the
+// principal point, 1 / (1 + r^2 tan^2(a))^2 with r = 1 at the farthest image corner and a chosen so
+// that the corner keeps 1 - strength. Strength 0: 1 everywhere.
+double VignettingAt(const Camera& camera, double strength, double x, double y);
+
+// Multiplies a linear signal image by the vignetting of the given strength (nothing for 0).
+void ApplyVignetting(const Camera& camera, double strength, Image* signal);
+
+// The sensor: shot noise (Poisson below 1000 electrons, Gaussian above), read noise, black level,
+// clipping at 1.0, the sRGB curve, quantization to `bits`, applied in place to a linear signal image.
+// One random stream per (seed, stream, row): the output does not depend on the thread count. Returns
+// the number of pixels with a clipped channel.
+uint64_t SimulateSensor(const CameraEffects& effects, uint64_t seed, uint64_t stream, Image* signal);
+
+// Hook in BuildSession: each measurement photo becomes options.radiometry.brackets photos of its pose
+// ("photos/003-e1.png"), with `bracket` = the pose's index and exposure_s holding the bracket's factor
+// (1, 2^-step, ...) that the auto-exposure multiplies. Nothing for 1 bracket.
+void ExpandBrackets(const SynthOptions& options, Session* session);
+
+// Hook before the session is saved, in the folder being written (`directory`): writes the flat-field
+// image (flat_field.exr, when vignetting is on) and the white-reference photo (light_unknown), adds
+// them to the session, and replaces the light's intensity by (1, 1, 1) when it is to be unknown.
+void WriteSynthCalibration(const SynthOptions& options, const std::string& directory, Session* session);
+
+}  // namespace ibrdf

@@ -1,0 +1,208 @@
+// The radiometric chain on hand-made images: response, black level, exposure, flat field, flags, the
+// noise model's sigma, exposure groups and the HDR merge of a bracket.
+#include "derender/radiance_image.h"
+
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "core/image_io.h"
+#include "core/radiometry.h"
+#include "tests/scratch_dir.h"
+
+namespace ibrdf {
+namespace {
+
+using testing::ScratchDir;
+
+constexpr int kWidth = 8, kHeight = 6;
+
+// A session in `dir` with a pinhole camera of kWidth x kHeight and no photos yet.
+Session SmallSession(const ScratchDir& dir) {
+  Session session;
+  session.directory = dir.str();
+  session.manifest_path = dir / "session.json";
+  session.camera = Camera::Create(CameraModelId::kPinhole, kWidth, kHeight, {10.0, 10.0, 4.0, 3.0});
+  return session;
+}
+
+// Writes a uniform grey image with the given file value and returns its photo spec.
+PhotoSpec UniformPhoto(const ScratchDir& dir, const std::string& name, float value, double exposure_s,
+                       PixelFormat format = PixelFormat::kFloat) {
+  Image image(kWidth, kHeight, 3);
+  for (float& v : image.pixels) v = value;
+  WriteImage(dir / name, image, format);
+  PhotoSpec photo;
+  photo.file = name;
+  photo.exposure_s = exposure_s;
+  return photo;
+}
+
+TEST(RadianceImage, SrgbBlackLevelExposureAndGain) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  session.radiometry.response.kind = Response::Kind::kSrgb;
+  session.radiometry.black_level = 0.02;
+  PhotoSpec photo = UniformPhoto(dir, "a.exr", 0.5f, 0.25);
+  photo.gain = 2.0;
+  const RadianceImage image = RadianceReader(session).Read({photo}, 0.002);
+  const double expected = (SrgbToLinear(0.5) - 0.02) / (0.25 * 2.0);
+  for (size_t p = 0; p < image.flags.size(); ++p) {
+    EXPECT_EQ(image.flags[p], 0);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(image.radiance[3 * p + c], expected, 1e-5 * expected);
+  }
+  EXPECT_TRUE(image.exposures_used.empty());
+}
+
+TEST(RadianceImage, LookupTableMatchesTheResponse) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  for (const Response::Kind kind : {Response::Kind::kSrgb, Response::Kind::kGamma}) {
+    session.radiometry.response.kind = kind;
+    const RadianceReader reader(session);
+    double worst = 0.0;
+    for (int i = 1; i <= 4000; ++i) {
+      const double encoded = i / 4000.0;
+      const double exact = session.radiometry.response.ToLinear(encoded);
+      worst = std::max(worst, std::abs(reader.Linear(encoded) - exact) / exact);
+    }
+    EXPECT_LT(worst, 3e-5) << session.radiometry.response.Describe();
+  }
+}
+
+TEST(RadianceImage, FlagsSaturatedBelowSignalAndNonFinite) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  Image image(kWidth, kHeight, 3);
+  for (float& v : image.pixels) v = 0.4f;
+  image.at(1, 1, 2) = 1.0f;                          // one channel clipped
+  image.at(2, 1, 0) = 0.001f;                        // darkest channel below the floor
+  image.at(3, 1, 1) = std::nanf("");                 // not finite
+  WriteImage(dir / "a.exr", image, PixelFormat::kFloat);
+  PhotoSpec photo;
+  photo.file = "a.exr";
+  const RadianceImage out = RadianceReader(session).Read({photo}, 0.002);
+  EXPECT_EQ(out.flags[out.Index(1, 1)], kPixelSaturated);
+  EXPECT_EQ(out.flags[out.Index(2, 1)], kPixelBelowSignal);
+  EXPECT_TRUE(out.flags[out.Index(3, 1)] & kPixelNonFinite);
+  EXPECT_EQ(out.flags[out.Index(0, 0)], 0);
+}
+
+// The single-exposure sigma is the noise model's: shot + read + quantization through the response.
+TEST(RadianceImage, SigmaFromTheNoiseModel) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  session.radiometry.noise = CameraNoise{20000.0, 4.0, 0};
+  const PhotoSpec photo = UniformPhoto(dir, "a.exr", 0.25f, 0.5);
+  const RadianceImage image = RadianceReader(session).Read({photo}, 0.002);
+  const double expected = std::sqrt(0.25 / 20000.0 + (4.0 / 20000.0) * (4.0 / 20000.0)) / 0.5;
+  EXPECT_NEAR(image.sigma[0], expected, 1e-4 * expected);
+}
+
+TEST(RadianceImage, FlatFieldDividesAndIsChecked) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  Image flat(kWidth, kHeight, 1);
+  for (float& v : flat.pixels) v = 0.5f;
+  flat.at(kWidth / 2, kHeight / 2, 0) = 1.0f;
+  WriteImage(dir / "flat.exr", flat, PixelFormat::kFloat);
+  session.radiometry.flat_field = "flat.exr";
+  const PhotoSpec photo = UniformPhoto(dir, "a.exr", 0.3f, 1.0);
+  const RadianceImage image = RadianceReader(session).Read({photo}, 0.002);
+  EXPECT_NEAR(image.radiance[3 * image.Index(0, 0)], 0.6, 1e-6);
+  EXPECT_NEAR(image.radiance[3 * image.Index(kWidth / 2, kHeight / 2) + 2], 0.3, 1e-6);
+
+  // Wrong size: an error naming the file and the manifest's field.
+  WriteImage(dir / "small.exr", Image(kWidth - 1, kHeight, 1), PixelFormat::kFloat);
+  session.radiometry.flat_field = "small.exr";
+  try {
+    RadianceReader reader(session);
+    FAIL() << "a mis-sized flat field was accepted";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("small.exr"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("/radiometry/flat_field"), std::string::npos) << error.what();
+  }
+  // A zero: not a sensitivity.
+  flat.at(0, 0, 0) = 0.0f;
+  WriteImage(dir / "zero.exr", flat, PixelFormat::kFloat);
+  session.radiometry.flat_field = "zero.exr";
+  EXPECT_THROW(RadianceReader reader(session), Error);
+}
+
+TEST(RadianceImage, ExposureGroupsByBracketAndByPose) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  const Rigid3d a(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 1));
+  const Rigid3d b(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0.1, 1));
+  auto photo = [](const Rigid3d& pose, std::optional<int> bracket, PhotoRole role = PhotoRole::kMeasurement) {
+    PhotoSpec p;
+    p.file = "x.png";
+    p.camera_from_world = pose;
+    p.bracket = bracket;
+    p.role = role;
+    return p;
+  };
+  session.photos = {photo(a, std::nullopt), photo(b, 7), photo(a, std::nullopt), photo(b, 7),
+                    photo(b, std::nullopt, PhotoRole::kTargets), photo(b, 8)};
+  const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
+  ASSERT_EQ(groups.size(), 3u);
+  EXPECT_EQ(groups[0], (std::vector<size_t>{0, 2}));
+  EXPECT_EQ(groups[1], (std::vector<size_t>{1, 3}));
+  EXPECT_EQ(groups[2], (std::vector<size_t>{5}));
+  // A bracket whose poses differ is refused, naming the photo.
+  session.photos[3].camera_from_world = a;
+  try {
+    ExposureGroups(session);
+    FAIL() << "a bracket of two poses was accepted";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("/photos/3/bracket"), std::string::npos) << error.what();
+  }
+}
+
+// A bracket: the long exposure clips where the short one does not; the merge uses what is usable,
+// inverse-variance weighted, and flags only where every exposure fails.
+TEST(RadianceImage, BracketMergesWhereUsable) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  session.radiometry.noise = CameraNoise{20000.0, 4.0, 0};
+  // True radiance 0.5 everywhere, except 4.0 at (1, 1) and 1e-4 at (2, 2).
+  auto exposure = [&](const std::string& name, double exposure_s) {
+    Image image(kWidth, kHeight, 3);
+    for (int y = 0; y < kHeight; ++y) {
+      for (int x = 0; x < kWidth; ++x) {
+        const double radiance = x == 1 && y == 1 ? 4.0 : x == 2 && y == 2 ? 1e-4 : 0.5;
+        for (int c = 0; c < 3; ++c) image.at(x, y, c) = static_cast<float>(std::min(1.0, radiance * exposure_s));
+      }
+    }
+    WriteImage(dir / name, image, PixelFormat::kFloat);
+    PhotoSpec photo;
+    photo.file = name;
+    photo.exposure_s = exposure_s;
+    return photo;
+  };
+  const std::vector<PhotoSpec> bracket = {exposure("long.exr", 1.6), exposure("short.exr", 0.2)};
+  const RadianceImage merged = RadianceReader(session).Read(bracket, 0.002);
+  ASSERT_EQ(merged.exposures_used.size(), merged.flags.size());
+  // Both usable: the mean, with a sigma below either exposure's.
+  const size_t both = merged.Index(0, 0);
+  EXPECT_EQ(merged.flags[both], 0);
+  EXPECT_EQ(merged.exposures_used[both], 2);
+  EXPECT_NEAR(merged.radiance[3 * both], 0.5, 1e-6);
+  const RadianceImage long_only = RadianceReader(session).Read({bracket[0]}, 0.002);
+  EXPECT_LT(merged.sigma[3 * both], long_only.sigma[3 * both]);
+  EXPECT_GT(merged.sigma[3 * both], 0.9 * long_only.sigma[3 * both]);  // the long exposure dominates
+  // Clipped in the long exposure: the short one alone.
+  const size_t bright = merged.Index(1, 1);
+  EXPECT_EQ(long_only.flags[bright], kPixelSaturated);
+  EXPECT_EQ(merged.flags[bright], 0);
+  EXPECT_EQ(merged.exposures_used[bright], 1);
+  EXPECT_NEAR(merged.radiance[3 * bright], 4.0, 1e-5);
+  // Below the floor in both: flagged.
+  EXPECT_EQ(merged.flags[merged.Index(2, 2)], kPixelBelowSignal);
+  EXPECT_EQ(merged.exposures_used[merged.Index(2, 2)], 0);
+}
+
+}  // namespace
+}  // namespace ibrdf
