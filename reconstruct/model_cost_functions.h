@@ -23,10 +23,16 @@ struct LafortuneResidual {
     T f = p[0] / T(M_PI);
     for (int k = 0; k < kLobes; ++k) {
       const T base = p[1 + 3 * k] * xy + p[2 + 3 * k] * z;
-      if (base > T(0.0)) f += pow(base, p[3 + 3 * k]);
+      if (!(base > T(0.0))) continue;
+      // A lobe with base > 1 and a large exponent overflows (value or derivatives) during the trust
+      // region's trial steps; reporting the evaluation as failed makes Ceres shrink the step (a
+      // non-finite value returned as a success would be logged as an error for every sample).
+      if (p[3 + 3 * k] * log(base) > T(100.0)) return false;
+      f += pow(base, p[3 + 3 * k]);
     }
     residual[0] = (f - value) * inv_sigma;
-    return true;
+    using std::isfinite;
+    return isfinite(residual[0]);
   }
 
   double xy, z, value, inv_sigma;
@@ -55,7 +61,8 @@ struct GgxResidual {
       const T f = diffuse[c] / T(M_PI) + fresnel * specular;
       residual[c] = (f - value[c]) * inv_sigma[c];
     }
-    return true;
+    using std::isfinite;
+    return isfinite(residual[0]) && isfinite(residual[1]) && isfinite(residual[2]);
   }
 
   template <class T>
