@@ -17,6 +17,25 @@ namespace fs = std::filesystem;
 namespace ibrdf {
 namespace {
 
+// A marker's "corners": four finite [x, y, z] points in OpenCV's order.
+std::array<Eigen::Vector3d, 4> MarkerCorners(JsonObject& marker) {
+  const nlohmann::json& corners = marker.Raw("corners");
+  if (!corners.is_array() || corners.size() != 4) {
+    ThrowError(marker.Where("corners"), "expected 4 corners [[x, y, z] x 4] (top-left, top-right, bottom-right, bottom-left)");
+  }
+  std::array<Eigen::Vector3d, 4> points;
+  for (int k = 0; k < 4; ++k) {
+    const nlohmann::json& c = corners[k];
+    const std::string where = marker.Where("corners") + "/" + std::to_string(k);
+    if (!c.is_array() || c.size() != 3 || !c[0].is_number() || !c[1].is_number() || !c[2].is_number()) {
+      ThrowError(where, "expected [x, y, z]");
+    }
+    points[k] = Eigen::Vector3d(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
+    if (!points[k].allFinite()) ThrowError(where, "expected finite numbers");
+  }
+  return points;
+}
+
 constexpr char kFormat[] = "ibrdf-session";
 constexpr int kVersion = 1;
 
@@ -102,20 +121,7 @@ void ParseMeshSample(JsonObject& object, SampleSpec* sample) {
       if (!seen.insert(target.id).second) {
         ThrowError(marker.Where("id"), "marker id " + std::to_string(target.id) + " is listed twice");
       }
-      const nlohmann::json& corners = marker.Raw("corners");
-      if (!corners.is_array() || corners.size() != 4) {
-        ThrowError(marker.Where("corners"), "expected 4 corners [[x, y, z] x 4] (top-left, top-right, bottom-right, bottom-left)");
-      }
-      for (int k = 0; k < 4; ++k) {
-        const nlohmann::json& c = corners[k];
-        if (!c.is_array() || c.size() != 3 || !c[0].is_number() || !c[1].is_number() || !c[2].is_number()) {
-          ThrowError(marker.Where("corners") + "/" + std::to_string(k), "expected [x, y, z]");
-        }
-        target.corners[k] = Eigen::Vector3d(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
-        if (!target.corners[k].allFinite()) {
-          ThrowError(marker.Where("corners") + "/" + std::to_string(k), "expected finite numbers");
-        }
-      }
+      target.corners = MarkerCorners(marker);
       marker.Finish();
       sample->scan_targets.push_back(target);
     }
@@ -268,18 +274,7 @@ TargetsSpec ParseTargets(JsonObject object) {
   auto marker_corners = [&](JsonObject& marker) {
     TargetSpec target;
     target.id = marker_id(marker);
-    const nlohmann::json& corners = marker.Raw("corners");
-    if (!corners.is_array() || corners.size() != 4) {
-      ThrowError(marker.Where("corners"), "expected 4 corners [[x, y, z] x 4] (top-left, top-right, bottom-right, bottom-left)");
-    }
-    for (int k = 0; k < 4; ++k) {
-      const nlohmann::json& c = corners[k];
-      if (!c.is_array() || c.size() != 3 || !c[0].is_number() || !c[1].is_number() || !c[2].is_number()) {
-        ThrowError(marker.Where("corners") + "/" + std::to_string(k), "expected [x, y, z]");
-      }
-      target.corners[k] = Eigen::Vector3d(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
-      if (!target.corners[k].allFinite()) ThrowError(marker.Where("corners") + "/" + std::to_string(k), "expected finite numbers");
-    }
+    target.corners = MarkerCorners(marker);
     marker.Finish();
     return target;
   };
