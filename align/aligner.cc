@@ -8,10 +8,10 @@
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
+#include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
-#include <tbb/parallel_for.h>
 
 #include "align/bundle_adjustment.h"
 #include "align/cost_functions/marker_corner_error.h"
@@ -21,6 +21,7 @@
 #include "align/markers.h"
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/linear_image.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
 
@@ -31,8 +32,9 @@ namespace {
 // centre, the sharpest drop from a lit limb to the dark background, located at sub-pixel precision
 // where the profile crosses the mid level. Edges against anything bright (the platform) or on the
 // unlit side (no contrast) are skipped.
-std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& camera, const Rigid3d& camera_from_world,
-                                              const Eigen::Vector3d& center, double radius, int lines, double band_px) {
+std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& camera,
+                                              const Rigid3d& camera_from_world, const Eigen::Vector3d& center,
+                                              double radius, int lines, double band_px) {
   std::vector<Eigen::Vector2d> points;
   const Eigen::Vector3d c = camera_from_world * center;
   if (!(c.z() > radius)) return points;
@@ -45,7 +47,8 @@ std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& 
     // Search the band around the predicted silhouette, with room for the inside and outside levels.
     const double s0 = radius_px - band_px - 3.0, s1 = radius_px + band_px + 3.0;
     std::vector<double> profile;
-    for (double s = s0; s <= s1; s += step) profile.push_back(BilinearLuminance(image, center_px.x() + s * direction.x(), center_px.y() + s * direction.y()));
+    for (double s = s0; s <= s1; s += step)
+      profile.push_back(BilinearLuminance(image, center_px.x() + s * direction.x(), center_px.y() + s * direction.y()));
     if (std::any_of(profile.begin(), profile.end(), [](double v) { return !std::isfinite(v); })) continue;
     // The sharpest drop over one pixel.
     const int span = static_cast<int>(1.0 / step);
@@ -107,8 +110,9 @@ bool AlignOptions::Check(std::string* why) const {
   if (min_markers_per_image < 1 || !(max_image_rms_px > 0.0) || !(huber_px > 0.0) || silhouette_lines < 8 ||
       !(corner_sigma_px > 0.0) || !(max_position_sigma_m > 0.0) || !(max_rotation_sigma_deg > 0.0) ||
       !(ambiguity_ratio > 0.0)) {
-    *why = "min_markers_per_image >= 1, max_image_rms_px > 0, huber_px > 0, silhouette_lines >= 8, corner_sigma_px > 0, "
-           "max_position_sigma_m > 0, max_rotation_sigma_deg > 0, ambiguity_ratio > 0";
+    *why =
+        "min_markers_per_image >= 1, max_image_rms_px > 0, huber_px > 0, silhouette_lines >= 8, corner_sigma_px > 0, "
+        "max_position_sigma_m > 0, max_rotation_sigma_deg > 0, ambiguity_ratio > 0";
     return false;
   }
   return bundle.Check(why) && cylinder.Check(why);
@@ -119,13 +123,15 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
   std::string why;
   if (!options.Check(&why)) ThrowError("align options", why);
   if (!session.targets || (session.targets->reference.empty() && !session.targets->unknown_layout)) {
-    ThrowError(session.manifest_path + ": /targets", "align needs markers of known layout (reference) or of unknown layout (unknown_layout)");
+    ThrowError(session.manifest_path + ": /targets",
+               "align needs markers of known layout (reference) or of unknown layout (unknown_layout)");
   }
   const TargetsSpec& targets = *session.targets;
   const MarkerDictionary dictionary(targets.dictionary, session.manifest_path + ": /targets/dictionary");
   auto check_id = [&](int id, const std::string& block) {
     if (id >= dictionary.size()) {
-      ThrowError(session.manifest_path + ": /targets/" + block, "marker id " + std::to_string(id) + " is not in " + dictionary.name());
+      ThrowError(session.manifest_path + ": /targets/" + block,
+                 "marker id " + std::to_string(id) + " is not in " + dictionary.name());
     }
   };
   // The markers of the pose: known layout (fixed), unknown layout (free; the origin marker fixed), and
@@ -154,7 +160,8 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
         marker.fixed = marker.posed = true;
         marker.corners = {Eigen::Vector3d(-h, h, 0.0), Eigen::Vector3d(h, h, 0.0), Eigen::Vector3d(h, -h, 0.0),
                           Eigen::Vector3d(-h, -h, 0.0)};
-        marker.world_from_marker = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX())), Eigen::Vector3d::Zero());
+        marker.world_from_marker =
+            Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX())), Eigen::Vector3d::Zero());
       }
     }
   }
@@ -180,8 +187,8 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
   session.CheckPhotos();
   const Camera& camera = session.camera;
   const std::array<double, 8> intrinsics = ProjectionIntrinsics(camera);
-  const cv::Mat camera_matrix = (cv::Mat_<double>(3, 3) << intrinsics[0], 0, intrinsics[2] - 0.5, 0, intrinsics[1],
-                                 intrinsics[3] - 0.5, 0, 0, 1);
+  const cv::Mat camera_matrix =
+      (cv::Mat_<double>(3, 3) << intrinsics[0], 0, intrinsics[2] - 0.5, 0, intrinsics[1], intrinsics[3] - 0.5, 0, 0, 1);
   const cv::Mat distortion = (cv::Mat_<double>(1, 4) << intrinsics[4], intrinsics[5], intrinsics[6], intrinsics[7]);
 
   AlignResult result;
@@ -197,9 +204,7 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     // sphere fit reads the same linear image later.
     images[i] = ReadImage(session.PhotoPath(i));
     Image& linear = images[i];
-    for (float& v : linear.pixels) {
-      v = static_cast<float>(std::max(0.0, session.radiometry.response.ToLinear(v) - session.radiometry.black_level));
-    }
+    LinearizeImage(session, i, &linear);
     std::map<int, int> seen;
     std::vector<MarkerDetection> detections = DetectMarkers(linear, dictionary);
     RefineMarkerCorners(linear, camera, &detections);
@@ -236,8 +241,8 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
       for (size_t i = 0; i < session.photos.size(); ++i) {
         if (!bundle_images[i].posed) continue;
         bundle_images[i].posed = false;
-        result.images[i].dropped_reason = "no pose once the photos linking it to the fixed markers were dropped (" +
-                                          result.bundle.message + ")";
+        result.images[i].dropped_reason =
+            "no pose once the photos linking it to the fixed markers were dropped (" + result.bundle.message + ")";
       }
       break;
     }
@@ -265,7 +270,8 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
         alignment.dropped_reason = "only " + std::to_string(alignment.markers) + " posed markers seen (need " +
                                    std::to_string(options.min_markers_per_image) + ")";
       } else if (image.rms_px > options.max_image_rms_px) {
-        std::snprintf(buffer, sizeof(buffer), "reprojection RMS %.3f px above %.3f", image.rms_px, options.max_image_rms_px);
+        std::snprintf(buffer, sizeof(buffer), "reprojection RMS %.3f px above %.3f", image.rms_px,
+                      options.max_image_rms_px);
         alignment.dropped_reason = buffer;
       } else if (!(uncertainty.position_sigma_m <= options.max_position_sigma_m) ||
                  !(uncertainty.rotation_sigma_deg <= options.max_rotation_sigma_deg)) {
@@ -276,9 +282,11 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
                       uncertainty.rotation_sigma_deg, options.max_rotation_sigma_deg);
         alignment.dropped_reason = buffer;
       } else if (alignment.alternative_rms_px >= 0.0 &&
-                 alignment.alternative_rms_px < options.ambiguity_ratio * std::max(image.rms_px, options.corner_sigma_px)) {
+                 alignment.alternative_rms_px <
+                     options.ambiguity_ratio * std::max(image.rms_px, options.corner_sigma_px)) {
         std::snprintf(buffer, sizeof(buffer),
-                      "ambiguous pose: a second pose, %.1f deg away, explains the coplanar corners with RMS %.3f px (own %.3f px)",
+                      "ambiguous pose: a second pose, %.1f deg away, explains the coplanar corners with RMS %.3f px "
+                      "(own %.3f px)",
                       alternative.rotation.angularDistance(image.camera_from_world.rotation) * 180.0 / M_PI,
                       alignment.alternative_rms_px, image.rms_px);
         alignment.dropped_reason = buffer;
@@ -346,7 +354,8 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
         const auto it = light_detections[i].find(id);
         if (!result.images[i].used || it == light_detections[i].end()) continue;
         sightings[m].push_back({i, it->second});
-        if (!cameras.count(i)) AngleAxisFromPose(result.images[i].camera_from_world, cameras[i].data(), cameras[i].data() + 3);
+        if (!cameras.count(i))
+          AngleAxisFromPose(result.images[i].camera_from_world, cameras[i].data(), cameras[i].data() + 3);
       }
     }
     auto sighting_cost = [&](const LightSighting& sighting, const double* marker_pose, double* squared) {
@@ -384,9 +393,10 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
       for (const LightSighting& sighting : sightings[m]) {
         double* pose = cameras.at(sighting.photo).data();
         for (int c = 0; c < 4; ++c) {
-          problem.AddResidualBlock(
-              MarkerCornerError::Create(intrinsics, corners_in_marker[c], sighting.corners[c].x(), sighting.corners[c].y()),
-              new ceres::HuberLoss(options.huber_px), pose, pose + 3, marker_poses[m].data(), marker_poses[m].data() + 3);
+          problem.AddResidualBlock(MarkerCornerError::Create(intrinsics, corners_in_marker[c], sighting.corners[c].x(),
+                                                             sighting.corners[c].y()),
+                                   new ceres::HuberLoss(options.huber_px), pose, pose + 3, marker_poses[m].data(),
+                                   marker_poses[m].data() + 3);
         }
       }
     }
@@ -416,10 +426,12 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
       ceres::Solver::Summary summary;
       ceres::Solve(solver_options, &problem, &summary);
       solved = summary.IsSolutionUsable();
-      if (!solved) fit.reason = "the light markers' refinement failed (" + summary.message + "); the light stays as given";
+      if (!solved)
+        fit.reason = "the light markers' refinement failed (" + summary.message + "); the light stays as given";
     }
     if (solved) {
-      for (const auto& [i, pose] : cameras) result.images[i].camera_from_world = PoseFromAngleAxis(pose.data(), pose.data() + 3);
+      for (const auto& [i, pose] : cameras)
+        result.images[i].camera_from_world = PoseFromAngleAxis(pose.data(), pose.data() + 3);
     }
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     int estimated = 0;
@@ -484,9 +496,11 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     }
   }
   if (result.session.photos.empty()) {
-    for (const ImageAlignment& image : result.images) Log(1, "dropped photo " + session.photos[image.photo].file + ": " + image.dropped_reason);
+    for (const ImageAlignment& image : result.images)
+      Log(1, "dropped photo " + session.photos[image.photo].file + ": " + image.dropped_reason);
   }
-  if (result.session.photos.empty()) ThrowError(session.manifest_path, "no photo could be aligned (see the reasons above)");
+  if (result.session.photos.empty())
+    ThrowError(session.manifest_path, "no photo could be aligned (see the reasons above)");
 
   // The sphere from its silhouettes: rays through sub-pixel limb points are tangent to it. Three
   // rounds, each extracting limb points in a band around the current estimate's silhouette (wide, then
@@ -505,9 +519,11 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
         const Rigid3d& pose = result.images[i].camera_from_world;
         const Rigid3d world_from_camera = pose.Inverse();
         const Eigen::Vector3d c = pose * current;
-        const double radius_px = camera.FocalX() * radius / std::sqrt(std::max(c.squaredNorm() - radius * radius, 1e-12));
+        const double radius_px =
+            camera.FocalX() * radius / std::sqrt(std::max(c.squaredNorm() - radius * radius, 1e-12));
         const double band = round == 0 ? bands_px[0] * radius_px : bands_px[round];
-        for (const Eigen::Vector2d& p : SilhouettePoints(images[i], camera, pose, current, radius, options.silhouette_lines, band)) {
+        for (const Eigen::Vector2d& p :
+             SilhouettePoints(images[i], camera, pose, current, radius, options.silhouette_lines, band)) {
           const Eigen::Vector2d xy = camera.CamPlaneFromImage(p);
           rays.emplace_back(world_from_camera.translation,
                             world_from_camera.rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0).normalized());
@@ -575,16 +591,19 @@ std::string AlignResult::BriefReport() const {
   if (cylinder.fitted || !cylinder.reason.empty()) {
     report += cylinder.BriefReport();
   } else if (sphere.fitted) {
-    std::snprintf(buffer, sizeof(buffer), "sphere centre (%.5f, %.5f, %.5f) m, radius %.5f m from %d silhouette points (RMS %.3f mm, %d rejected)",
-                  sphere.center.x(), sphere.center.y(), sphere.center.z(), sphere.radius, sphere.silhouette_points,
-                  1e3 * sphere.rms_m, sphere.rejected_points);
+    std::snprintf(
+        buffer, sizeof(buffer),
+        "sphere centre (%.5f, %.5f, %.5f) m, radius %.5f m from %d silhouette points (RMS %.3f mm, %d rejected)",
+        sphere.center.x(), sphere.center.y(), sphere.center.z(), sphere.radius, sphere.silhouette_points,
+        1e3 * sphere.rms_m, sphere.rejected_points);
     report += buffer;
   } else {
     report += "sample pose as given";
   }
   if (light.fitted) {
     std::snprintf(buffer, sizeof(buffer), "; light at (%.5f, %.5f, %.5f) m from %zu markers (spread %.3f mm)",
-                  light.position.x(), light.position.y(), light.position.z(), light.markers.size(), 1e3 * light.spread_m);
+                  light.position.x(), light.position.y(), light.position.z(), light.markers.size(),
+                  1e3 * light.spread_m);
     report += buffer;
   } else if (!light.reason.empty()) {
     report += "; " + light.reason;
@@ -603,8 +622,10 @@ nlohmann::json ToJson(const AlignResult& result) {
                             {"outlier_corners", image.outlier_corners},
                             {"rms_px", image.rms_px}};
     if (image.used || image.position_sigma_m > 0.0) {
-      entry["position_sigma_m"] = std::isfinite(image.position_sigma_m) ? nlohmann::json(image.position_sigma_m) : nlohmann::json(nullptr);
-      entry["rotation_sigma_deg"] = std::isfinite(image.rotation_sigma_deg) ? nlohmann::json(image.rotation_sigma_deg) : nlohmann::json(nullptr);
+      entry["position_sigma_m"] =
+          std::isfinite(image.position_sigma_m) ? nlohmann::json(image.position_sigma_m) : nlohmann::json(nullptr);
+      entry["rotation_sigma_deg"] =
+          std::isfinite(image.rotation_sigma_deg) ? nlohmann::json(image.rotation_sigma_deg) : nlohmann::json(nullptr);
     }
     if (image.alternative_rms_px >= 0.0) entry["alternative_pose_rms_px"] = image.alternative_rms_px;
     if (!image.used) entry["dropped"] = image.dropped_reason;
@@ -612,7 +633,8 @@ nlohmann::json ToJson(const AlignResult& result) {
   }
   nlohmann::json markers = nlohmann::json::array();
   for (const MarkerResidual& marker : result.markers) {
-    nlohmann::json entry = {{"id", marker.id}, {"kind", marker.kind}, {"observations", marker.observations}, {"rms_px", marker.rms_px}};
+    nlohmann::json entry = {
+        {"id", marker.id}, {"kind", marker.kind}, {"observations", marker.observations}, {"rms_px", marker.rms_px}};
     if (marker.kind != "reference") {
       nlohmann::json corners = nlohmann::json::array();
       for (const Eigen::Vector3d& c : marker.corners) corners.push_back(ToJson(c));
@@ -620,8 +642,9 @@ nlohmann::json ToJson(const AlignResult& result) {
     }
     markers.push_back(entry);
   }
-  nlohmann::json json = {{"format", "ibrdf-alignment"}, {"version", 1}, {"rms_px", result.rms_px},
-                         {"images", images},          {"markers", markers}, {"total_s", result.total_s}};
+  nlohmann::json json = {{"format", "ibrdf-alignment"}, {"version", 1},
+                         {"rms_px", result.rms_px},     {"images", images},
+                         {"markers", markers},          {"total_s", result.total_s}};
   json["bundle_adjustment"] = {{"images", result.bundle.images},
                                {"free_markers", result.bundle.free_markers},
                                {"fixed_markers", result.bundle.fixed_markers},
@@ -668,4 +691,3 @@ nlohmann::json ToJson(const AlignResult& result) {
 }
 
 }  // namespace ibrdf
-

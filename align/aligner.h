@@ -20,9 +20,9 @@
 namespace ibrdf {
 
 struct AlignOptions {
-  int min_markers_per_image = 2;     // fewer posed markers seen (corners of known or estimated layout): dropped
-  double max_image_rms_px = 1.0;     // reprojection RMS above this: the photo is dropped
-  double huber_px = 1.0;             // robust loss scale for marker corners, pixels
+  int min_markers_per_image = 2;  // fewer posed markers seen (corners of known or estimated layout): dropped
+  double max_image_rms_px = 1.0;  // reprojection RMS above this: the photo is dropped
+  double huber_px = 1.0;          // robust loss scale for marker corners, pixels
   // Reliability of a pose from its corners' geometry (EstimatePoseUncertainty), for corners measured
   // to corner_sigma_px (or the photo's own RMS, if larger): a photo whose camera position or rotation
   // is predicted worse than these (one sigma) is dropped. Nearly collinear markers, one small marker or
@@ -33,11 +33,11 @@ struct AlignOptions {
   // Planar pose ambiguity: a photo whose coplanar corners are explained by a second, distinct pose
   // with a reprojection RMS below ambiguity_ratio x max(its own RMS, corner_sigma_px) is dropped.
   double ambiguity_ratio = 3.0;
-  bool fit_sphere = true;            // refine a sphere sample's centre and radius from silhouettes
-  bool fit_cylinder = true;          // a cylinder's centre and axis from its markers (targets.sample)
-  bool fit_light = true;             // the light's position from its markers, when the session has them
-  int silhouette_lines = 360;        // radial search lines per photo
-  BundleAdjustmentOptions bundle;    // huber_px is taken from above
+  bool fit_sphere = true;          // refine a sphere sample's centre and radius from silhouettes
+  bool fit_cylinder = true;        // a cylinder's centre and axis from its markers (targets.sample)
+  bool fit_light = true;           // the light's position from its markers, when the session has them
+  int silhouette_lines = 360;      // radial search lines per photo
+  BundleAdjustmentOptions bundle;  // huber_px is taken from above
   CylinderFitOptions cylinder;
   bool Check(std::string* why) const;
 };
@@ -45,13 +45,13 @@ struct AlignOptions {
 struct ImageAlignment {
   size_t photo = 0;
   bool used = false;
-  std::string dropped_reason;        // empty when used
-  int markers = 0;                   // markers of the pose (known, unknown layout, sample) detected and posed
-  int light_markers = 0;             // markers of the light detected
-  int ignored_markers = 0;           // detections of ids in no target list (or duplicated)
-  int outlier_corners = 0;           // corners left out of the final solve (partly hidden markers)
-  double rms_px = 0.0;               // reprojection RMS of the inlier corners after the bundle adjustment
-  double position_sigma_m = 0.0;     // predicted standard deviations of the pose (EstimatePoseUncertainty)
+  std::string dropped_reason;     // empty when used
+  int markers = 0;                // markers of the pose (known, unknown layout, sample) detected and posed
+  int light_markers = 0;          // markers of the light detected
+  int ignored_markers = 0;        // detections of ids in no target list (or duplicated)
+  int outlier_corners = 0;        // corners left out of the final solve (partly hidden markers)
+  double rms_px = 0.0;            // reprojection RMS of the inlier corners after the bundle adjustment
+  double position_sigma_m = 0.0;  // predicted standard deviations of the pose (EstimatePoseUncertainty)
   double rotation_sigma_deg = 0.0;
   double alternative_rms_px = -1.0;  // RMS of the planar second pose (AlternativePoseRms); < 0: none
   Rigid3d camera_from_world;         // photos that see light markers: after the joint refinement with them
@@ -59,8 +59,8 @@ struct ImageAlignment {
 
 struct MarkerResidual {
   int id = -1;
-  std::string kind;                  // "reference" (known layout), "unknown" (estimated) or "sample"
-  int observations = 0;              // used photos that see it
+  std::string kind;      // "reference" (known layout), "unknown" (estimated) or "sample"
+  int observations = 0;  // used photos that see it
   double rms_px = 0.0;
   std::array<Eigen::Vector3d, 4> corners;  // world frame (estimated, for "unknown" and "sample")
 };
@@ -69,9 +69,9 @@ struct SphereFit {
   bool fitted = false;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   double radius = 0.0;
-  int silhouette_points = 0;         // tangent rays used
-  int rejected_points = 0;           // outliers removed after the first solve
-  double rms_m = 0.0;                // RMS of ray-to-sphere distances, metres
+  int silhouette_points = 0;  // tangent rays used
+  int rejected_points = 0;    // outliers removed after the first solve
+  double rms_m = 0.0;         // RMS of ray-to-sphere distances, metres
 };
 
 // One marker on the light: its pose from every posed photo that sees it (square PnP, the candidate that
@@ -79,30 +79,30 @@ struct SphereFit {
 // photos that see them, their reference corners included), and the light's position it implies.
 struct LightMarkerFit {
   int id = -1;
-  int photos = 0;                    // posed photos that see it; 0 = not seen, no estimate
-  double rms_px = 0.0;               // corner reprojection RMS after refinement
+  int photos = 0;       // posed photos that see it; 0 = not seen, no estimate
+  double rms_px = 0.0;  // corner reprojection RMS after refinement
   Rigid3d world_from_marker;
   Eigen::Vector3d light_in_world = Eigen::Vector3d::Zero();
 };
 
 struct LightFit {
-  bool fitted = false;               // false: the light stays as given (see `reason`)
-  std::string reason;                // why not fitted
+  bool fitted = false;                                 // false: the light stays as given (see `reason`)
+  std::string reason;                                  // why not fitted
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // metres, world frame: the markers' mean
-  double spread_m = 0.0;             // largest distance of one marker's estimate from the mean
+  double spread_m = 0.0;                               // largest distance of one marker's estimate from the mean
   std::vector<LightMarkerFit> markers;
 };
 
 struct AlignResult {
   bool success = false;
-  Session session;                   // the input session with poses (and sphere) replaced; dropped photos removed
+  Session session;  // the input session with poses (and sphere) replaced; dropped photos removed
   std::vector<ImageAlignment> images;
   std::vector<MarkerResidual> markers;
   SphereFit sphere;
   CylinderFit cylinder;
   LightFit light;
   BundleAdjustmentSummary bundle;
-  double rms_px = 0.0;               // over all corners of used photos
+  double rms_px = 0.0;  // over all corners of used photos
   double total_s = 0.0;
   std::string BriefReport() const;
 };

@@ -15,6 +15,7 @@
 #include "align/cost_functions/marker_corner_error.h"
 #include "align/cost_functions/reprojection_error.h"
 #include "core/logging.h"
+#include "core/statistics.h"
 
 namespace ibrdf {
 namespace {
@@ -97,7 +98,8 @@ double PoseRms(const std::array<double, 8>& intrinsics, const Rigid3d& camera_fr
 
 // A photo's first pose from its posed markers: SQPnP, then the robust refinement.
 bool InitialImagePose(const std::array<double, 8>& intrinsics, const OpenCvCamera& cv_camera, double huber_px,
-                      const BundleImage& image, const std::map<int, BundleMarker>& markers, Rigid3d* camera_from_world) {
+                      const BundleImage& image, const std::map<int, BundleMarker>& markers,
+                      Rigid3d* camera_from_world) {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2d> pixels;
   UsableCorners(image, markers, &points, &pixels);
@@ -109,7 +111,8 @@ bool InitialImagePose(const std::array<double, 8>& intrinsics, const OpenCvCamer
     image_points.emplace_back(pixels[k].x() - 0.5, pixels[k].y() - 0.5);
   }
   cv::Mat rvec, tvec;
-  if (!cv::solvePnP(object, image_points, cv_camera.matrix, cv_camera.distortion, rvec, tvec, false, cv::SOLVEPNP_SQPNP)) {
+  if (!cv::solvePnP(object, image_points, cv_camera.matrix, cv_camera.distortion, rvec, tvec, false,
+                    cv::SOLVEPNP_SQPNP)) {
     return false;
   }
   *camera_from_world = PoseFromCv(rvec, tvec);
@@ -152,7 +155,8 @@ bool InitialMarkerPose(const std::array<double, 8>& intrinsics, const OpenCvCame
       for (const Sighting& other : sightings) {
         double pose[6];
         AngleAxisFromPose(other.image->camera_from_world, pose, pose + 3);
-        for (int c = 0; c < 4; ++c) cost += SquaredResidual(intrinsics, pose, candidate * in_marker[c], other.pixels[c]);
+        for (int c = 0; c < 4; ++c)
+          cost += SquaredResidual(intrinsics, pose, candidate * in_marker[c], other.pixels[c]);
       }
       if (cost < best_cost) {
         best_cost = cost;
@@ -172,10 +176,21 @@ std::array<double, 8> ProjectionIntrinsics(const Camera& camera) {
   std::array<double, 8> k = {camera.FocalX(), camera.FocalY(), camera.PrincipalX(), camera.PrincipalY(), 0, 0, 0, 0};
   const std::vector<double>& p = camera.params;
   switch (camera.model) {
-    case CameraModelId::kSimpleRadial: k[4] = p[3]; break;
-    case CameraModelId::kRadial: k[4] = p[3]; k[5] = p[4]; break;
-    case CameraModelId::kOpenCV: k[4] = p[4]; k[5] = p[5]; k[6] = p[6]; k[7] = p[7]; break;
-    default: break;
+    case CameraModelId::kSimpleRadial:
+      k[4] = p[3];
+      break;
+    case CameraModelId::kRadial:
+      k[4] = p[3];
+      k[5] = p[4];
+      break;
+    case CameraModelId::kOpenCV:
+      k[4] = p[4];
+      k[5] = p[5];
+      k[6] = p[6];
+      k[7] = p[7];
+      break;
+    default:
+      break;
   }
   return k;
 }
@@ -202,7 +217,8 @@ Rigid3d PoseFromAngleAxis(const double* rotation, const double* translation) {
 
 std::array<Eigen::Vector3d, 4> MarkerCornersInMarker(double size) {
   const double h = 0.5 * size;
-  return {Eigen::Vector3d(-h, -h, 0.0), Eigen::Vector3d(h, -h, 0.0), Eigen::Vector3d(h, h, 0.0), Eigen::Vector3d(-h, h, 0.0)};
+  return {Eigen::Vector3d(-h, -h, 0.0), Eigen::Vector3d(h, -h, 0.0), Eigen::Vector3d(h, h, 0.0),
+          Eigen::Vector3d(-h, h, 0.0)};
 }
 
 void BundleMarker::UpdateCorners() {
@@ -228,7 +244,8 @@ std::string BundleAdjustmentSummary::BriefReport() const {
   std::snprintf(buffer, sizeof(buffer),
                 "bundle adjustment: %d photos, %d free and %d fixed markers, %d corners (%d outliers left out), "
                 "RMS %.3f -> %.3f px in %d iterations, %.2f s",
-                images, free_markers, fixed_markers, corners, outliers, initial_rms_px, final_rms_px, iterations, total_s);
+                images, free_markers, fixed_markers, corners, outliers, initial_rms_px, final_rms_px, iterations,
+                total_s);
   return buffer;
 }
 
@@ -241,12 +258,14 @@ BundleAdjustmentSummary BundleAdjust(const Camera& camera, const BundleAdjustmen
   std::map<int, std::array<double, 6>> marker_poses;
   std::map<int, std::array<std::array<double, 3>, 4>> fixed_points;
   for (size_t i = 0; i < images->size(); ++i) {
-    if ((*images)[i].posed) AngleAxisFromPose((*images)[i].camera_from_world, camera_poses[i].data(), camera_poses[i].data() + 3);
+    if ((*images)[i].posed)
+      AngleAxisFromPose((*images)[i].camera_from_world, camera_poses[i].data(), camera_poses[i].data() + 3);
   }
   for (auto& [id, marker] : *markers) {
     if (!marker.posed) continue;
     if (marker.fixed) {
-      for (int c = 0; c < 4; ++c) fixed_points[id][c] = {marker.corners[c].x(), marker.corners[c].y(), marker.corners[c].z()};
+      for (int c = 0; c < 4; ++c)
+        fixed_points[id][c] = {marker.corners[c].x(), marker.corners[c].y(), marker.corners[c].z()};
     } else {
       AngleAxisFromPose(marker.world_from_marker, marker_poses[id].data(), marker_poses[id].data() + 3);
     }
@@ -260,10 +279,12 @@ BundleAdjustmentSummary BundleAdjust(const Camera& camera, const BundleAdjustmen
     const BundleMarker& marker = markers->at(o.marker_id);
     const double* pose = camera_poses[i].data();
     if (marker.fixed) {
-      ReprojectionError(intrinsics, o.pixel.x(), o.pixel.y())(pose, pose + 3, fixed_points.at(o.marker_id)[o.corner].data(), r);
+      ReprojectionError(intrinsics, o.pixel.x(), o.pixel.y())(pose, pose + 3,
+                                                              fixed_points.at(o.marker_id)[o.corner].data(), r);
     } else {
       const double* m = marker_poses.at(o.marker_id).data();
-      MarkerCornerError(intrinsics, MarkerCornersInMarker(marker.size)[o.corner], o.pixel.x(), o.pixel.y())(pose, pose + 3, m, m + 3, r);
+      MarkerCornerError(intrinsics, MarkerCornersInMarker(marker.size)[o.corner], o.pixel.x(), o.pixel.y())(
+          pose, pose + 3, m, m + 3, r);
     }
   };
   auto inlier_rms = [&]() {
@@ -302,9 +323,9 @@ BundleAdjustmentSummary BundleAdjust(const Camera& camera, const BundleAdjustmen
           fixed_seen.insert(o.marker_id);
         } else {
           double* m = marker_poses.at(o.marker_id).data();
-          problem.AddResidualBlock(
-              MarkerCornerError::Create(intrinsics, MarkerCornersInMarker(marker.size)[o.corner], o.pixel.x(), o.pixel.y()),
-              new ceres::HuberLoss(options.huber_px), pose, pose + 3, m, m + 3);
+          problem.AddResidualBlock(MarkerCornerError::Create(intrinsics, MarkerCornersInMarker(marker.size)[o.corner],
+                                                             o.pixel.x(), o.pixel.y()),
+                                   new ceres::HuberLoss(options.huber_px), pose, pose + 3, m, m + 3);
           free_seen.insert(o.marker_id);
         }
       }
@@ -314,7 +335,8 @@ BundleAdjustmentSummary BundleAdjust(const Camera& camera, const BundleAdjustmen
       summary.total_s = timer.ElapsedSeconds();
       return summary;
     }
-    parameters = 6 * static_cast<int>(std::count_if(images->begin(), images->end(), [](const BundleImage& b) { return b.posed; })) +
+    parameters = 6 * static_cast<int>(
+                         std::count_if(images->begin(), images->end(), [](const BundleImage& b) { return b.posed; })) +
                  6 * static_cast<int>(free_seen.size());
     ceres::Solver::Summary solver_summary;
     ceres::Solve(SolverOptions(parameters, options.max_num_iterations, options.tolerance), &problem, &solver_summary);
@@ -339,9 +361,7 @@ BundleAdjustmentSummary BundleAdjust(const Camera& camera, const BundleAdjustmen
         norms.push_back(std::hypot(r[0], r[1]));
       }
       if (norms.empty()) continue;
-      std::vector<double> sorted = norms;
-      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-      const double limit = std::max(options.min_outlier_px, 3.0 * 1.4826 * sorted[sorted.size() / 2]);
+      const double limit = std::max(options.min_outlier_px, 3.0 * 1.4826 * Median(norms));
       // A corner beyond the limit condemns its marker in this photo: its corners come from lines fitted
       // to its sides, and a partly hidden side shifts both of that side's corners.
       size_t k = 0;
@@ -461,13 +481,14 @@ PoseUncertainty EstimatePoseUncertainty(const Camera& camera, const BundleImage&
   // Parameters: the camera's centre (metres) and a small rotation of the camera in the world (radians).
   const Rigid3d world_from_camera = image.camera_from_world.Inverse();
   auto project = [&](const Eigen::Matrix<double, 6, 1>& delta, Eigen::VectorXd* out) {
-    const Eigen::Quaterniond turn(Eigen::AngleAxisd(delta.tail<3>().norm(), delta.tail<3>().norm() > 0.0
-                                                                                 ? Eigen::Vector3d(delta.tail<3>().normalized())
-                                                                                 : Eigen::Vector3d::UnitZ()));
+    const Eigen::Quaterniond turn(Eigen::AngleAxisd(
+        delta.tail<3>().norm(),
+        delta.tail<3>().norm() > 0.0 ? Eigen::Vector3d(delta.tail<3>().normalized()) : Eigen::Vector3d::UnitZ()));
     const Rigid3d perturbed(turn * world_from_camera.rotation, world_from_camera.translation + delta.head<3>());
     const Rigid3d camera_from_world = perturbed.Inverse();
     out->resize(2 * points.size());
-    for (size_t k = 0; k < points.size(); ++k) out->segment<2>(2 * k) = camera.ImageFromCamera(camera_from_world * points[k]);
+    for (size_t k = 0; k < points.size(); ++k)
+      out->segment<2>(2 * k) = camera.ImageFromCamera(camera_from_world * points[k]);
   };
   Eigen::MatrixXd jacobian(2 * points.size(), 6);
   const double step = 1e-6;
@@ -515,7 +536,8 @@ double AlternativePoseRms(const Camera& camera, const BundleImage& image, const 
   }
   std::vector<cv::Mat> rvecs, tvecs;
   try {
-    cv::solvePnPGeneric(object, image_points, cv_camera.matrix, cv_camera.distortion, rvecs, tvecs, false, cv::SOLVEPNP_IPPE);
+    cv::solvePnPGeneric(object, image_points, cv_camera.matrix, cv_camera.distortion, rvecs, tvecs, false,
+                        cv::SOLVEPNP_IPPE);
   } catch (const cv::Exception&) {
     return -1.0;
   }

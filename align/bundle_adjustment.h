@@ -36,10 +36,10 @@ std::array<Eigen::Vector3d, 4> MarkerCornersInMarker(double size);
 // A marker in the adjustment.
 struct BundleMarker {
   int id = -1;
-  bool fixed = false;         // corners known and held constant (known layout, or the origin marker)
-  double size = 0.0;          // free markers: printed side, metres
-  bool posed = false;         // has a pose estimate (fixed markers always)
-  Rigid3d world_from_marker;  // free markers: the estimate
+  bool fixed = false;                      // corners known and held constant (known layout, or the origin marker)
+  double size = 0.0;                       // free markers: printed side, metres
+  bool posed = false;                      // has a pose estimate (fixed markers always)
+  Rigid3d world_from_marker;               // free markers: the estimate
   std::array<Eigen::Vector3d, 4> corners;  // world frame: given (fixed) or from the pose (free)
   // Outputs: used photos that see the marker, and the reprojection RMS of its inlier corners.
   int images = 0;
@@ -51,15 +51,15 @@ struct BundleMarker {
 
 struct CornerObservation {
   int marker_id = -1;
-  int corner = 0;          // 0..3, OpenCV's order
-  Eigen::Vector2d pixel;   // COLMAP convention (pixel centres at +0.5)
-  bool inlier = true;      // false: left out (a corner of a partly hidden marker)
+  int corner = 0;         // 0..3, OpenCV's order
+  Eigen::Vector2d pixel;  // COLMAP convention (pixel centres at +0.5)
+  bool inlier = true;     // false: left out (a corner of a partly hidden marker)
 };
 
 // One photo in the adjustment.
 struct BundleImage {
   std::vector<CornerObservation> corners;
-  bool posed = false;          // has a pose estimate and takes part
+  bool posed = false;  // has a pose estimate and takes part
   Rigid3d camera_from_world;
   // Outputs: inlier corners of posed markers, their RMS, and the outliers left out.
   int inliers = 0;
@@ -68,34 +68,34 @@ struct BundleImage {
 };
 
 struct BundleAdjustmentOptions {
-  double huber_px = 1.0;        // robust loss scale for marker corners, pixels
-  int max_num_iterations = 200; // Ceres iterations per solve
-  double tolerance = 1e-12;     // Ceres function and parameter tolerance
-  double min_outlier_px = 0.25; // outlier pass: a corner beyond max(this, 3 robust sigmas) of its photo
-                                // leaves its marker out of that photo
+  double huber_px = 1.0;         // robust loss scale for marker corners, pixels
+  int max_num_iterations = 200;  // Ceres iterations per solve
+  double tolerance = 1e-12;      // Ceres function and parameter tolerance
+  double min_outlier_px = 0.25;  // outlier pass: a corner beyond max(this, 3 robust sigmas) of its photo
+                                 // leaves its marker out of that photo
   bool Check(std::string* why) const;
 };
 
 struct BundleAdjustmentSummary {
   bool success = false;
-  int images = 0;          // posed photos in the problem
-  int free_markers = 0;    // markers whose pose was adjusted
-  int fixed_markers = 0;   // markers held constant (gauge)
-  int corners = 0;         // inlier corner observations
-  int outliers = 0;        // corners left out by the outlier pass
+  int images = 0;         // posed photos in the problem
+  int free_markers = 0;   // markers whose pose was adjusted
+  int fixed_markers = 0;  // markers held constant (gauge)
+  int corners = 0;        // inlier corner observations
+  int outliers = 0;       // corners left out by the outlier pass
   double initial_rms_px = 0.0;
   double final_rms_px = 0.0;
   int iterations = 0;
   double total_s = 0.0;
-  std::string message;     // Ceres' when it failed
+  std::string message;  // Ceres' when it failed
   std::string BriefReport() const;
 };
 
 // Jointly refines every posed photo's pose and every posed free marker's pose from the inlier corners
 // of posed markers (Huber loss), then leaves out, per photo, every marker with a corner beyond
-// max(min_outlier_px, 3 robust sigmas) of that photo's residuals, and solves again. Fixed markers stay constant; without any fixed marker
-// in the problem the gauge is free and the call fails. Updates poses, corners, inlier flags and the
-// per-photo and per-marker residuals.
+// max(min_outlier_px, 3 robust sigmas) of that photo's residuals, and solves again. Fixed markers stay constant;
+// without any fixed marker in the problem the gauge is free and the call fails. Updates poses, corners, inlier flags
+// and the per-photo and per-marker residuals.
 BundleAdjustmentSummary BundleAdjust(const Camera& camera, const BundleAdjustmentOptions& options,
                                      std::vector<BundleImage>* images, std::map<int, BundleMarker>* markers);
 

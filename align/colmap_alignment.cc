@@ -1,9 +1,9 @@
 #include "align/colmap_alignment.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
-#include <array>
 #include <map>
 #include <random>
 
@@ -108,7 +108,8 @@ ColmapAlignment AlignColmapModel(const ColmapModel& model, const std::vector<std
       id = exact->second;
     } else if (const auto copy = by_path.find(path + ".png"); copy != by_path.end()) {
       id = copy->second;  // align/colmap_runner's PNG copy of a photo in another format
-    } else if (const auto named = by_file_name.find(fs::path(photo_files[i]).filename().string()); named != by_file_name.end()) {
+    } else if (const auto named = by_file_name.find(fs::path(photo_files[i]).filename().string());
+               named != by_file_name.end()) {
       id = named->second;  // -2 where ambiguous
     }
     if (id >= 0 && !claimed.count(id)) {
@@ -127,10 +128,10 @@ ColmapAlignment AlignColmapModel(const ColmapModel& model, const std::vector<std
   }
   result.both = static_cast<int>(both.size());
   if (result.both < options.min_images) {
-    ThrowError(model_directory, std::to_string(result.matched) + " of the session's " + std::to_string(photo_files.size()) +
-                                    " photos are in the COLMAP model (matched by file name) and " + std::to_string(result.both) +
-                                    " of those were posed by the targets; the similarity needs " +
-                                    std::to_string(options.min_images));
+    ThrowError(model_directory,
+               std::to_string(result.matched) + " of the session's " + std::to_string(photo_files.size()) +
+                   " photos are in the COLMAP model (matched by file name) and " + std::to_string(result.both) +
+                   " of those were posed by the targets; the similarity needs " + std::to_string(options.min_images));
   }
   const auto colmap_pose = [&](size_t i) -> const Rigid3d& {
     return model.images.at(static_cast<uint32_t>(result.photos[i].image_id)).camera_from_world;
@@ -193,11 +194,12 @@ ColmapAlignment AlignColmapModel(const ColmapModel& model, const std::vector<std
     }
   }
   if (best_score.first < options.min_images) {
-    ThrowError(model_directory, "no similarity brings " + std::to_string(options.min_images) + " of the " +
-                                    std::to_string(n) + " photos posed both ways within " +
-                                    std::to_string(1e3 * options.max_center_error_m) + " mm and " +
-                                    std::to_string(options.max_rotation_error_deg) +
-                                    " degrees of their target-based poses (the centres may be collinear, or the model is not of these photos)");
+    ThrowError(
+        model_directory,
+        "no similarity brings " + std::to_string(options.min_images) + " of the " + std::to_string(n) +
+            " photos posed both ways within " + std::to_string(1e3 * options.max_center_error_m) + " mm and " +
+            std::to_string(options.max_rotation_error_deg) +
+            " degrees of their target-based poses (the centres may be collinear, or the model is not of these photos)");
   }
   // Refit on the inliers until they stop changing.
   Similarity3d similarity;
@@ -258,11 +260,12 @@ const Camera* SharedColmapCamera(const ColmapModel& model, const ColmapAlignment
 
 std::string ColmapAlignment::BriefReport() const {
   char buffer[400];
-  std::snprintf(buffer, sizeof(buffer),
-                "colmap: %d photos registered (%d images unmatched), %d posed by the targets too, %d inliers; scale %.6g; "
-                "camera centres RMS %.3f mm (max %.3f mm), orientations RMS %.4f deg",
-                matched, unmatched_images, both, inliers, world_from_colmap.scale, 1e3 * rms_center_error_m,
-                1e3 * max_center_error_m, rms_rotation_error_deg);
+  std::snprintf(
+      buffer, sizeof(buffer),
+      "colmap: %d photos registered (%d images unmatched), %d posed by the targets too, %d inliers; scale %.6g; "
+      "camera centres RMS %.3f mm (max %.3f mm), orientations RMS %.4f deg",
+      matched, unmatched_images, both, inliers, world_from_colmap.scale, 1e3 * rms_center_error_m,
+      1e3 * max_center_error_m, rms_rotation_error_deg);
   return buffer;
 }
 

@@ -33,39 +33,40 @@ struct Similarity3d {
   Rigid3d TransformPose(const Rigid3d& camera_from_source) const;
   // Umeyama's least-squares similarity taking `source` onto `target` (columns are points; >= 3, not
   // collinear). Throws Error (naming `where`) on degenerate input.
-  static Similarity3d Estimate(const Eigen::Matrix3Xd& source, const Eigen::Matrix3Xd& target, const std::string& where);
+  static Similarity3d Estimate(const Eigen::Matrix3Xd& source, const Eigen::Matrix3Xd& target,
+                               const std::string& where);
 };
 
 struct ColmapAlignmentOptions {
-  int min_images = 3;                 // photos posed both ways needed for the similarity
-  double max_center_error_m = 0.01;   // a camera centre further than this from its target-based one is an outlier
+  int min_images = 3;                   // photos posed both ways needed for the similarity
+  double max_center_error_m = 0.01;     // a camera centre further than this from its target-based one is an outlier
   double max_rotation_error_deg = 1.0;  // likewise for the camera's orientation
-  int max_triples = 20000;            // consensus: every triple of photos up to this many, else a seeded sample
+  int max_triples = 20000;              // consensus: every triple of photos up to this many, else a seeded sample
   bool Check(std::string* why) const;
 };
 
 // One photo of the session and what COLMAP and the targets say about it.
 struct ColmapPhotoMatch {
-  std::string photo;                          // the session's file name (as in session.json)
-  int64_t image_id = -1;                      // COLMAP's image, -1 if COLMAP did not register it
-  std::optional<Rigid3d> target_pose;         // camera_from_world from the coded targets, if posed
-  std::optional<Rigid3d> metric_pose;         // COLMAP's pose through the similarity (set after success)
-  bool inlier = false;                        // used for the final similarity
-  double center_error_m = 0.0;                // |C_target - S * C_colmap|, where both exist
-  double rotation_error_deg = 0.0;            // angle between the two orientations, where both exist
+  std::string photo;                   // the session's file name (as in session.json)
+  int64_t image_id = -1;               // COLMAP's image, -1 if COLMAP did not register it
+  std::optional<Rigid3d> target_pose;  // camera_from_world from the coded targets, if posed
+  std::optional<Rigid3d> metric_pose;  // COLMAP's pose through the similarity (set after success)
+  bool inlier = false;                 // used for the final similarity
+  double center_error_m = 0.0;         // |C_target - S * C_colmap|, where both exist
+  double rotation_error_deg = 0.0;     // angle between the two orientations, where both exist
 };
 
 struct ColmapAlignment {
   bool success = false;
   Similarity3d world_from_colmap;
-  std::vector<ColmapPhotoMatch> photos;       // in the session's order
-  int matched = 0;                            // photos COLMAP registered
-  int both = 0;                               // of those, posed by the targets too
-  int inliers = 0;                            // of those, agreeing with the similarity
-  int unmatched_images = 0;                   // COLMAP images named like no photo of the session
-  double rms_center_error_m = 0.0;            // over the inliers
-  double max_center_error_m = 0.0;            // over the inliers
-  double rms_rotation_error_deg = 0.0;        // over the inliers
+  std::vector<ColmapPhotoMatch> photos;  // in the session's order
+  int matched = 0;                       // photos COLMAP registered
+  int both = 0;                          // of those, posed by the targets too
+  int inliers = 0;                       // of those, agreeing with the similarity
+  int unmatched_images = 0;              // COLMAP images named like no photo of the session
+  double rms_center_error_m = 0.0;       // over the inliers
+  double max_center_error_m = 0.0;       // over the inliers
+  double rms_rotation_error_deg = 0.0;   // over the inliers
   std::string BriefReport() const;
 };
 

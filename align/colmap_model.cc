@@ -15,10 +15,17 @@ namespace ibrdf {
 namespace {
 
 // COLMAP's camera model ids, in its order.
-constexpr const char* kColmapModels[] = {"SIMPLE_PINHOLE",    "PINHOLE",        "SIMPLE_RADIAL",
-                                         "RADIAL",            "OPENCV",         "OPENCV_FISHEYE",
-                                         "FULL_OPENCV",       "FOV",            "SIMPLE_RADIAL_FISHEYE",
-                                         "RADIAL_FISHEYE",    "THIN_PRISM_FISHEYE"};
+constexpr const char* kColmapModels[] = {"SIMPLE_PINHOLE",
+                                         "PINHOLE",
+                                         "SIMPLE_RADIAL",
+                                         "RADIAL",
+                                         "OPENCV",
+                                         "OPENCV_FISHEYE",
+                                         "FULL_OPENCV",
+                                         "FOV",
+                                         "SIMPLE_RADIAL_FISHEYE",
+                                         "RADIAL_FISHEYE",
+                                         "THIN_PRISM_FISHEYE"};
 
 // A little-endian binary reader that names the file and the byte offset on a short read.
 class BinaryReader {
@@ -87,7 +94,8 @@ Camera MakeCamera(const std::string& model_name, uint64_t width, uint64_t height
   return Camera::Create(model, static_cast<int>(width), static_cast<int>(height), std::move(params), where);
 }
 
-Rigid3d MakePose(double qw, double qx, double qy, double qz, double tx, double ty, double tz, const std::string& where) {
+Rigid3d MakePose(double qw, double qx, double qy, double qz, double tx, double ty, double tz,
+                 const std::string& where) {
   const double norm = std::sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
   if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-6 || !std::isfinite(tx + ty + tz)) {
     ThrowError(where, "pose is not a unit quaternion and finite translation");
@@ -354,7 +362,8 @@ ColmapModel ColmapModel::ReadText(const std::string& directory) {
 void ColmapModel::Validate(const std::string& directory) const {
   for (const auto& [id, image] : images) {
     if (!cameras.count(image.camera_id)) {
-      ThrowError(directory, "image " + std::to_string(id) + " refers to missing camera " + std::to_string(image.camera_id));
+      ThrowError(directory,
+                 "image " + std::to_string(id) + " refers to missing camera " + std::to_string(image.camera_id));
     }
   }
   for (const auto& [id, point] : points) {
@@ -407,8 +416,8 @@ void ColmapModel::WriteText(const std::string& directory) const {
         << "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
         << "# Number of points: " << points.size() << "\n";
     for (const auto& [id, point] : points) {
-      out << id << " " << point.xyz.x() << " " << point.xyz.y() << " " << point.xyz.z() << " " << int(point.rgb[0]) << " "
-          << int(point.rgb[1]) << " " << int(point.rgb[2]) << " " << point.error;
+      out << id << " " << point.xyz.x() << " " << point.xyz.y() << " " << point.xyz.z() << " " << int(point.rgb[0])
+          << " " << int(point.rgb[1]) << " " << int(point.rgb[2]) << " " << point.error;
       for (const auto& [image_id, index] : point.track) out << " " << image_id << " " << index;
       out << "\n";
     }

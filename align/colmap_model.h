@@ -32,7 +32,7 @@ struct ColmapPoint3D {
   uint64_t id = 0;
   Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
   uint8_t rgb[3] = {0, 0, 0};
-  double error = 0.0;  // mean reprojection error, pixels
+  double error = 0.0;                                // mean reprojection error, pixels
   std::vector<std::pair<uint32_t, uint32_t>> track;  // (image id, index of the 2D point)
 };
 

@@ -1,9 +1,5 @@
 #include "align/colmap_runner.h"
 
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/prctl.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,8 +12,11 @@
 
 #include "align/colmap_model.h"
 #include "core/error.h"
+#include "core/statistics.h"
+#include "core/subprocess.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/linear_image.h"
 #include "core/logging.h"
 #include "core/radiometry.h"
 
@@ -41,51 +40,26 @@ std::string Tail(const std::string& path, size_t count) {
   return tail;
 }
 
-// Runs `executable arguments...` with stdout and stderr into `log_path`, headless (Qt offscreen); the
-// child dies with this process. Returns the exit code, or 128 + the signal.
+// Runs `executable arguments...` with stdout and stderr into `log_path`, headless (Qt offscreen).
 int RunLogged(const std::string& executable, const std::vector<std::string>& arguments, const std::string& log_path) {
   std::vector<std::string> argv = {executable};
   argv.insert(argv.end(), arguments.begin(), arguments.end());
-  std::vector<char*> raw;
-  for (std::string& arg : argv) raw.push_back(arg.data());
-  raw.push_back(nullptr);
-  const pid_t parent = ::getpid();
-  const pid_t pid = ::fork();
-  IBRDF_CHECK(pid >= 0) << "fork failed";
-  if (pid == 0) {
-    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    if (::getppid() != parent) ::_exit(127);
-    const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (log < 0) ::_exit(126);
-    ::dup2(log, STDOUT_FILENO);
-    ::dup2(log, STDERR_FILENO);
-    ::close(log);
-    ::setenv("QT_QPA_PLATFORM", "offscreen", 1);
-    ::execv(raw[0], raw.data());
-    ::_exit(127);
-  }
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    IBRDF_CHECK(errno == EINTR) << "waitpid failed";
-  }
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-  return -1;
+  SubprocessOptions options;
+  options.log_path = log_path;
+  options.environment = {{"QT_QPA_PLATFORM", "offscreen"}};
+  return RunSubprocess(argv, options);
 }
 
 // An 8-bit, sRGB-encoded copy of a photo for SIFT: linearized, scaled so its 99.9th percentile is white.
 void WriteColmapImage(const Session& session, size_t photo, const std::string& path) {
   Image image = ReadImage(session.PhotoPath(photo));
-  for (float& v : image.pixels) {
-    v = static_cast<float>(std::max(0.0, session.radiometry.response.ToLinear(v) - session.radiometry.black_level));
-  }
+  LinearizeImage(session, photo, &image);
   std::vector<float> values;
   for (size_t i = 0; i < image.pixels.size(); i += 7) values.push_back(image.pixels[i]);
   float white = 1.0f;
   if (!values.empty()) {
-    const size_t k = static_cast<size_t>(0.999 * (values.size() - 1));
-    std::nth_element(values.begin(), values.begin() + k, values.end());
-    if (values[k] > 0.0f) white = values[k];
+    const float level = PercentileInPlace(&values, 0.999);
+    if (level > 0.0f) white = level;
   }
   for (float& v : image.pixels) v = static_cast<float>(LinearToSrgb(std::min(1.0, double(v) / white)));
   fs::create_directories(fs::path(path).parent_path());
@@ -104,7 +78,8 @@ std::string ParamsList(const std::vector<double>& params) {
 std::string ColmapImageName(const std::string& photo_file) {
   const std::string name = fs::path(photo_file).lexically_normal().generic_string();
   std::string extension = fs::path(name).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return extension == ".png" ? name : name + ".png";
 }
 
@@ -138,25 +113,28 @@ std::vector<ColmapCommand> ColmapCommands(const Session& session, const std::str
   const std::string images = (fs::path(work_dir) / "images").string();
   const std::string list = (fs::path(work_dir) / "image-list.txt").string();
   const std::string threads = std::to_string(options.num_threads);
-  ColmapCommand extract{"feature_extractor",
-                        {"--database_path", database, "--image_path", images, "--image_list_path", list,
-                         "--ImageReader.single_camera", options.single_camera ? "1" : "0", "--SiftExtraction.use_gpu", "0",
-                         "--SiftExtraction.num_threads", threads, "--SiftExtraction.max_image_size",
-                         std::to_string(options.max_image_size)}};
+  ColmapCommand extract{
+      "feature_extractor",
+      {"--database_path", database, "--image_path", images, "--image_list_path", list, "--ImageReader.single_camera",
+       options.single_camera ? "1" : "0", "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads,
+       "--SiftExtraction.max_image_size", std::to_string(options.max_image_size)}};
   if (options.use_session_intrinsics) {
-    extract.arguments.insert(extract.arguments.end(), {"--ImageReader.camera_model", CameraModelName(session.camera.model),
-                                                       "--ImageReader.camera_params", ParamsList(session.camera.params)});
+    extract.arguments.insert(extract.arguments.end(),
+                             {"--ImageReader.camera_model", CameraModelName(session.camera.model),
+                              "--ImageReader.camera_params", ParamsList(session.camera.params)});
   } else {
     extract.arguments.insert(extract.arguments.end(), {"--ImageReader.camera_model", "OPENCV"});
   }
-  ColmapCommand match{"exhaustive_matcher",
-                      {"--database_path", database, "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads", threads}};
+  ColmapCommand match{
+      "exhaustive_matcher",
+      {"--database_path", database, "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads", threads}};
   ColmapCommand map{"mapper",
                     {"--database_path", database, "--image_path", images, "--image_list_path", list, "--output_path",
                      (fs::path(work_dir) / "sparse").string(), "--Mapper.num_threads", threads}};
   if (options.fix_intrinsics) {
-    map.arguments.insert(map.arguments.end(), {"--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_principal_point",
-                                               "0", "--Mapper.ba_refine_extra_params", "0"});
+    map.arguments.insert(map.arguments.end(),
+                         {"--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_principal_point", "0",
+                          "--Mapper.ba_refine_extra_params", "0"});
   }
   return {extract, match, map};
 }
@@ -168,7 +146,9 @@ ColmapRunResult RunColmap(const Session& session, const std::string& work_dir, c
   if (!options.Check(&why)) ThrowError("COLMAP options", why);
   const std::string executable = FindExecutable(options.binary);
   if (executable.empty()) {
-    ThrowError(options.binary, "the COLMAP executable was not found (install it: apt-get install colmap; or name it with --colmap-binary)");
+    ThrowError(
+        options.binary,
+        "the COLMAP executable was not found (install it: apt-get install colmap; or name it with --colmap-binary)");
   }
   session.CheckPhotos();
   ColmapRunResult result;
@@ -201,7 +181,8 @@ ColmapRunResult RunColmap(const Session& session, const std::string& work_dir, c
     arguments.insert(arguments.end(), command.arguments.begin(), command.arguments.end());
     const int code = RunLogged(executable, arguments, log);
     if (code != 0) {
-      ThrowError(executable + " " + command.step, "failed with exit code " + std::to_string(code) + "; the end of its log:" + Tail(log, 12));
+      ThrowError(executable + " " + command.step,
+                 "failed with exit code " + std::to_string(code) + "; the end of its log:" + Tail(log, 12));
     }
     result.steps.push_back({command.step, step_timer.ElapsedSeconds()});
     char line[120];
@@ -220,9 +201,10 @@ ColmapRunResult RunColmap(const Session& session, const std::string& work_dir, c
     }
   }
   if (best.empty()) {
-    ThrowError(executable + " mapper", "found no model in " + std::to_string(result.photos) +
-                                           " photos (too little texture for SIFT, or too little overlap); the end of its log:" +
-                                           Tail((work / "logs" / "mapper.log").string(), 8));
+    ThrowError(executable + " mapper",
+               "found no model in " + std::to_string(result.photos) +
+                   " photos (too little texture for SIFT, or too little overlap); the end of its log:" +
+                   Tail((work / "logs" / "mapper.log").string(), 8));
   }
   std::ofstream(work / "model.txt") << "sparse/" << best << "\n";
   directory.Commit();

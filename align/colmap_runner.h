@@ -16,14 +16,14 @@
 namespace ibrdf {
 
 struct ColmapRunnerOptions {
-  std::string binary = "colmap";   // the COLMAP executable; without a '/', searched on PATH
-  bool single_camera = true;       // one camera for every photo (one physical camera and lens)
+  std::string binary = "colmap";       // the COLMAP executable; without a '/', searched on PATH
+  bool single_camera = true;           // one camera for every photo (one physical camera and lens)
   bool use_session_intrinsics = true;  // the session's camera (model and parameters) as COLMAP's starting intrinsics
   // Keep them fixed in COLMAP's bundle adjustment: the session's camera is given or calibrated, and
   // COLMAP refining it on a (near-)planar target scene fails to initialize (docs/align-colmap.md).
   bool fix_intrinsics = true;
-  int num_threads = -1;            // COLMAP's threads; -1 = every core
-  int max_image_size = 3200;       // SIFT works on images downscaled to this longer side
+  int num_threads = -1;       // COLMAP's threads; -1 = every core
+  int max_image_size = 3200;  // SIFT works on images downscaled to this longer side
   bool Check(std::string* why) const;
 };
 
@@ -44,11 +44,11 @@ struct ColmapStepTime {
 
 struct ColmapRunResult {
   bool success = false;
-  std::string work_dir;            // the committed work folder
-  std::string model_dir;           // its largest model, work_dir/sparse/N
-  int models = 0;                  // models the mapper wrote
-  int registered_images = 0;       // images of the largest model
-  int photos = 0;                  // photos handed to COLMAP
+  std::string work_dir;       // the committed work folder
+  std::string model_dir;      // its largest model, work_dir/sparse/N
+  int models = 0;             // models the mapper wrote
+  int registered_images = 0;  // images of the largest model
+  int photos = 0;             // photos handed to COLMAP
   std::vector<ColmapStepTime> steps;
   double total_s = 0.0;
   std::string BriefReport() const;

@@ -22,9 +22,10 @@ bool CylinderFitOptions::Check(std::string* why) const {
 std::string CylinderFit::BriefReport() const {
   if (!fitted) return "cylinder as given: " + reason;
   char buffer[320];
-  std::snprintf(buffer, sizeof(buffer),
-                "cylinder centre (%.5f, %.5f, %.5f) m, axis (%.5f, %.5f, %.5f) from %d markers (corner RMS %.3f mm, %d left out)",
-                center.x(), center.y(), center.z(), axis.x(), axis.y(), axis.z(), markers, 1e3 * rms_m, rejected_markers);
+  std::snprintf(
+      buffer, sizeof(buffer),
+      "cylinder centre (%.5f, %.5f, %.5f) m, axis (%.5f, %.5f, %.5f) from %d markers (corner RMS %.3f mm, %d left out)",
+      center.x(), center.y(), center.z(), axis.x(), axis.y(), axis.z(), markers, 1e3 * rms_m, rejected_markers);
   return buffer;
 }
 
@@ -58,12 +59,13 @@ CylinderFit FitCylinderToMarkers(const SampleTargetsSpec& spec, const std::map<i
       }
     }
     const Eigen::Matrix4d start = Eigen::umeyama(in_sample, in_world, false);
-    AngleAxisFromPose(Rigid3d(Eigen::Quaterniond(Eigen::Matrix3d(start.topLeftCorner<3, 3>())), start.topRightCorner<3, 1>()),
-                      pose, pose + 3);
+    AngleAxisFromPose(
+        Rigid3d(Eigen::Quaterniond(Eigen::Matrix3d(start.topLeftCorner<3, 3>())), start.topRightCorner<3, 1>()), pose,
+        pose + 3);
     ceres::Problem problem;
     for (Eigen::Index k = 0; k < in_sample.cols(); ++k) {
-      problem.AddResidualBlock(RigidPointError::Create(in_sample.col(k), in_world.col(k)), new ceres::CauchyLoss(options.cauchy_m),
-                               pose, pose + 3);
+      problem.AddResidualBlock(RigidPointError::Create(in_sample.col(k), in_world.col(k)),
+                               new ceres::CauchyLoss(options.cauchy_m), pose, pose + 3);
     }
     ceres::Solver::Options solver_options;
     solver_options.linear_solver_type = ceres::DENSE_QR;
@@ -81,7 +83,8 @@ CylinderFit FitCylinderToMarkers(const SampleTargetsSpec& spec, const std::map<i
     for (const TargetSpec* target : used) {
       double marker_squared = 0.0;
       for (int c = 0; c < 4; ++c) {
-        marker_squared += (fit.world_from_sample * target->corners[c] - markers.at(target->id).corners[c]).squaredNorm();
+        marker_squared +=
+            (fit.world_from_sample * target->corners[c] - markers.at(target->id).corners[c]).squaredNorm();
       }
       if (std::sqrt(marker_squared / 4.0) <= options.max_marker_rms_m) {
         kept.push_back(target);

@@ -26,13 +26,13 @@ struct CylinderFitOptions {
 
 struct CylinderFit {
   bool fitted = false;
-  std::string reason;                 // why not fitted
+  std::string reason;  // why not fitted
   Rigid3d world_from_sample;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, the given axis' sense
-  int markers = 0;                    // sample markers used
-  int rejected_markers = 0;           // posed but left out (their corners disagree)
-  double rms_m = 0.0;                 // corner distance RMS after the fit, metres
+  int markers = 0;                                  // sample markers used
+  int rejected_markers = 0;                         // posed but left out (their corners disagree)
+  double rms_m = 0.0;                               // corner distance RMS after the fit, metres
   std::string BriefReport() const;
 };
 

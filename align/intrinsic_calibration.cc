@@ -4,12 +4,12 @@
 #include <cmath>
 #include <filesystem>
 
+#include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
-#include <tbb/parallel_for.h>
 
 #include "align/markers.h"
 #include "core/error.h"
@@ -39,7 +39,8 @@ cv::Ptr<cv::aruco::CharucoBoard> MakeBoard(const CharucoBoardSpec& spec, const s
 
 bool IsImageFile(const fs::path& path) {
   std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   for (const char* known : {".png", ".jpg", ".jpeg", ".tif", ".tiff", ".exr", ".bmp", ".pgm", ".ppm"}) {
     if (extension == known) return true;
   }
@@ -59,8 +60,9 @@ ViewCorners FindCorners(const Image& image, const cv::Ptr<cv::aruco::CharucoBoar
   cv::Mat grey(image.height, image.width, CV_32FC1), grey8(image.height, image.width, CV_8UC1);
   for (int y = 0; y < image.height; ++y) {
     for (int x = 0; x < image.width; ++x) {
-      double v = image.channels >= 3 ? 0.2126 * image.at(x, y, 0) + 0.7152 * image.at(x, y, 1) + 0.0722 * image.at(x, y, 2)
-                                     : image.at(x, y, 0);
+      double v = image.channels >= 3
+                     ? 0.2126 * image.at(x, y, 0) + 0.7152 * image.at(x, y, 1) + 0.0722 * image.at(x, y, 2)
+                     : image.at(x, y, 0);
       if (!std::isfinite(v)) v = 0.0;
       v = std::clamp(v, 0.0, 1.0);
       grey.at<float>(y, x) = static_cast<float>(v);
@@ -124,7 +126,8 @@ CharucoBoardSpec CharucoBoardSpec::Load(const std::string& path) {
   RequireFile(path, "ChArUco board description");
   const nlohmann::json json = ReadJsonFile(path);
   JsonObject root(json, path);
-  if (root.String("format") != "ibrdf-charuco-board") ThrowError(root.Where("format"), "expected \"ibrdf-charuco-board\"");
+  if (root.String("format") != "ibrdf-charuco-board")
+    ThrowError(root.Where("format"), "expected \"ibrdf-charuco-board\"");
   if (root.Integer("version") != 1) ThrowError(root.Where("version"), "expected 1");
   CharucoBoardSpec spec;
   spec.dictionary = root.String("dictionary");
@@ -138,7 +141,7 @@ CharucoBoardSpec CharucoBoardSpec::Load(const std::string& path) {
 }
 
 nlohmann::json CharucoBoardSpec::ToJson() const {
-  return {{"format", "ibrdf-charuco-board"}, {"version", 1},        {"dictionary", dictionary},
+  return {{"format", "ibrdf-charuco-board"}, {"version", 1},           {"dictionary", dictionary},
           {"squares_x", squares_x},          {"squares_y", squares_y}, {"square_size", square_size},
           {"marker_size", marker_size}};
 }
@@ -166,7 +169,8 @@ bool IntrinsicCalibrationOptions::Check(std::string* why) const {
   return true;
 }
 
-IntrinsicCalibrationResult CalibrateIntrinsics(const std::string& directory, const IntrinsicCalibrationOptions& options) {
+IntrinsicCalibrationResult CalibrateIntrinsics(const std::string& directory,
+                                               const IntrinsicCalibrationOptions& options) {
   Timer timer;
   std::string why;
   if (!options.Check(&why)) ThrowError("calibration options", why);
@@ -185,8 +189,9 @@ IntrinsicCalibrationResult CalibrateIntrinsics(const std::string& directory, con
   for (const std::string& file : files) {
     const ImageSpec spec_i = ReadImageSpec(file);
     if (spec_i.width != size.width || spec_i.height != size.height) {
-      ThrowError(file, "is " + std::to_string(spec_i.width) + "x" + std::to_string(spec_i.height) + ", the first photo " +
-                           std::to_string(size.width) + "x" + std::to_string(size.height) + ": one camera, one size");
+      ThrowError(file, "is " + std::to_string(spec_i.width) + "x" + std::to_string(spec_i.height) +
+                           ", the first photo " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+                           ": one camera, one size");
     }
   }
 
@@ -231,7 +236,8 @@ IntrinsicCalibrationResult CalibrateIntrinsics(const std::string& directory, con
         if (!view.used) reasons += "\n  " + fs::path(view.file).filename().string() + ": " + view.dropped_reason;
       }
       ThrowError(directory, "only " + std::to_string(corners.size()) + " of " + std::to_string(files.size()) +
-                                " photos show enough of the board (need " + std::to_string(options.min_views) + ")" + reasons);
+                                " photos show enough of the board (need " + std::to_string(options.min_views) + ")" +
+                                reasons);
     }
     std::vector<cv::Mat> rvecs, tvecs;
     cv::Mat std_extrinsics, per_view;
@@ -249,7 +255,8 @@ IntrinsicCalibrationResult CalibrateIntrinsics(const std::string& directory, con
   for (CalibrationView& view : result.views) {
     if (view.used && view.rms_px > options.max_view_rms_px) {
       view.used = false;
-      view.dropped_reason = "reprojection RMS " + std::to_string(view.rms_px) + " px above " + std::to_string(options.max_view_rms_px);
+      view.dropped_reason =
+          "reprojection RMS " + std::to_string(view.rms_px) + " px above " + std::to_string(options.max_view_rms_px);
       dropped = true;
     }
   }
@@ -259,8 +266,9 @@ IntrinsicCalibrationResult CalibrateIntrinsics(const std::string& directory, con
   const double* k = camera_matrix.ptr<double>();
   const double* d = distortion.ptr<double>();
   // OpenCV's pixel centres are at integers, COLMAP's at +0.5.
-  result.camera = Camera::Create(CameraModelId::kOpenCV, size.width, size.height,
-                                 {k[0], k[4], k[2] + 0.5, k[5] + 0.5, d[0], d[1], d[2], d[3]}, directory + ": calibrated camera");
+  result.camera =
+      Camera::Create(CameraModelId::kOpenCV, size.width, size.height,
+                     {k[0], k[4], k[2] + 0.5, k[5] + 0.5, d[0], d[1], d[2], d[3]}, directory + ": calibrated camera");
   for (int p = 0; p < 8; ++p) result.std_dev.push_back(std_intrinsics.at<double>(p));
   result.rms_px = rms;
   for (const CalibrationView& view : result.views) {
@@ -279,14 +287,16 @@ std::string IntrinsicCalibrationResult::BriefReport() const {
   std::snprintf(buffer, sizeof(buffer),
                 "calibration: %d of %zu board photos, %d corners, RMS %.3f px; fx %.2f fy %.2f cx %.2f cy %.2f "
                 "k1 %.5f k2 %.5f p1 %.6f p2 %.6f; %.2f s",
-                views_used, views.size(), corners_used, rms_px, p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], total_s);
+                views_used, views.size(), corners_used, rms_px, p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7],
+                total_s);
   return buffer;
 }
 
 nlohmann::json ToJson(const IntrinsicCalibrationResult& result) {
   nlohmann::json views = nlohmann::json::array();
   for (const CalibrationView& view : result.views) {
-    nlohmann::json entry = {{"file", view.file}, {"markers", view.markers}, {"corners", view.corners}, {"used", view.used}};
+    nlohmann::json entry = {
+        {"file", view.file}, {"markers", view.markers}, {"corners", view.corners}, {"used", view.used}};
     if (view.used) {
       entry["rms_px"] = view.rms_px;
     } else {

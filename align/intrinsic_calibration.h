@@ -49,27 +49,28 @@ struct CharucoBoardSpec {
 std::vector<uint8_t> DrawCharucoBoard(const CharucoBoardSpec& board, int texels_per_square, int* width, int* height);
 
 struct IntrinsicCalibrationOptions {
-  int min_corners_per_view = 12;    // photos with fewer chessboard corners found are left out
-  int min_views = 5;                // fewer usable photos: refused
-  double max_view_rms_px = 1.0;     // photos whose reprojection RMS exceeds this are left out, then recalibrated
-  int corner_window_px = 5;         // largest half-size of the saddle-point refinement window, pixels (smaller where the markers come closer)
+  int min_corners_per_view = 12;  // photos with fewer chessboard corners found are left out
+  int min_views = 5;              // fewer usable photos: refused
+  double max_view_rms_px = 1.0;   // photos whose reprojection RMS exceeds this are left out, then recalibrated
+  int corner_window_px =
+      5;  // largest half-size of the saddle-point refinement window, pixels (smaller where the markers come closer)
   bool Check(std::string* why) const;
 };
 
 struct CalibrationView {
-  std::string file;                 // the photo's path
-  int markers = 0;                  // ArUco markers detected
-  int corners = 0;                  // chessboard corners interpolated and refined
+  std::string file;  // the photo's path
+  int markers = 0;   // ArUco markers detected
+  int corners = 0;   // chessboard corners interpolated and refined
   bool used = false;
-  std::string dropped_reason;       // empty when used
-  double rms_px = 0.0;              // reprojection RMS of its corners in the final calibration
+  std::string dropped_reason;  // empty when used
+  double rms_px = 0.0;         // reprojection RMS of its corners in the final calibration
 };
 
 struct IntrinsicCalibrationResult {
   bool success = false;
-  Camera camera;                    // OPENCV model, COLMAP's pixel convention
-  std::vector<double> std_dev;      // one-sigma uncertainty of fx, fy, cx, cy, k1, k2, p1, p2
-  double rms_px = 0.0;              // reprojection RMS over every corner used
+  Camera camera;                // OPENCV model, COLMAP's pixel convention
+  std::vector<double> std_dev;  // one-sigma uncertainty of fx, fy, cx, cy, k1, k2, p1, p2
+  double rms_px = 0.0;          // reprojection RMS over every corner used
   int views_used = 0;
   int corners_used = 0;
   std::vector<CalibrationView> views;
@@ -80,7 +81,8 @@ struct IntrinsicCalibrationResult {
 // Calibrates from every image in `directory` (sorted by name; board.json describes the board). The
 // image size is every photo's; photos of another size are an Error naming the photo. Too few usable
 // photos or corners is an Error saying how many were found and why the others were left out.
-IntrinsicCalibrationResult CalibrateIntrinsics(const std::string& directory, const IntrinsicCalibrationOptions& options);
+IntrinsicCalibrationResult CalibrateIntrinsics(const std::string& directory,
+                                               const IntrinsicCalibrationOptions& options);
 
 nlohmann::json ToJson(const IntrinsicCalibrationResult& result);
 

@@ -23,17 +23,17 @@ class MarkerDictionary {
   // Throws Error (naming `where`) for an unknown dictionary name.
   explicit MarkerDictionary(const std::string& name, const std::string& where = "targets");
   const std::string& name() const { return name_; }
-  int size() const { return size_; }              // number of marker ids
-  int modules() const { return bits_ + 2; }       // cells across the printed marker, border included
-  int id_for_opencv() const { return id_; }       // OpenCV's PREDEFINED_DICTIONARY_NAME value
+  int size() const { return size_; }         // number of marker ids
+  int modules() const { return bits_ + 2; }  // cells across the printed marker, border included
+  int id_for_opencv() const { return id_; }  // OpenCV's PREDEFINED_DICTIONARY_NAME value
 
   // The printed marker as modules() x modules() cells, row-major, true = white.
   std::vector<bool> Modules(int id) const;
 
  private:
   std::string name_;
-  int id_ = 0;     // OpenCV's PREDEFINED_DICTIONARY_NAME
-  int bits_ = 0;   // inner cells across
+  int id_ = 0;    // OpenCV's PREDEFINED_DICTIONARY_NAME
+  int bits_ = 0;  // inner cells across
   int size_ = 0;
 };
 
@@ -43,8 +43,8 @@ struct MarkerDetection {
 };
 
 struct MarkerDetectionOptions {
-  bool subpixel = true;         // refine corners to sub-pixel accuracy
-  double min_side_px = 12.0;    // detections with a shorter side are dropped
+  bool subpixel = true;       // refine corners to sub-pixel accuracy
+  double min_side_px = 12.0;  // detections with a shorter side are dropped
 };
 
 class Camera;

@@ -95,8 +95,8 @@ bool MeshRegistrationOptions::Check(std::string* why) const {
 }
 
 MeshRegistration RegisterMeshToTargets(const std::vector<ScanTargetSpec>& scan_targets,
-                                       const std::vector<TargetSpec>& reference,
-                                       const MeshRegistrationOptions& options, const std::string& where) {
+                                       const std::vector<TargetSpec>& reference, const MeshRegistrationOptions& options,
+                                       const std::string& where) {
   std::string why;
   if (!options.Check(&why)) ThrowError("mesh registration options", why);
   MeshRegistration result;
@@ -118,8 +118,9 @@ MeshRegistration RegisterMeshToTargets(const std::vector<ScanTargetSpec>& scan_t
     pairs.push_back(pair);
   }
   if (static_cast<int>(pairs.size()) < options.min_markers) {
-    ThrowError(where, "only " + std::to_string(pairs.size()) + " marker(s) shared with targets.reference; registering " +
-                          "the mesh needs at least " + std::to_string(options.min_markers) + " markers the scanner and the layout share");
+    ThrowError(where, "only " + std::to_string(pairs.size()) +
+                          " marker(s) shared with targets.reference; registering " + "the mesh needs at least " +
+                          std::to_string(options.min_markers) + " markers the scanner and the layout share");
   }
   std::vector<size_t> use(pairs.size());
   for (size_t i = 0; i < pairs.size(); ++i) use[i] = i;
@@ -196,13 +197,14 @@ MeshRegistration RegisterMeshToTargets(const std::vector<ScanTargetSpec>& scan_t
 std::string MeshRegistration::BriefReport() const {
   char buffer[256];
   std::snprintf(buffer, sizeof(buffer),
-                "mesh registration: %d of %zu markers, corner RMS %.3f mm (worst marker %.3f mm), scale %.6f", used_markers,
-                markers.size(), rms_m * 1e3, max_marker_rms_m * 1e3, world_from_mesh.scale);
+                "mesh registration: %d of %zu markers, corner RMS %.3f mm (worst marker %.3f mm), scale %.6f",
+                used_markers, markers.size(), rms_m * 1e3, max_marker_rms_m * 1e3, world_from_mesh.scale);
   std::string report = buffer;
   for (const MarkerRegistrationResidual& marker : markers) {
     if (!marker.used) report += "; dropped marker " + std::to_string(marker.id) + " (" + marker.dropped_reason + ")";
   }
-  if (!unmatched_ids.empty()) report += "; " + std::to_string(unmatched_ids.size()) + " scan target(s) not in the layout";
+  if (!unmatched_ids.empty())
+    report += "; " + std::to_string(unmatched_ids.size()) + " scan target(s) not in the layout";
   return report;
 }
 

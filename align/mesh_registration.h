@@ -28,7 +28,7 @@ struct MeshRegistrationOptions {
   // A layout whose marker centres' second principal extent is below this fraction of the first is
   // collinear (degenerate).
   double min_spread_ratio = 0.05;
-  bool estimate_scale = true;       // a similarity (a scanner may work in millimetres); false: rigid
+  bool estimate_scale = true;  // a similarity (a scanner may work in millimetres); false: rigid
   // At most this fraction of the shared markers (at least one) may be dropped as outliers; more
   // means the scan and the layout disagree, which is refused.
   double max_outlier_fraction = 0.25;
@@ -45,10 +45,10 @@ struct MarkerRegistrationResidual {
 };
 
 struct MeshRegistration {
-  bool success = false;           // false until a transform passed every check
+  bool success = false;  // false until a transform passed every check
   Sim3d world_from_mesh;
   std::vector<MarkerRegistrationResidual> markers;  // the shared markers, in scan_targets' order
-  std::vector<int> unmatched_ids;  // scan targets whose id is not in the layout (ignored)
+  std::vector<int> unmatched_ids;                   // scan targets whose id is not in the layout (ignored)
   int used_markers = 0;
   double rms_m = 0.0;             // over the used markers' corners, metres
   double max_marker_rms_m = 0.0;  // the worst used marker
@@ -60,8 +60,8 @@ struct MeshRegistration {
 // "session.json: /sample/scan_targets"). Throws Error for too few shared markers, a collinear layout,
 // or residuals above options.max_marker_rms_m that dropping outliers does not cure.
 MeshRegistration RegisterMeshToTargets(const std::vector<ScanTargetSpec>& scan_targets,
-                                       const std::vector<TargetSpec>& reference,
-                                       const MeshRegistrationOptions& options, const std::string& where);
+                                       const std::vector<TargetSpec>& reference, const MeshRegistrationOptions& options,
+                                       const std::string& where);
 
 nlohmann::json ToJson(const MeshRegistration& registration);
 

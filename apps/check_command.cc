@@ -28,14 +28,19 @@ void AddCheckCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   command->add_option("samples", args->samples, "Sample file (.npy) from `ibrdf derender`")->required();
   command->add_option("--out", args->out, "Report to write (.json)")->required();
-  command->add_option("--theta-bin-deg", args->options.theta_bin_deg, "Bin width in theta_i and theta_e")->capture_default_str();
-  command->add_option("--phi-bin-deg", args->options.phi_bin_deg, "Bin width in delta_phi (divides 360)")->capture_default_str();
-  command->add_option("--min-samples", args->options.min_samples_per_bin, "Samples a bin needs to be compared")->capture_default_str();
-  command->add_option("--max-theta-deg", args->options.max_theta_deg, "Compare bins up to this theta")->capture_default_str();
+  command->add_option("--theta-bin-deg", args->options.theta_bin_deg, "Bin width in theta_i and theta_e")
+      ->capture_default_str();
+  command->add_option("--phi-bin-deg", args->options.phi_bin_deg, "Bin width in delta_phi (divides 360)")
+      ->capture_default_str();
+  command->add_option("--min-samples", args->options.min_samples_per_bin, "Samples a bin needs to be compared")
+      ->capture_default_str();
+  command->add_option("--max-theta-deg", args->options.max_theta_deg, "Compare bins up to this theta")
+      ->capture_default_str();
   command->add_flag("--regression", args->regression,
                     "Also the local-regression checks: reciprocity near the incidence plane, bilateral symmetry\n"
                     "(unfolded fit) and held-out photos (fit without a photo, predict it)");
-  command->add_option("--held-out", args->prediction.held_out_photos, "Photos to hold out with --regression")->capture_default_str();
+  command->add_option("--held-out", args->prediction.held_out_photos, "Photos to hold out with --regression")
+      ->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace an existing report");
   command->callback([args] {
     StageLog stage("check");

@@ -33,7 +33,8 @@ std::string TruthFromSidecar(const std::string& samples_path) {
 }
 
 void PrintTable(const TruthComparison& comparison) {
-  std::printf("%-12s %9s  %-26s  %-26s\n", "theta band", "samples", "median |rel error| R G B %", "p95 |rel error| R G B %");
+  std::printf("%-12s %9s  %-26s  %-26s\n", "theta band", "samples", "median |rel error| R G B %",
+              "p95 |rel error| R G B %");
   auto row = [](const std::string& name, const ErrorStats& s) {
     std::printf("%-12s %9zu  %7.3f %7.3f %7.3f    %7.2f %7.2f %7.2f\n", name.c_str(), s.count, 100 * s.median[0],
                 100 * s.median[1], 100 * s.median[2], 100 * s.p95[0], 100 * s.p95[1], 100 * s.p95[2]);

@@ -25,30 +25,39 @@ void AddDerenderCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   command->add_option("session", args->session, "Session folder or session.json")->required();
   command->add_option("--out", args->out, "Sample file to write (.npy); the sidecar goes to <out>.json")->required();
-  command->add_option("--max-theta-i-deg", args->options.max_theta_i_deg, "Grazing limit for incidence")->capture_default_str();
-  command->add_option("--max-theta-e-deg", args->options.max_theta_e_deg, "Grazing limit for exitance")->capture_default_str();
-  command->add_option("--min-signal", args->options.min_signal, "Signal floor (linear, normalized units)")->capture_default_str();
+  command->add_option("--max-theta-i-deg", args->options.max_theta_i_deg, "Grazing limit for incidence")
+      ->capture_default_str();
+  command->add_option("--max-theta-e-deg", args->options.max_theta_e_deg, "Grazing limit for exitance")
+      ->capture_default_str();
+  command->add_option("--min-signal", args->options.min_signal, "Signal floor (linear, normalized units)")
+      ->capture_default_str();
   command->add_option("--stride", args->options.pixel_stride, "Use every n-th pixel in x and y")->capture_default_str();
-  command->add_option("--visibility", args->visibility,
-                      "Mesh samples: shadow rays auto (where the scan's convexity report asks for them), on or "
-                      "off; overrides the session's sample.visibility")
+  command
+      ->add_option("--visibility", args->visibility,
+                   "Mesh samples: shadow rays auto (where the scan's convexity report asks for them), on or "
+                   "off; overrides the session's sample.visibility")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   command->add_flag("!--no-mixed-pixel-mask", args->options.mask_mixed_pixels,
                     "Mesh samples: keep pixels that straddle the silhouette (corner rays miss or jump in depth)");
-  command->add_option("--mixed-pixel-depth-factor", args->options.mixed_pixel_depth_factor,
-                      "Mesh samples: depth jump across a pixel, in pixel footprints, that marks it mixed")
+  command
+      ->add_option("--mixed-pixel-depth-factor", args->options.mixed_pixel_depth_factor,
+                   "Mesh samples: depth jump across a pixel, in pixel footprints, that marks it mixed")
       ->capture_default_str();
-  command->add_option("--max-normal-fit-rms-m", args->options.max_normal_fit_rms_m,
-                      "Mesh samples: reject hits whose local-plane fit RMS exceeds this (metres; 0: no limit)")
+  command
+      ->add_option("--max-normal-fit-rms-m", args->options.max_normal_fit_rms_m,
+                   "Mesh samples: reject hits whose local-plane fit RMS exceeds this (metres; 0: no limit)")
       ->capture_default_str();
-  command->add_option("--min-fit-neighbours", args->options.min_fit_neighbours,
-                      "Mesh samples: reject hits on faces with a corner fitted from fewer points")
+  command
+      ->add_option("--min-fit-neighbours", args->options.min_fit_neighbours,
+                   "Mesh samples: reject hits on faces with a corner fitted from fewer points")
       ->capture_default_str();
-  command->add_option("--shadow-edge-deg", args->options.shadow_edge_deg,
-                      "Mesh samples, shadow rays on: reject lit pixels within this angle of a shadow edge")
+  command
+      ->add_option("--shadow-edge-deg", args->options.shadow_edge_deg,
+                   "Mesh samples, shadow rays on: reject lit pixels within this angle of a shadow edge")
       ->capture_default_str();
-  command->add_option("--shadow-edge-rays", args->options.shadow_edge_rays,
-                      "Mesh samples, shadow rays on: rays to the disc around the light (0: no shadow-edge test)")
+  command
+      ->add_option("--shadow-edge-rays", args->options.shadow_edge_rays,
+                   "Mesh samples, shadow rays on: rays to the disc around the light (0: no shadow-edge test)")
       ->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace existing output files");
   command->callback([args] {
@@ -67,8 +76,7 @@ void AddDerenderCommand(CLI::App& app) {
     RequireWritableOutput(args->out, args->overwrite, inputs);
     RequireWritableOutput(SidecarPath(args->out), args->overwrite, inputs);
     Log(1, "session " + session.name + ": " + std::to_string(session.photos.size()) + " photos, " +
-               SampleKindName(session.sample.kind) + " sample, response " +
-               session.radiometry.response.Describe());
+               SampleKindName(session.sample.kind) + " sample, response " + session.radiometry.response.Describe());
     const DerenderResult result = Derender(session, args->options);
     WriteSamples(args->out, result.samples);
     WriteJsonFile(SidecarPath(args->out), DerenderSidecar(session, args->options, result.summary));

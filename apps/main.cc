@@ -3,8 +3,8 @@
 #include <iostream>
 #include <memory>
 
-#include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
+#include <CLI/CLI.hpp>
 
 #include "apps/commands.h"
 #include "core/error.h"
@@ -18,8 +18,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "ibrdf 0.1.0");
   int verbosity = 2;
   int threads = 0;
-  app.add_flag_callback("-q,--quiet", [&] { verbosity = 1; }, "Stage lines and summaries only, no progress bars");
-  app.add_flag_callback("--silent", [&] { verbosity = 0; }, "Errors only");
+  app.add_flag_callback(
+      "-q,--quiet", [&] { verbosity = 1; }, "Stage lines and summaries only, no progress bars");
+  app.add_flag_callback(
+      "--silent", [&] { verbosity = 0; }, "Errors only");
   app.add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
 
   for (ibrdf::AddCommandFunction add : ibrdf::RegisteredCommands()) add(app);

@@ -18,8 +18,7 @@ CommandRegistrar::CommandRegistrar(int order, AddCommandFunction add) { Registry
 
 std::vector<AddCommandFunction> RegisteredCommands() {
   std::vector<std::pair<int, AddCommandFunction>> sorted = Registry();
-  std::stable_sort(sorted.begin(), sorted.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<AddCommandFunction> out;
   for (const auto& entry : sorted) out.push_back(entry.second);
   return out;

@@ -16,7 +16,7 @@
 #include "reconstruct/local_regression.h"
 #include "reconstruct/merl_table.h"
 #include "reconstruct/model_fit.h"
-#include "reconstruct/npy_array.h"
+#include "core/npy.h"
 #include "reconstruct/reconstruction_error.h"
 #include "reconstruct/truth_comparison.h"
 
@@ -59,27 +59,43 @@ void AddReconstructCommand(CLI::App& app) {
   command->add_option("samples", args->samples, "Sample file (.npy) from `ibrdf derender`")->required();
   command->add_option("--out", args->out, "Output folder (created; replaced only with --overwrite)")->required();
   command->add_option("--degree", args->regression.degree, "Local polynomial degree: 0, 1 or 2")->capture_default_str();
-  command->add_option("--radius-h-deg", args->regression.radius_h_deg, "Kernel radius along the sheets (theta_h)")->capture_default_str();
-  command->add_option("--radius-d-deg", args->regression.radius_d_deg, "Kernel radius across the sheets (theta_d)")->capture_default_str();
-  command->add_option("--bandwidth", args->bandwidth,
-                      "Kernel radii: 'given' (--radius-h-deg, --radius-d-deg), or selected by 'loo' (leave-one-out)\n"
-                      "or 'gcv' (generalized cross-validation) among the given radii times --bandwidth-scales")
+  command->add_option("--radius-h-deg", args->regression.radius_h_deg, "Kernel radius along the sheets (theta_h)")
       ->capture_default_str();
-  command->add_option("--bandwidth-scales", args->selection.scales, "Factors on both radii tried by --bandwidth loo|gcv")
+  command->add_option("--radius-d-deg", args->regression.radius_d_deg, "Kernel radius across the sheets (theta_d)")
+      ->capture_default_str();
+  command
+      ->add_option("--bandwidth", args->bandwidth,
+                   "Kernel radii: 'given' (--radius-h-deg, --radius-d-deg), or selected by 'loo' (leave-one-out)\n"
+                   "or 'gcv' (generalized cross-validation) among the given radii times --bandwidth-scales")
+      ->capture_default_str();
+  command
+      ->add_option("--bandwidth-scales", args->selection.scales, "Factors on both radii tried by --bandwidth loo|gcv")
       ->delimiter(',')
       ->capture_default_str();
-  command->add_option("--bandwidth-samples", args->selection.samples, "Samples each candidate is scored at")->capture_default_str();
-  command->add_option("--bin-h", args->regression.bin_fraction_h, "Bin edge along the sheets, fraction of --radius-h-deg (0: no binning)")->capture_default_str();
-  command->add_option("--bin-d", args->regression.bin_fraction_d, "Bin edge across the sheets, fraction of --radius-d-deg (0: no binning)")->capture_default_str();
+  command->add_option("--bandwidth-samples", args->selection.samples, "Samples each candidate is scored at")
+      ->capture_default_str();
+  command
+      ->add_option("--bin-h", args->regression.bin_fraction_h,
+                   "Bin edge along the sheets, fraction of --radius-h-deg (0: no binning)")
+      ->capture_default_str();
+  command
+      ->add_option("--bin-d", args->regression.bin_fraction_d,
+                   "Bin edge across the sheets, fraction of --radius-d-deg (0: no binning)")
+      ->capture_default_str();
   command->add_flag("--no-fold", args->no_fold, "Do not assume reciprocity and bilateral symmetry");
   command->add_flag("--linear-values", args->linear_values, "Fit f rather than log f");
-  command->add_option("--max-theta-deg", args->tabulate.max_theta_deg, "Tabulate cells up to this theta_i, theta_e")->capture_default_str();
-  command->add_option("--min-effective-samples", args->tabulate.min_effective_samples, "Cells with fewer are written as unmeasured (-1)")->capture_default_str();
+  command->add_option("--max-theta-deg", args->tabulate.max_theta_deg, "Tabulate cells up to this theta_i, theta_e")
+      ->capture_default_str();
+  command
+      ->add_option("--min-effective-samples", args->tabulate.min_effective_samples,
+                   "Cells with fewer are written as unmeasured (-1)")
+      ->capture_default_str();
   command->add_option("--lobes", args->fit.lafortune_lobes, "Lafortune lobes (1 to 3)")->capture_default_str();
   command->add_option("--fit-samples", args->fit.max_samples, "Samples used by the model fits")->capture_default_str();
   command->add_flag("--no-fits", args->no_fits, "Skip the Lafortune and GGX fits");
   command->add_option("--truth", args->truth, "truth.json (or a material file) to score the reconstruction against");
-  command->add_option("--eval", args->eval, "Also evaluate at these points: .npy float64 (N, 3) theta_i, theta_e, delta_phi (radians)");
+  command->add_option("--eval", args->eval,
+                      "Also evaluate at these points: .npy float64 (N, 3) theta_i, theta_e, delta_phi (radians)");
   command->add_flag("--eval-only", args->eval_only, "With --eval: skip the MERL table and the fits (for benchmarks)");
   command->add_flag("--overwrite", args->overwrite, "Replace an existing output folder");
   command->callback([args] {
@@ -115,7 +131,9 @@ void AddReconstructCommand(CLI::App& app) {
     Timer total;
     const std::vector<BrdfSample> samples = ReadSamples(args->samples);
     if (samples.empty()) ThrowError(args->samples, "holds no samples");
-    nlohmann::json summary = {{"format", "ibrdf-reconstruction"}, {"version", 1}, {"samples_file", args->samples},
+    nlohmann::json summary = {{"format", "ibrdf-reconstruction"},
+                              {"version", 1},
+                              {"samples_file", args->samples},
                               {"samples", samples.size()}};
     AtomicDirectory dir(args->out, args->overwrite);
     const std::string tmp = dir.temporary_path();
@@ -178,8 +196,8 @@ void AddReconstructCommand(CLI::App& app) {
       std::vector<uint8_t> measured_domain;
       const MerlTable table = TabulateMerl(regression, args->tabulate, &tabulated, &ess, &measured_domain);
       timings["tabulate_s"] = tabulated.seconds;
-      Log(1, "regression: " + std::to_string(regression.size()) + " samples in " +
-                 std::to_string(regression.points()) + " points, " + tabulated.reliability.Brief());
+      Log(1, "regression: " + std::to_string(regression.size()) + " samples in " + std::to_string(regression.points()) +
+                 " points, " + tabulated.reliability.Brief());
       Log(1, tabulated.BriefReport());
       timer.Restart();
       WriteMerl(tmp + "/brdf.binary", table);
@@ -215,8 +233,12 @@ void AddReconstructCommand(CLI::App& app) {
       WriteText(tmp + "/ggx.pbrt", PbrtV4Material(*ggx.brdf, "ggx_fit"));
       WriteText(tmp + "/ggx.xml", Mitsuba3Material(*ggx.brdf, "ggx_fit"));
       timings["fits_s"] = timer.ElapsedSeconds();
-      summary["fits"] = {{"lafortune", {{"rel_rms_vs_samples", lafortune.rel_rms}, {"samples", lafortune.samples_used}, {"seconds", lafortune.seconds}}},
-                         {"ggx", {{"rel_rms_vs_samples", ggx.rel_rms}, {"samples", ggx.samples_used}, {"seconds", ggx.seconds}}}};
+      summary["fits"] = {
+          {"lafortune",
+           {{"rel_rms_vs_samples", lafortune.rel_rms},
+            {"samples", lafortune.samples_used},
+            {"seconds", lafortune.seconds}}},
+          {"ggx", {{"rel_rms_vs_samples", ggx.rel_rms}, {"samples", ggx.samples_used}, {"seconds", ggx.seconds}}}};
     }
     timings["total_s"] = total.ElapsedSeconds();
     summary["timings_s"] = timings;

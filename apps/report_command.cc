@@ -13,11 +13,13 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
-#include "apps/run_child.h"
+#include "core/statistics.h"
+#include "core/subprocess.h"
 #include "core/brdf_model.h"
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/linear_image.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
 #include "core/radiometry.h"
@@ -42,8 +44,8 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
 struct ReportOptions {
-  int photo = -1;          // the measured photo shown beside the renders (-1: the median phase angle)
-  int render_size = 256;   // pixels, square renders of a sphere
+  int photo = -1;         // the measured photo shown beside the renders (-1: the median phase angle)
+  int render_size = 256;  // pixels, square renders of a sphere
   bool Check(std::string* why) const {
     if (render_size < 16 || render_size > 4096) {
       *why = "--render-size must be in [16, 4096]";
@@ -59,13 +61,6 @@ struct PhotoStats {
   int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
   std::vector<float> phase;
 };
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  const size_t k = std::min(values.size() - 1, size_t(q * double(values.size())));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
-}
 
 // Linear RGB (NaN marks "no value") to an 8-bit-ready sRGB image, scaled so that the 99th percentile
 // of the luminance lands at 0.8; NaN pixels are drawn magenta.
@@ -85,8 +80,8 @@ Image ToneMap(const Image& linear, double* scale_out) {
     for (int x = 0; x < linear.width; ++x) {
       for (int c = 0; c < 3; ++c) {
         const double v = linear.at(x, y, c);
-        out.at(x, y, c) = std::isfinite(v) ? float(LinearToSrgb(std::clamp(v * scale, 0.0, 1.0)))
-                                           : (c == 1 ? 0.0f : 1.0f);
+        out.at(x, y, c) =
+            std::isfinite(v) ? float(LinearToSrgb(std::clamp(v * scale, 0.0, 1.0))) : (c == 1 ? 0.0f : 1.0f);
       }
     }
   }
@@ -129,19 +124,26 @@ void AddReportCommand(CLI::App& app) {
     bool overwrite = false;
   };
   auto args = std::make_shared<Args>();
-  command->add_option("run_dir", args->run_dir, "Run folder of `ibrdf run` (samples.npy, consistency.json, reconstruction/ ...)")->required();
+  command
+      ->add_option("run_dir", args->run_dir,
+                   "Run folder of `ibrdf run` (samples.npy, consistency.json, reconstruction/ ...)")
+      ->required();
   command->add_option("--out", args->out, "Report folder to write (default: RUN_DIR/report)");
-  command->add_option("--photo", args->options.photo, "Photo index shown beside the render (default: median phase angle)");
-  command->add_option("--render-size", args->options.render_size, "Rendered sphere size, pixels")->capture_default_str();
+  command->add_option("--photo", args->options.photo,
+                      "Photo index shown beside the render (default: median phase angle)");
+  command->add_option("--render-size", args->options.render_size, "Rendered sphere size, pixels")
+      ->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace an existing report folder");
   command->callback([args] {
     StageLog stage("report");
     std::string why;
     if (!args->options.Check(&why)) ThrowError("ibrdf report", why);
     const fs::path run_dir(args->run_dir);
-    if (!fs::is_directory(run_dir)) ThrowError(args->run_dir, "is not a folder (expected the output folder of `ibrdf run`)");
+    if (!fs::is_directory(run_dir))
+      ThrowError(args->run_dir, "is not a folder (expected the output folder of `ibrdf run`)");
     const std::string samples_path = (run_dir / "samples.npy").string();
-    if (!fs::is_regular_file(samples_path)) ThrowError(samples_path, "does not exist: not the folder of a completed `ibrdf run` (it has no samples)");
+    if (!fs::is_regular_file(samples_path))
+      ThrowError(samples_path, "does not exist: not the folder of a completed `ibrdf run` (it has no samples)");
     const std::string out = args->out.empty() ? (run_dir / "report").string() : args->out;
     const char* script_env = std::getenv("IBRDF_REPORT_SCRIPT");
     const std::string script = script_env ? script_env : IBRDF_REPORT_SCRIPT;
@@ -175,7 +177,8 @@ void AddReportCommand(CLI::App& app) {
     if (args->options.photo >= 0) {
       const auto found = std::find_if(by_phase.begin(), by_phase.end(),
                                       [&](const auto& e) { return e.second == uint32_t(args->options.photo); });
-      if (found == by_phase.end()) ThrowError("--photo", "photo " + std::to_string(args->options.photo) + " has no samples");
+      if (found == by_phase.end())
+        ThrowError("--photo", "photo " + std::to_string(args->options.photo) + " has no samples");
       chosen = found->second;
       phase = found->first;
     }
@@ -205,26 +208,25 @@ void AddReportCommand(CLI::App& app) {
       const nlohmann::json side = ReadJsonFile(sidecar.string());
       try {
         const Session session = Session::Load(side.at("session").get<std::string>());
-        if (chosen >= session.photos.size()) ThrowError(session.manifest_path, "has fewer photos than the samples name");
+        if (chosen >= session.photos.size())
+          ThrowError(session.manifest_path, "has fewer photos than the samples name");
         const PhotoStats& p = photos[chosen];
         const int pad = std::max(4, (p.x1 - p.x0) / 8);
-        const Image photo = ReadImage(session.PhotoPath(chosen));
+        Image photo = ReadImage(session.PhotoPath(chosen));
+        LinearizeImage(session, chosen, &photo, /*divide_by_exposure=*/true);
         const int x0 = std::max(0, p.x0 - pad), y0 = std::max(0, p.y0 - pad);
         const int x1 = std::min(photo.width - 1, p.x1 + pad), y1 = std::min(photo.height - 1, p.y1 + pad);
         Image crop(x1 - x0 + 1, y1 - y0 + 1, 3);
-        const PhotoSpec& spec = session.photos[chosen];
         for (int y = y0; y <= y1; ++y) {
           for (int x = x0; x <= x1; ++x) {
             for (int c = 0; c < 3; ++c) {
-              const double v = photo.at(x, y, std::min(c, photo.channels - 1));
-              crop.at(x - x0, y - y0, c) = float((session.radiometry.response.ToLinear(v) - session.radiometry.black_level) /
-                                                 (spec.exposure_s * spec.gain));
+              crop.at(x - x0, y - y0, c) = photo.at(x, y, std::min(c, photo.channels - 1));
             }
           }
         }
         WriteImage((tmp / "photo.png").string(), ToneMap(crop, nullptr), PixelFormat::kUint8);
-        data["photo"] = {{"file", "photo.png"}, {"source", session.PhotoPath(chosen)}, {"index", chosen},
-                         {"crop", {x0, y0, x1, y1}}, {"phase_deg", phase / kDeg}, {"samples", p.count}};
+        data["photo"] = {{"file", "photo.png"},      {"source", session.PhotoPath(chosen)}, {"index", chosen},
+                         {"crop", {x0, y0, x1, y1}}, {"phase_deg", phase / kDeg},           {"samples", p.count}};
       } catch (const Error& e) {
         photo_note = e.what();
         Log(1, "report: no photo: " + photo_note);
@@ -235,16 +237,14 @@ void AddReportCommand(CLI::App& app) {
     // Spheres of the reconstructed (and the true) material, lit at the chosen photo's phase angle.
     const int size = args->options.render_size;
     if (table) {
-      const Image render = RenderSphere(size, phase, [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) {
-        return table->Lookup(wi, wo);
-      });
+      const Image render = RenderSphere(
+          size, phase, [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) { return table->Lookup(wi, wo); });
       WriteImage((tmp / "render.png").string(), ToneMap(render, nullptr), PixelFormat::kUint8);
       data["render"] = {{"file", "render.png"}, {"phase_deg", phase / kDeg}};
     }
     if (truth) {
-      const Image render = RenderSphere(size, phase, [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) {
-        return truth->Eval(wi, wo);
-      });
+      const Image render = RenderSphere(
+          size, phase, [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) { return truth->Eval(wi, wo); });
       WriteImage((tmp / "render-truth.png").string(), ToneMap(render, nullptr), PixelFormat::kUint8);
       data["render_truth"] = {{"file", "render-truth.png"}, {"phase_deg", phase / kDeg}};
       data["truth"] = truth_path;
@@ -254,7 +254,8 @@ void AddReportCommand(CLI::App& app) {
     // (positive on the light's side, delta_phi = 0; negative on the mirror side, delta_phi = pi).
     nlohmann::json curves = nlohmann::json::array();
     for (const double theta0 : {15.0, 30.0, 45.0, 60.0}) {
-      nlohmann::json angles = nlohmann::json::array(), recon = nlohmann::json::array(), true_values = nlohmann::json::array();
+      nlohmann::json angles = nlohmann::json::array(), recon = nlohmann::json::array(),
+                     true_values = nlohmann::json::array();
       for (double x = -88.0; x <= 88.0; x += 0.5) {
         const Eigen::Vector3d wi(std::sin(theta0 * kDeg), 0.0, std::cos(theta0 * kDeg));
         const Eigen::Vector3d wo(std::sin(x * kDeg), 0.0, std::cos(x * kDeg));
@@ -268,12 +269,13 @@ void AddReportCommand(CLI::App& app) {
           true_values.push_back({f[0], f[1], f[2]});
         }
       }
-      curves.push_back({{"theta0_deg", theta0}, {"angle_deg", angles}, {"reconstruction", recon}, {"truth", true_values}});
+      curves.push_back(
+          {{"theta0_deg", theta0}, {"angle_deg", angles}, {"reconstruction", recon}, {"truth", true_values}});
     }
     data["incidence_plane"] = curves;
     WriteJsonFile((tmp / "report-data.json").string(), data);
 
-    const int code = RunChildProcess({IBRDF_PYTHON, script, fs::absolute(run_dir).string(), tmp.string()});
+    const int code = RunSubprocess({IBRDF_PYTHON, script, fs::absolute(run_dir).string(), tmp.string()});
     if (code != 0) {
       ThrowError(script, "the plotting script failed (exit " + std::to_string(code) +
                              "); its message is above (it needs Debian's python3-numpy and python3-matplotlib)");

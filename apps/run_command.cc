@@ -17,11 +17,11 @@
 
 #include <Eigen/Geometry>
 
-#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
+#include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
-#include "apps/run_child.h"
+#include "core/subprocess.h"
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/json_reader.h"
@@ -58,10 +58,11 @@ struct RunOptions {
       *why = "kernel radii must be positive";
       return false;
     }
-    static const std::vector<std::string> kStages = {"synth", "scan", "align", "derender", "check",
-                                                      "compare", "reconstruct", "report"};
+    static const std::vector<std::string> kStages = {"synth", "scan",    "align",       "derender",
+                                                     "check", "compare", "reconstruct", "report"};
     if (!stop_after.empty() && std::find(kStages.begin(), kStages.end(), stop_after) == kStages.end()) {
-      *why = "--stop-after: unknown stage \"" + stop_after + "\" (synth, scan, align, derender, check, compare, reconstruct, report)";
+      *why = "--stop-after: unknown stage \"" + stop_after +
+             "\" (synth, scan, align, derender, check, compare, reconstruct, report)";
       return false;
     }
     return true;
@@ -322,8 +323,8 @@ void PrintHeadline(const nlohmann::json& summary) {
       if (it.value().get<uint64_t>() == 0) continue;
       rejected += (rejected.empty() ? "" : ", ") + it.key() + " " + std::to_string(it.value().get<uint64_t>());
     }
-    Log(1, "samples: " + std::to_string(summary["samples"]["accepted"].get<uint64_t>()) + " accepted; rejected: " +
-               (rejected.empty() ? "none" : rejected));
+    Log(1, "samples: " + std::to_string(summary["samples"]["accepted"].get<uint64_t>()) +
+               " accepted; rejected: " + (rejected.empty() ? "none" : rejected));
   }
   if (summary.contains("consistency")) {
     const nlohmann::json& c = summary["consistency"];
@@ -357,19 +358,23 @@ void AddRunCommand(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   RunOptions& o = args->options;
-  command->add_option("session", args->input,
-                      "Session folder or session.json; or a recipe folder (samples/<name>, with recipe.json)")
+  command
+      ->add_option("session", args->input,
+                   "Session folder or session.json; or a recipe folder (samples/<name>, with recipe.json)")
       ->required();
   command->add_option("--out", args->out, "Run folder (created; an existing one is resumed)")->required();
   command->add_option("--stride", o.pixel_stride, "derender: every n-th pixel in x and y")->capture_default_str();
   command->add_option("--degree", o.degree, "reconstruct: local polynomial degree (default: reconstruct's)");
-  command->add_option("--radius-h-deg", o.radius_h_deg, "reconstruct: kernel radius along the sheets (default: reconstruct's)");
-  command->add_option("--radius-d-deg", o.radius_d_deg, "reconstruct: kernel radius across the sheets (default: reconstruct's)");
+  command->add_option("--radius-h-deg", o.radius_h_deg,
+                      "reconstruct: kernel radius along the sheets (default: reconstruct's)");
+  command->add_option("--radius-d-deg", o.radius_d_deg,
+                      "reconstruct: kernel radius across the sheets (default: reconstruct's)");
   command->add_flag("!--no-fits", o.fits, "reconstruct: skip the Lafortune and GGX fits");
   command->add_flag("--check-regression", o.check_regression, "check: also the regression checks (held-out photos)");
   command->add_flag("!--no-report", o.report, "Skip the HTML report");
   command->add_flag("--force", o.force, "Re-run every stage, up to date or not");
-  command->add_option("--stop-after", o.stop_after, "Stop after this stage (synth, scan, align, derender, check, compare,\n"
+  command->add_option("--stop-after", o.stop_after,
+                      "Stop after this stage (synth, scan, align, derender, check, compare,\n"
                       "reconstruct, report); later stages are left as they are");
   command->callback([args] {
     Timer wall;
@@ -380,7 +385,8 @@ void AddRunCommand(CLI::App& app) {
 
     // The input: a recipe folder, or a session (validated here, so a bad one is one clear line).
     std::string input = args->input;
-    if (!fs::exists(input)) ThrowError(input, "does not exist (expected a session folder, session.json or a recipe folder)");
+    if (!fs::exists(input))
+      ThrowError(input, "does not exist (expected a session folder, session.json or a recipe folder)");
     std::optional<Recipe> recipe;
     std::string manifest_path;
     if (fs::is_directory(input) && fs::exists(fs::path(input) / "recipe.json")) {
@@ -429,7 +435,8 @@ void AddRunCommand(CLI::App& app) {
       const int number = int(stages.size());
       if (!stage.not_applicable.empty()) {
         outcome = {"not_applicable", stage.not_applicable, 0.0};
-        Log(1, "== run " + std::to_string(number) + ": " + stage.name + ": not applicable (" + stage.not_applicable + ")");
+        Log(1,
+            "== run " + std::to_string(number) + ": " + stage.name + ": not applicable (" + stage.not_applicable + ")");
         return;
       }
       const std::string stale = options.force ? "--force" : WhyStale(run_dir, stage, version);
@@ -446,7 +453,7 @@ void AddRunCommand(CLI::App& app) {
       std::vector<std::string> argv = child_prefix;
       argv.insert(argv.end(), stage.args.begin(), stage.args.end());
       Timer timer;
-      const int code = RunChildProcess(argv, stage.name);
+      const int code = RunSubprocess(argv, {"", {}, stage.name});
       if (code != 0) {
         ThrowError("ibrdf run", "stage " + stage.name + " failed (exit " + std::to_string(code) +
                                     (code > 128 ? ", killed by signal " + std::to_string(code - 128) : "") +
@@ -454,20 +461,20 @@ void AddRunCommand(CLI::App& app) {
       }
       if (after) after();
       outcome = {"ran", stale, timer.ElapsedSeconds()};
-      const nlohmann::json stamp = {{"version", version},
-                                    {"stage", stage.name},
-                                    {"args", stage.args},
-                                    {"inputs", InputFingerprints(stage)},
-                                    {"outputs", stage.outputs},
-                                    {"seconds", outcome.seconds}};
+      const nlohmann::json stamp = {{"version", version},       {"stage", stage.name},
+                                    {"args", stage.args},       {"inputs", InputFingerprints(stage)},
+                                    {"outputs", stage.outputs}, {"seconds", outcome.seconds}};
       WriteJsonFile(StampPath(run_dir, stage.name), stamp);
       Log(1, "-- run: " + stage.name + ": " + FormatSeconds(outcome.seconds));
     };
 
     // synth (recipes only).
     if (recipe) {
-      Stage synth{"synth", {"synth", "--material", recipe->material}, {recipe->path, recipe->material},
-                  {at("synth/session.json"), at("synth/truth.json")}, ""};
+      Stage synth{"synth",
+                  {"synth", "--material", recipe->material},
+                  {recipe->path, recipe->material},
+                  {at("synth/session.json"), at("synth/truth.json")},
+                  ""};
       synth.args.insert(synth.args.end(), recipe->synth_args.begin(), recipe->synth_args.end());
       for (const char* tail : {"--out", "", "--overwrite"}) synth.args.push_back(tail);
       synth.args[synth.args.size() - 2] = at("synth");
@@ -482,7 +489,8 @@ void AddRunCommand(CLI::App& app) {
 
     // scan: a mesh sample with raw scans merges them into the run folder's mesh.
     {
-      Stage scan{"scan", {}, {manifest_path}, {at("scan/mesh.ply"), at("scan/mesh.ply.json"), at("scan/session.json")}, ""};
+      Stage scan{
+          "scan", {}, {manifest_path}, {at("scan/mesh.ply"), at("scan/mesh.ply.json"), at("scan/session.json")}, ""};
       const nlohmann::json* sample = original.contains("sample") ? &original["sample"] : nullptr;
       if (!sample || sample->value("kind", "") != "mesh") {
         scan.not_applicable = "the sample is analytic, not a scanned mesh";
@@ -508,8 +516,8 @@ void AddRunCommand(CLI::App& app) {
           }
           // The Stanford .conf quaternion rotates the common frame into the scan's (scan/scan_io.cc).
           const Eigen::Quaterniond c = q.conjugate();
-          conf << "bmesh " << fs::path(path).filename().string() << ' ' << t.x() << ' ' << t.y() << ' ' << t.z()
-               << ' ' << c.x() << ' ' << c.y() << ' ' << c.z() << ' ' << c.w() << '\n';
+          conf << "bmesh " << fs::path(path).filename().string() << ' ' << t.x() << ' ' << t.y() << ' ' << t.z() << ' '
+               << c.x() << ' ' << c.y() << ' ' << c.z() << ' ' << c.w() << '\n';
         }
         if (any_transform) {
           fs::create_directories(dir / "scan");
@@ -535,8 +543,11 @@ void AddRunCommand(CLI::App& app) {
     // align: sessions with coded targets; otherwise every photo needs its pose.
     {
       const nlohmann::json manifest = manifest_of(current);
-      Stage align{"align", {"align", current, "--out", at("align"), "--overwrite"}, {current},
-                  {at("align/session.json"), at("align/alignment.json")}, ""};
+      Stage align{"align",
+                  {"align", current, "--out", at("align"), "--overwrite"},
+                  {current},
+                  {at("align/session.json"), at("align/alignment.json")},
+                  ""};
       for (const std::string& photo : PhotoFiles(manifest, current)) align.inputs.push_back(photo);
       if (!manifest.contains("targets")) {
         align.not_applicable = "the session has no targets; its photos' poses are used as given";
@@ -564,15 +575,19 @@ void AddRunCommand(CLI::App& app) {
         derender.args.push_back(std::to_string(options.pixel_stride));
       }
       for (const std::string& photo : PhotoFiles(manifest, current)) derender.inputs.push_back(photo);
-      if (manifest.contains("sample") && manifest["sample"].contains("file") && manifest["sample"]["file"].is_string()) {
+      if (manifest.contains("sample") && manifest["sample"].contains("file") &&
+          manifest["sample"]["file"].is_string()) {
         derender.inputs.push_back(ResolvePath(fs::path(current).parent_path().string(), manifest["sample"]["file"]));
       }
       execute(derender);
     }
     const std::vector<std::string> samples_in = {at("samples.npy"), at("samples.npy.json")};
 
-    Stage check{"check", {"check", at("samples.npy"), "--out", at("consistency.json"), "--overwrite"}, samples_in,
-                {at("consistency.json")}, ""};
+    Stage check{"check",
+                {"check", at("samples.npy"), "--out", at("consistency.json"), "--overwrite"},
+                samples_in,
+                {at("consistency.json")},
+                ""};
     if (options.check_regression) check.args.push_back("--regression");
     execute(check);
 
@@ -580,7 +595,8 @@ void AddRunCommand(CLI::App& app) {
     if (truth_path.empty()) {
       compare.not_applicable = "no truth.json beside the session (not synthetic)";
     } else {
-      compare.args = {"compare", at("samples.npy"), "--truth", truth_path, "--out", at("truth-comparison.json"), "--overwrite"};
+      compare.args = {"compare", at("samples.npy"),           "--truth",    truth_path,
+                      "--out",   at("truth-comparison.json"), "--overwrite"};
       compare.inputs.push_back(truth_path);
     }
     execute(compare);
@@ -608,12 +624,13 @@ void AddRunCommand(CLI::App& app) {
     if (!options.fits) reconstruct.args.push_back("--no-fits");
     execute(reconstruct);
 
-    Stage report{"report", {"report", run_dir, "--out", at("report"), "--overwrite"}, {}, {at("report/index.html")}, ""};
+    Stage report{
+        "report", {"report", run_dir, "--out", at("report"), "--overwrite"}, {}, {at("report/index.html")}, ""};
     if (!options.report) {
       report.not_applicable = "--no-report";
     } else {
-      report.inputs = {at("samples.npy"), at("samples.npy.json"), at("consistency.json"), at("reconstruction/summary.json"),
-                       at("reconstruction/brdf.binary")};
+      report.inputs = {at("samples.npy"), at("samples.npy.json"), at("consistency.json"),
+                       at("reconstruction/summary.json"), at("reconstruction/brdf.binary")};
       if (!truth_path.empty()) report.inputs.push_back(at("truth-comparison.json"));
       for (const Stage& stage : stages) {
         if (outcomes[stage.name].status != "not_applicable") report.inputs.push_back(StampPath(run_dir, stage.name));
@@ -621,12 +638,12 @@ void AddRunCommand(CLI::App& app) {
     }
     execute(report);
 
-    const nlohmann::json summary = BuildSummary(run_dir, Absolute(args->input), stages, outcomes, truth_path,
-                                                wall.ElapsedSeconds());
+    const nlohmann::json summary =
+        BuildSummary(run_dir, Absolute(args->input), stages, outcomes, truth_path, wall.ElapsedSeconds());
     WriteJsonFile(at("summary.json"), summary);
     PrintHeadline(summary);
-    Log(1, "-- run: " + FormatSeconds(wall.ElapsedSeconds()) + " (stages as recorded: " +
-               FormatSeconds(summary["timings_s"]["stages_total"].get<double>()) + ")");
+    Log(1, "-- run: " + FormatSeconds(wall.ElapsedSeconds()) +
+               " (stages as recorded: " + FormatSeconds(summary["timings_s"]["stages_total"].get<double>()) + ")");
     Log(1, "summary: " + at("summary.json"));
     if (summary.contains("report")) Log(1, "report: " + summary["report"].get<std::string>());
   });

@@ -24,28 +24,47 @@ void AddScanCommand(CLI::App& app) {
     bool overwrite = false;
   };
   auto args = std::make_shared<Args>();
-  command->add_option("inputs", args->inputs, "Scan files (with --conf: each must be listed there; none: all it lists)");
+  command->add_option("inputs", args->inputs,
+                      "Scan files (with --conf: each must be listed there; none: all it lists)");
   command->add_option("--out", args->out, "Mesh to write (.ply); the sidecar goes to <out>.json")->required();
   command->add_option("--conf", args->conf, "Stanford .conf file: per-scan transforms into one frame");
-  command->add_option("--max-edge-factor", args->options.grid.max_edge_factor,
-                      "Range grids: drop triangles with an edge longer than this times the grid spacing")->capture_default_str();
-  command->add_option("--max-edge-m", args->options.grid.max_edge_m,
-                      "Range grids: absolute edge limit in metres (0: use the factor)")->capture_default_str();
+  command
+      ->add_option("--max-edge-factor", args->options.grid.max_edge_factor,
+                   "Range grids: drop triangles with an edge longer than this times the grid spacing")
+      ->capture_default_str();
+  command
+      ->add_option("--max-edge-m", args->options.grid.max_edge_m,
+                   "Range grids: absolute edge limit in metres (0: use the factor)")
+      ->capture_default_str();
   command->add_flag("--no-outliers", args->no_outliers, "Skip the statistical outlier removal");
-  command->add_option("--outlier-neighbours", args->options.clean.outlier_neighbours,
-                      "Outlier removal: neighbours per point")->capture_default_str();
-  command->add_option("--outlier-stddev", args->options.clean.outlier_stddev,
-                      "Outlier removal: standard deviations above the mean distance")->capture_default_str();
-  command->add_option("--min-piece-fraction", args->options.clean.min_piece_fraction,
-                      "Remove connected pieces with fewer than this fraction of the faces")->capture_default_str();
-  command->add_option("--radius-m", args->options.normals.radius_m,
-                      "Local-plane radius in metres (0: --radius-factor times the point spacing)")->capture_default_str();
-  command->add_option("--radius-factor", args->options.normals.radius_spacing_factor,
-                      "Local-plane radius as a multiple of the median point spacing")->capture_default_str();
-  command->add_option("--hull-tolerance-m", args->options.convexity.tolerance_m,
-                      "Convexity: distance to the hull counted as on it (0: a fraction of the size)")->capture_default_str();
-  command->add_option("--min-convex-fraction", args->options.convexity.min_convex_fraction,
-                      "Convexity: surface fraction within the tolerance for a convex sample")->capture_default_str();
+  command
+      ->add_option("--outlier-neighbours", args->options.clean.outlier_neighbours,
+                   "Outlier removal: neighbours per point")
+      ->capture_default_str();
+  command
+      ->add_option("--outlier-stddev", args->options.clean.outlier_stddev,
+                   "Outlier removal: standard deviations above the mean distance")
+      ->capture_default_str();
+  command
+      ->add_option("--min-piece-fraction", args->options.clean.min_piece_fraction,
+                   "Remove connected pieces with fewer than this fraction of the faces")
+      ->capture_default_str();
+  command
+      ->add_option("--radius-m", args->options.normals.radius_m,
+                   "Local-plane radius in metres (0: --radius-factor times the point spacing)")
+      ->capture_default_str();
+  command
+      ->add_option("--radius-factor", args->options.normals.radius_spacing_factor,
+                   "Local-plane radius as a multiple of the median point spacing")
+      ->capture_default_str();
+  command
+      ->add_option("--hull-tolerance-m", args->options.convexity.tolerance_m,
+                   "Convexity: distance to the hull counted as on it (0: a fraction of the size)")
+      ->capture_default_str();
+  command
+      ->add_option("--min-convex-fraction", args->options.convexity.min_convex_fraction,
+                   "Convexity: surface fraction within the tolerance for a convex sample")
+      ->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace existing output files");
   command->callback([args] {
     StageLog stage("scan");

@@ -175,7 +175,8 @@ void BM_PixelRays(benchmark::State& state) {
           directions[x] = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
         }
         if (mode == 0) {
-          for (int x = 0; x < width; ++x) found[x] = sphere->Intersect(world_from_camera.translation, directions[x], &hits[x]);
+          for (int x = 0; x < width; ++x)
+            found[x] = sphere->Intersect(world_from_camera.translation, directions[x], &hits[x]);
         } else {
           mesh.IntersectBatch(world_from_camera.translation, directions.data(), width, hits.data(), found.get());
         }
@@ -184,8 +185,8 @@ void BM_PixelRays(benchmark::State& state) {
     }
     benchmark::DoNotOptimize(hit_count);
   }
-  state.counters["rays/s"] = benchmark::Counter(double(width) * height * session.photos.size(),
-                                                benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["rays/s"] =
+      benchmark::Counter(double(width) * height * session.photos.size(), benchmark::Counter::kIsIterationInvariantRate);
   state.counters["hits"] = double(hit_count);
 }
 
@@ -194,7 +195,12 @@ BENCHMARK(BM_DecodePhotos)->Args({0, 1})->Args({0, 2})->Args({1, 2})->Unit(bench
 BENCHMARK(BM_DerenderSession)->Args({0, 1})->Args({0, 2})->Args({1, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DerenderDecodedPhotos)->Unit(benchmark::kMillisecond)->UseRealTime();
 // Args: {shadow rays (0 off, 1 on), threads}.
-BENCHMARK(BM_DerenderMeshSession)->Args({0, 1})->Args({0, 2})->Args({1, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DerenderMeshSession)
+    ->Args({0, 1})
+    ->Args({0, 2})
+    ->Args({1, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_PixelRays)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

@@ -81,10 +81,14 @@ void BM_RadianceImages(benchmark::State& state) {
       benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_RadianceImages)
-    ->Args({kLinear, 1})->Args({kLinear, 2})
-    ->Args({kSrgbFlat, 1})->Args({kSrgbFlat, 2})
-    ->Args({kBracket, 1})->Args({kBracket, 2})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Args({kLinear, 1})
+    ->Args({kLinear, 2})
+    ->Args({kSrgbFlat, 1})
+    ->Args({kSrgbFlat, 2})
+    ->Args({kBracket, 1})
+    ->Args({kBracket, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // The white reference step of the sRGB session (one photo).
 void BM_LightCalibration(benchmark::State& state) {

@@ -14,9 +14,7 @@ Eigen::Vector3d LambertianBrdf::Eval(const Eigen::Vector3d& wi, const Eigen::Vec
   return albedo_ / M_PI;
 }
 
-nlohmann::json LambertianBrdf::ToJson() const {
-  return {{"model", "lambertian"}, {"albedo", ibrdf::ToJson(albedo_)}};
-}
+nlohmann::json LambertianBrdf::ToJson() const { return {{"model", "lambertian"}, {"albedo", ibrdf::ToJson(albedo_)}}; }
 
 Eigen::Vector3d LafortuneBrdf::Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const {
   if (!(wi.z() > 0.0) || !(wo.z() > 0.0)) return Eigen::Vector3d::Zero();
@@ -35,9 +33,7 @@ Eigen::Vector3d LafortuneBrdf::Eval(const Eigen::Vector3d& wi, const Eigen::Vect
 nlohmann::json LafortuneBrdf::ToJson() const {
   nlohmann::json lobes = nlohmann::json::array();
   for (const LafortuneLobe& lobe : lobes_) {
-    lobes.push_back({{"Cxy", ibrdf::ToJson(lobe.cxy)},
-                     {"Cz", ibrdf::ToJson(lobe.cz)},
-                     {"n", ibrdf::ToJson(lobe.n)}});
+    lobes.push_back({{"Cxy", ibrdf::ToJson(lobe.cxy)}, {"Cz", ibrdf::ToJson(lobe.cz)}, {"n", ibrdf::ToJson(lobe.n)}});
   }
   return {{"model", "lafortune"}, {"diffuse", ibrdf::ToJson(diffuse_)}, {"lobes", lobes}};
 }
@@ -55,8 +51,7 @@ Eigen::Vector3d GgxBrdf::Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& 
   };
   const double g = g1(wi.z()) * g1(wo.z());
   const double schlick = std::pow(1.0 - std::max(0.0, wi.dot(h)), 5.0);
-  const Eigen::Vector3d fresnel =
-      specular_f0_ + (Eigen::Vector3d::Ones() - specular_f0_) * schlick;
+  const Eigen::Vector3d fresnel = specular_f0_ + (Eigen::Vector3d::Ones() - specular_f0_) * schlick;
   return diffuse_albedo_ / M_PI + fresnel * (d * g / (4.0 * wi.z() * wo.z()));
 }
 
@@ -105,15 +100,12 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
     if (!(alpha > 0.0 && alpha <= 1.0)) ThrowError(object.Where("alpha"), "expected 0 < alpha <= 1");
     brdf = std::make_unique<GgxBrdf>(diffuse, f0, alpha);
   } else {
-    ThrowError(object.Where("model"),
-               "unknown model \"" + model + "\" (expected lambertian, lafortune or ggx)");
+    ThrowError(object.Where("model"), "unknown model \"" + model + "\" (expected lambertian, lafortune or ggx)");
   }
   object.Finish();
   return brdf;
 }
 
-std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path) {
-  return MaterialFromJson(ReadJsonFile(path), path);
-}
+std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path) { return MaterialFromJson(ReadJsonFile(path), path); }
 
 }  // namespace ibrdf

@@ -61,8 +61,7 @@ Coefficients CoefficientsOf(const Camera& camera) {
 }
 
 // Distorted point and its Jacobian with respect to the undistorted point.
-Eigen::Vector2d DistortWithJacobian(const Coefficients& c, const Eigen::Vector2d& xy,
-                                    Eigen::Matrix2d* jacobian) {
+Eigen::Vector2d DistortWithJacobian(const Coefficients& c, const Eigen::Vector2d& xy, Eigen::Matrix2d* jacobian) {
   const double x = xy.x(), y = xy.y();
   const double x2 = x * x, y2 = y * y, xy_ = x * y;
   const double r2 = x2 + y2;
@@ -134,8 +133,7 @@ Eigen::Vector2d Camera::ImageFromCamera(const Eigen::Vector3d& p_in_camera) cons
 }
 
 Eigen::Vector2d Camera::CamPlaneFromImage(const Eigen::Vector2d& pixel) const {
-  const Eigen::Vector2d distorted((pixel.x() - PrincipalX()) / FocalX(),
-                                  (pixel.y() - PrincipalY()) / FocalY());
+  const Eigen::Vector2d distorted((pixel.x() - PrincipalX()) / FocalX(), (pixel.y() - PrincipalY()) / FocalY());
   const Coefficients c = CoefficientsOf(*this);
   if (c.k1 == 0 && c.k2 == 0 && c.p1 == 0 && c.p2 == 0) return distorted;
   // Newton's method on Distort(x) = distorted, started at the distorted point.
@@ -146,7 +144,7 @@ Eigen::Vector2d Camera::CamPlaneFromImage(const Eigen::Vector2d& pixel) const {
     if (residual.squaredNorm() < 1e-30) break;
     const double det = jacobian(0, 0) * jacobian(1, 1) - jacobian(0, 1) * jacobian(1, 0);
     if (!(std::abs(det) > 1e-300)) break;
-    const Eigen::Vector2d step(( jacobian(1, 1) * residual.x() - jacobian(0, 1) * residual.y()) / det,
+    const Eigen::Vector2d step((jacobian(1, 1) * residual.x() - jacobian(0, 1) * residual.y()) / det,
                                (-jacobian(1, 0) * residual.x() + jacobian(0, 0) * residual.y()) / det);
     if (!step.allFinite()) break;
     x -= step;
@@ -158,13 +156,12 @@ Eigen::Vector2d Camera::CamPlaneFromImage(const Eigen::Vector2d& pixel) const {
 bool Camera::Check(std::string* why) const {
   const int expected = CameraModelNumParams(model);
   if (static_cast<int>(params.size()) != expected) {
-    *why = std::string(CameraModelName(model)) + " takes " + std::to_string(expected) +
-           " parameters, got " + std::to_string(params.size());
+    *why = std::string(CameraModelName(model)) + " takes " + std::to_string(expected) + " parameters, got " +
+           std::to_string(params.size());
     return false;
   }
   if (width <= 0 || height <= 0) {
-    *why = "width and height must be positive, got " + std::to_string(width) + "x" +
-           std::to_string(height);
+    *why = "width and height must be positive, got " + std::to_string(width) + "x" + std::to_string(height);
     return false;
   }
   for (double p : params) {

@@ -81,17 +81,25 @@ void WriteImage(const std::string& path, const Image& image, PixelFormat format)
   if (!output) ThrowError(path, "no image writer for this extension: " + OIIO::geterror());
   OIIO::TypeDesc type = OIIO::TypeDesc::FLOAT;
   switch (format) {
-    case PixelFormat::kUint8: type = OIIO::TypeDesc::UINT8; break;
-    case PixelFormat::kUint16: type = OIIO::TypeDesc::UINT16; break;
-    case PixelFormat::kHalf: type = OIIO::TypeDesc::HALF; break;
-    case PixelFormat::kFloat: type = OIIO::TypeDesc::FLOAT; break;
+    case PixelFormat::kUint8:
+      type = OIIO::TypeDesc::UINT8;
+      break;
+    case PixelFormat::kUint16:
+      type = OIIO::TypeDesc::UINT16;
+      break;
+    case PixelFormat::kHalf:
+      type = OIIO::TypeDesc::HALF;
+      break;
+    case PixelFormat::kFloat:
+      type = OIIO::TypeDesc::FLOAT;
+      break;
   }
   OIIO::ImageSpec spec(image.width, image.height, image.channels, type);
   if (LowerExtension(path) == ".exr") spec.attribute("compression", "zip");
   // Fast deflate: noisy 16-bit photos barely compress, and level 6 costs 5x the time.
   if (LowerExtension(path) == ".png") spec.attribute("png:compressionLevel", 1);
-  if (!output->open(file.temporary_path(), spec) ||
-      !output->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data()) || !output->close()) {
+  if (!output->open(file.temporary_path(), spec) || !output->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data()) ||
+      !output->close()) {
     ThrowError(path, "cannot write image: " + output->geterror());
   }
   file.Commit();

@@ -40,15 +40,22 @@ void WriteJsonFile(const std::string& path, const nlohmann::json& value) {
 
 std::string JsonTypeName(const nlohmann::json& value) {
   switch (value.type()) {
-    case nlohmann::json::value_t::null: return "null";
-    case nlohmann::json::value_t::object: return "an object";
-    case nlohmann::json::value_t::array: return "an array";
-    case nlohmann::json::value_t::string: return "a string";
-    case nlohmann::json::value_t::boolean: return "a boolean";
+    case nlohmann::json::value_t::null:
+      return "null";
+    case nlohmann::json::value_t::object:
+      return "an object";
+    case nlohmann::json::value_t::array:
+      return "an array";
+    case nlohmann::json::value_t::string:
+      return "a string";
+    case nlohmann::json::value_t::boolean:
+      return "a boolean";
     case nlohmann::json::value_t::number_integer:
     case nlohmann::json::value_t::number_unsigned:
-    case nlohmann::json::value_t::number_float: return "a number";
-    default: return "an unsupported value";
+    case nlohmann::json::value_t::number_float:
+      return "a number";
+    default:
+      return "an unsupported value";
   }
 }
 
@@ -57,8 +64,7 @@ nlohmann::json ToJson(const Eigen::Vector3d& v) { return nlohmann::json::array({
 JsonObject::JsonObject(const nlohmann::json& value, std::string file, std::string pointer)
     : value_(&value), file_(std::move(file)), pointer_(std::move(pointer)) {
   if (!value.is_object()) {
-    ThrowError(file_ + ": " + (pointer_.empty() ? "/" : pointer_),
-               "expected an object, got " + JsonTypeName(value));
+    ThrowError(file_ + ": " + (pointer_.empty() ? "/" : pointer_), "expected an object, got " + JsonTypeName(value));
   }
 }
 
@@ -91,10 +97,9 @@ double JsonObject::Number(const std::string& key) {
 int JsonObject::Integer(const std::string& key) {
   const nlohmann::json& v = Field(key);
   if (!v.is_number_integer()) TypeError(key, "an integer");
-  const bool out_of_range = v.is_number_unsigned()
-                                ? v.get<uint64_t>() > uint64_t(std::numeric_limits<int>::max())
-                                : (v.get<int64_t>() < std::numeric_limits<int>::min() ||
-                                   v.get<int64_t>() > std::numeric_limits<int>::max());
+  const bool out_of_range = v.is_number_unsigned() ? v.get<uint64_t>() > uint64_t(std::numeric_limits<int>::max())
+                                                   : (v.get<int64_t>() < std::numeric_limits<int>::min() ||
+                                                      v.get<int64_t>() > std::numeric_limits<int>::max());
   if (out_of_range) ThrowError(Where(key), "integer out of range, got " + v.dump());
   return v.get<int>();
 }
@@ -175,8 +180,8 @@ void JsonObject::Finish() const {
     if (read_.count(it.key())) continue;
     std::string accepted;
     for (const std::string& key : read_) accepted += (accepted.empty() ? "" : ", ") + key;
-    ThrowError(Where(it.key()), "unknown key \"" + it.key() + "\"" +
-                                    (accepted.empty() ? "" : " (this object takes: " + accepted + ")"));
+    ThrowError(Where(it.key()),
+               "unknown key \"" + it.key() + "\"" + (accepted.empty() ? "" : " (this object takes: " + accepted + ")"));
   }
 }
 

@@ -5,8 +5,7 @@
 
 namespace ibrdf {
 
-Incidence IncidenceAt(const Light& light, const Eigen::Vector3d& point,
-                      const Eigen::Vector3d& normal) {
+Incidence IncidenceAt(const Light& light, const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
   Incidence incidence;
   double inverse_square = 1.0;
   if (light.kind == Light::Kind::kPoint) {

@@ -11,8 +11,8 @@ struct Light {
     kDirectional,  // a distant source towards `direction`; `intensity` is irradiance at normal incidence
   };
   Kind kind = Kind::kPoint;
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();       // metres, world frame (point light)
-  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();     // unit, towards the light (directional)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();    // metres, world frame (point light)
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  // unit, towards the light (directional)
   // RGB, in the session's radiance units (linear pixel value per second of exposure at unit gain)
   // times square metres for a point light.
   Eigen::Vector3d intensity = Eigen::Vector3d::Ones();
@@ -20,16 +20,15 @@ struct Light {
 
 // What a surface point receives from the light.
 struct Incidence {
-  Eigen::Vector3d wi = Eigen::Vector3d::Zero();  // unit direction towards the light, world frame
-  double cos_theta = 0.0;                         // wi . normal; <= 0 means the light is behind
-  double distance = 0.0;                          // metres to a point light; +inf if directional
+  Eigen::Vector3d wi = Eigen::Vector3d::Zero();          // unit direction towards the light, world frame
+  double cos_theta = 0.0;                                // wi . normal; <= 0 means the light is behind
+  double distance = 0.0;                                 // metres to a point light; +inf if directional
   Eigen::Vector3d irradiance = Eigen::Vector3d::Zero();  // E = I cos(theta_i) / r^2, RGB; 0 if unlit
   bool lit = false;                                      // cos_theta > 0 and a finite distance
 };
 
 // The irradiance at `point` with unit `normal`, E = I cos(theta_i) / r^2 for a point light.
 // A point coinciding with the light, or a light behind the surface, gives lit = false.
-Incidence IncidenceAt(const Light& light, const Eigen::Vector3d& point,
-                      const Eigen::Vector3d& normal);
+Incidence IncidenceAt(const Light& light, const Eigen::Vector3d& point, const Eigen::Vector3d& normal);
 
 }  // namespace ibrdf

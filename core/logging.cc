@@ -59,8 +59,8 @@ void ProgressBar::Draw(uint64_t done, bool final) {
   const int width = 30;
   const int filled = static_cast<int>(fraction * width + 0.5);
   std::ostringstream line;
-  line << "   " << label_ << " [" << std::string(filled, '#') << std::string(width - filled, '.')
-       << "] " << done << "/" << total_;
+  line << "   " << label_ << " [" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << done << "/"
+       << total_;
   char seconds[32];
   std::snprintf(seconds, sizeof(seconds), " %.1f s", timer_.ElapsedSeconds());
   line << seconds;

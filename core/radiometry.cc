@@ -5,13 +5,9 @@
 
 namespace ibrdf {
 
-double SrgbToLinear(double v) {
-  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-}
+double SrgbToLinear(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
 
-double LinearToSrgb(double v) {
-  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
-}
+double LinearToSrgb(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055; }
 
 double Response::ToLinear(double v) const {
   switch (kind) {
@@ -52,10 +48,14 @@ double Response::FromLinear(double v) const {
 
 std::string Response::Describe() const {
   switch (kind) {
-    case Kind::kLinear: return "linear";
-    case Kind::kSrgb: return "srgb";
-    case Kind::kGamma: return "gamma " + std::to_string(gamma);
-    case Kind::kTable: return "table (" + std::to_string(table.size()) + " entries)";
+    case Kind::kLinear:
+      return "linear";
+    case Kind::kSrgb:
+      return "srgb";
+    case Kind::kGamma:
+      return "gamma " + std::to_string(gamma);
+    case Kind::kTable:
+      return "table (" + std::to_string(table.size()) + " entries)";
   }
   return "unknown";
 }

@@ -9,8 +9,7 @@
 
 namespace ibrdf {
 
-Rigid3d LookAtCameraFromWorld(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
-                              const Eigen::Vector3d& up) {
+Rigid3d LookAtCameraFromWorld(const Eigen::Vector3d& center, const Eigen::Vector3d& target, const Eigen::Vector3d& up) {
   const Eigen::Vector3d z = (target - center).normalized();
   Eigen::Vector3d x = z.cross(up);
   IBRDF_CHECK(x.norm() > 1e-12) << "look-at direction is parallel to up";
@@ -33,8 +32,8 @@ nlohmann::json Sim3dToJson(const Sim3d& sim) {
 
 Sim3d Sim3dFromJson(const nlohmann::json& value, const std::string& file, const std::string& pointer) {
   if (!value.is_object()) {
-    ThrowError(file + ": " + pointer, "expected an object {\"rotation\", \"translation\", \"scale\"}, got " +
-                                          JsonTypeName(value));
+    ThrowError(file + ": " + pointer,
+               "expected an object {\"rotation\", \"translation\", \"scale\"}, got " + JsonTypeName(value));
   }
   JsonObject object(value, file, pointer);
   const std::vector<double> q = object.Numbers("rotation");

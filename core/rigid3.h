@@ -70,7 +70,6 @@ Sim3d Sim3dFromJson(const nlohmann::json& value, const std::string& file, const 
 
 // The pose of a camera at `center` looking at `target`, with `up` projecting upwards in the image.
 // Camera axes as in COLMAP and OpenCV: x right, y down, z forward.
-Rigid3d LookAtCameraFromWorld(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
-                              const Eigen::Vector3d& up);
+Rigid3d LookAtCameraFromWorld(const Eigen::Vector3d& center, const Eigen::Vector3d& target, const Eigen::Vector3d& up);
 
 }  // namespace ibrdf

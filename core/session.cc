@@ -21,7 +21,8 @@ namespace {
 std::array<Eigen::Vector3d, 4> MarkerCorners(JsonObject& marker) {
   const nlohmann::json& corners = marker.Raw("corners");
   if (!corners.is_array() || corners.size() != 4) {
-    ThrowError(marker.Where("corners"), "expected 4 corners [[x, y, z] x 4] (top-left, top-right, bottom-right, bottom-left)");
+    ThrowError(marker.Where("corners"),
+               "expected 4 corners [[x, y, z] x 4] (top-left, top-right, bottom-right, bottom-left)");
   }
   std::array<Eigen::Vector3d, 4> points;
   for (int k = 0; k < 4; ++k) {
@@ -217,7 +218,8 @@ RadiometrySpec ParseRadiometry(JsonObject object, const std::string& directory) 
   if (object.Has("flat_field")) {
     radiometry.flat_field = object.String("flat_field");
     const std::string path = ResolvePath(directory, radiometry.flat_field);
-    if (!fs::is_regular_file(path)) ThrowError(object.Where("flat_field"), "flat-field image " + path + " does not exist");
+    if (!fs::is_regular_file(path))
+      ThrowError(object.Where("flat_field"), "flat-field image " + path + " does not exist");
   }
   object.Finish();
   return radiometry;
@@ -290,20 +292,25 @@ TargetsSpec ParseTargets(JsonObject object) {
     if (ids.empty()) ThrowError(layout.Where("ids"), "expected at least one marker id");
     for (size_t k = 0; k < ids.size(); ++k) {
       const std::string where = layout.Where("ids") + "/" + std::to_string(k);
-      if (!(ids[k] >= 0.0) || ids[k] != std::floor(ids[k]) || ids[k] > 1e6) ThrowError(where, "expected a non-negative integer id");
-      if (!seen.insert(int(ids[k])).second) ThrowError(where, "marker id " + std::to_string(int(ids[k])) + " is listed twice");
+      if (!(ids[k] >= 0.0) || ids[k] != std::floor(ids[k]) || ids[k] > 1e6)
+        ThrowError(where, "expected a non-negative integer id");
+      if (!seen.insert(int(ids[k])).second)
+        ThrowError(where, "marker id " + std::to_string(int(ids[k])) + " is listed twice");
       spec.ids.push_back(int(ids[k]));
     }
     if (layout.Has("origin_id")) {
       spec.origin_id = layout.Integer("origin_id");
       if (!targets.reference.empty()) {
-        ThrowError(layout.Where("origin_id"), "the known-layout markers in /targets/reference already fix the world frame; drop origin_id");
+        ThrowError(layout.Where("origin_id"),
+                   "the known-layout markers in /targets/reference already fix the world frame; drop origin_id");
       }
       if (std::find(spec.ids.begin(), spec.ids.end(), *spec.origin_id) == spec.ids.end()) {
         ThrowError(layout.Where("origin_id"), "marker " + std::to_string(*spec.origin_id) + " is not in ids");
       }
     } else if (targets.reference.empty()) {
-      ThrowError(layout.Where("origin_id"), "without known-layout markers (/targets/reference) one marker must fix the world frame: give origin_id");
+      ThrowError(
+          layout.Where("origin_id"),
+          "without known-layout markers (/targets/reference) one marker must fix the world frame: give origin_id");
     }
     layout.Finish();
     targets.unknown_layout = spec;
@@ -318,7 +325,8 @@ TargetsSpec ParseTargets(JsonObject object) {
       for (int k = 0; k < 4; ++k) {
         const double edge = (target.corners[(k + 1) % 4] - target.corners[k]).norm();
         if (!(side > 0.0) || std::abs(edge - side) > 1e-3 * side ||
-            std::abs((target.corners[(k + 1) % 4] - target.corners[k]).dot(target.corners[(k + 2) % 4] - target.corners[(k + 1) % 4])) > 1e-3 * side * side) {
+            std::abs((target.corners[(k + 1) % 4] - target.corners[k])
+                         .dot(target.corners[(k + 2) % 4] - target.corners[(k + 1) % 4])) > 1e-3 * side * side) {
           ThrowError(where, "the corners are not a square (sides and right angles within 0.1 %)");
         }
       }
@@ -387,18 +395,24 @@ nlohmann::json PoseToJson(const Rigid3d& pose) {
 
 const char* SampleKindName(SampleSpec::Kind kind) {
   switch (kind) {
-    case SampleSpec::Kind::kSphere: return "sphere";
-    case SampleSpec::Kind::kCylinder: return "cylinder";
-    case SampleSpec::Kind::kMesh: return "mesh";
+    case SampleSpec::Kind::kSphere:
+      return "sphere";
+    case SampleSpec::Kind::kCylinder:
+      return "cylinder";
+    case SampleSpec::Kind::kMesh:
+      return "mesh";
   }
   return "unknown";
 }
 
 const char* VisibilityName(Visibility visibility) {
   switch (visibility) {
-    case Visibility::kAuto: return "auto";
-    case Visibility::kOn: return "on";
-    case Visibility::kOff: return "off";
+    case Visibility::kAuto:
+      return "auto";
+    case Visibility::kOn:
+      return "on";
+    case Visibility::kOff:
+      return "off";
   }
   return "unknown";
 }
@@ -425,8 +439,8 @@ Session Session::Load(const std::string& path) {
   if (format != kFormat) ThrowError(root.Where("format"), "expected \"" + std::string(kFormat) + "\"");
   const int version = root.Integer("version");
   if (version != kVersion) {
-    ThrowError(root.Where("version"), "unsupported version " + std::to_string(version) +
-                                          " (this ibrdf reads version " + std::to_string(kVersion) + ")");
+    ThrowError(root.Where("version"), "unsupported version " + std::to_string(version) + " (this ibrdf reads version " +
+                                          std::to_string(kVersion) + ")");
   }
   session.name = root.String("name", fs::path(session.directory).filename().string());
   session.description = root.String("description", "");
@@ -496,10 +510,18 @@ nlohmann::json Session::ToJson() const {
   }
   nlohmann::json& r = json["radiometry"];
   switch (radiometry.response.kind) {
-    case Response::Kind::kLinear: r["response"] = "linear"; break;
-    case Response::Kind::kSrgb: r["response"] = "srgb"; break;
-    case Response::Kind::kGamma: r["response"] = {{"gamma", radiometry.response.gamma}}; break;
-    case Response::Kind::kTable: r["response"] = {{"table", radiometry.response.table}}; break;
+    case Response::Kind::kLinear:
+      r["response"] = "linear";
+      break;
+    case Response::Kind::kSrgb:
+      r["response"] = "srgb";
+      break;
+    case Response::Kind::kGamma:
+      r["response"] = {{"gamma", radiometry.response.gamma}};
+      break;
+    case Response::Kind::kTable:
+      r["response"] = {{"table", radiometry.response.table}};
+      break;
   }
   r["black_level"] = radiometry.black_level;
   r["saturation_level"] = radiometry.saturation_level;

@@ -27,9 +27,9 @@ struct CameraNoise {
 };
 
 struct RadiometrySpec {
-  Response response;             // file value -> linear signal
-  double black_level = 0.0;      // linear signal of a dark pixel, subtracted (normalized file units)
-  double saturation_level = 1.0; // file value at which a channel is clipped (normalized file units)
+  Response response;              // file value -> linear signal
+  double black_level = 0.0;       // linear signal of a dark pixel, subtracted (normalized file units)
+  double saturation_level = 1.0;  // file value at which a channel is clipped (normalized file units)
   std::optional<CameraNoise> noise;
   // Optional flat-field image (relative to the session folder): the camera's relative sensitivity per
   // pixel (vignetting x pixel response), linear, 1 where exposure and gain alone are right (normally
@@ -65,10 +65,10 @@ struct SampleSpec {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   // cylinder axis, unit
   double length = 0.0;                               // cylinder length along the axis, metres
   // Mesh samples. The file need not exist when the session is read (the scan stage may write it).
-  std::string mesh_file;                             // the scan stage's PLY, relative to the session folder
-  Sim3d world_from_mesh;                             // p_world = s R p_mesh + t; identity when absent
-  std::vector<ScanInputSpec> scan_inputs;            // raw scans merged into mesh_file (kept, not read)
-  std::vector<ScanTargetSpec> scan_targets;          // markers seen by the scanner, mesh frame
+  std::string mesh_file;                     // the scan stage's PLY, relative to the session folder
+  Sim3d world_from_mesh;                     // p_world = s R p_mesh + t; identity when absent
+  std::vector<ScanInputSpec> scan_inputs;    // raw scans merged into mesh_file (kept, not read)
+  std::vector<ScanTargetSpec> scan_targets;  // markers seen by the scanner, mesh frame
   Visibility visibility = Visibility::kAuto;
 };
 
@@ -99,9 +99,9 @@ struct LightTargetsSpec {
 // fixes the gauge: the world frame has its origin at that marker's centre, x to the right of the print,
 // y up the print, z out of the print (up, for a marker lying face-up); the scale comes from `size`.
 struct UnknownLayoutSpec {
-  double size = 0.0;              // metres, printed side (border included)
+  double size = 0.0;  // metres, printed side (border included)
   std::vector<int> ids;
-  std::optional<int> origin_id;   // required when `reference` is empty, not allowed otherwise
+  std::optional<int> origin_id;  // required when `reference` is empty, not allowed otherwise
 };
 
 // Markers fixed to the sample (a cylinder's end cap): their corners in the sample's own frame (origin
@@ -112,11 +112,11 @@ struct SampleTargetsSpec {
 };
 
 struct TargetsSpec {
-  std::string dictionary;              // OpenCV predefined dictionary name, e.g. "DICT_4X4_50"
-  std::vector<TargetSpec> reference;   // markers with known layout (may be empty with unknown_layout)
+  std::string dictionary;                           // OpenCV predefined dictionary name, e.g. "DICT_4X4_50"
+  std::vector<TargetSpec> reference;                // markers with known layout (may be empty with unknown_layout)
   std::optional<UnknownLayoutSpec> unknown_layout;  // markers of unknown layout, if any
-  std::optional<LightTargetsSpec> light;  // markers on the light, if any
-  std::optional<SampleTargetsSpec> sample;  // markers on the sample, if any
+  std::optional<LightTargetsSpec> light;            // markers on the light, if any
+  std::optional<SampleTargetsSpec> sample;          // markers on the sample, if any
 };
 
 // What a photo is for: measurement photos are derendered; target photos only serve the alignment
@@ -124,9 +124,9 @@ struct TargetsSpec {
 enum class PhotoRole { kMeasurement, kTargets };
 
 struct PhotoSpec {
-  std::string file;          // relative to the session folder
-  double exposure_s = 1.0;   // exposure time, seconds
-  double gain = 1.0;         // linear gain relative to the base ISO
+  std::string file;                          // relative to the session folder
+  double exposure_s = 1.0;                   // exposure time, seconds
+  double gain = 1.0;                         // linear gain relative to the base ISO
   std::optional<Rigid3d> camera_from_world;  // known pose, if any
   PhotoRole role = PhotoRole::kMeasurement;
   // Exposure bracket: measurement photos with the same bracket id are exposures of one pose, merged
@@ -140,9 +140,9 @@ struct PhotoSpec {
 // session's radiance unit (derender/light_calibration.h).
 struct WhiteReferenceSpec {
   Eigen::Vector3d reflectance = Eigen::Vector3d::Constant(0.99);  // Lambertian albedo per channel
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // the target's centre, world frame, metres
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // its front face's normal (unit), world frame
-  double size = 0.0;  // metres: the side of a square target or the diameter of a round one
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();               // the target's centre, world frame, metres
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();              // its front face's normal (unit), world frame
+  double size = 0.0;              // metres: the side of a square target or the diameter of a round one
   std::vector<PhotoSpec> photos;  // each with a camera_from_world pose
 };
 

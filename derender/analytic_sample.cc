@@ -21,8 +21,7 @@ std::unique_ptr<AnalyticSample> AnalyticSample::Create(const SampleSpec& spec) {
 // Ray/sphere in the form of Haines et al., "Precision improvements for ray/sphere intersection" (Ray
 // Tracing Gems, ch. 7): the discriminant from the ray's closest approach, and the far root from the
 // near one by Vieta, so a small sphere far from the camera keeps its digits.
-bool SphereSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                             SurfaceHit* hit) const {
+bool SphereSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const {
   const Eigen::Vector3d f = origin - center_;
   const double b = f.dot(direction);
   const double c = f.squaredNorm() - radius_ * radius_;
@@ -46,8 +45,7 @@ bool SphereSample::Contains(const Eigen::Vector3d& point) const {
 
 double CylinderSample::BoundingRadius() const { return std::hypot(radius_, half_length_); }
 
-bool CylinderSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                               SurfaceHit* hit) const {
+bool CylinderSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const {
   const Eigen::Vector3d f = origin - center_;
   const double f_axial = f.dot(axis_);
   const double d_axial = direction.dot(axis_);

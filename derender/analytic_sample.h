@@ -31,8 +31,7 @@ class SampleSurface {
   // The nearest hit with t > 0 of the ray origin + t * direction (direction unit length) on the
   // measured surface. False for a miss, for a ray that starts inside, and (cylinder) for rays that hit
   // an end cap first: the caps are not measured.
-  virtual bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                         SurfaceHit* hit) const = 0;
+  virtual bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const = 0;
   // True if the point is inside the solid (a camera there sees no outer surface).
   virtual bool Contains(const Eigen::Vector3d& point) const = 0;
   // A bounding sphere: centre and radius (framing synthetic views, culling pixels).
@@ -53,8 +52,7 @@ class AnalyticSample : public SampleSurface {
 class SphereSample : public AnalyticSample {
  public:
   SphereSample(const Eigen::Vector3d& center, double radius) : center_(center), radius_(radius) {}
-  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                 SurfaceHit* hit) const override;
+  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const override;
   bool Contains(const Eigen::Vector3d& point) const override;
   Eigen::Vector3d BoundingCenter() const override { return center_; }
   double BoundingRadius() const override { return radius_; }
@@ -69,8 +67,7 @@ class CylinderSample : public AnalyticSample {
  public:
   CylinderSample(const Eigen::Vector3d& center, const Eigen::Vector3d& axis, double radius, double length)
       : center_(center), axis_(axis.normalized()), radius_(radius), half_length_(0.5 * length) {}
-  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                 SurfaceHit* hit) const override;
+  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const override;
   bool Contains(const Eigen::Vector3d& point) const override;
   Eigen::Vector3d BoundingCenter() const override { return center_; }
   double BoundingRadius() const override;

@@ -1,16 +1,16 @@
 #include "derender/derenderer.h"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
-#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <mutex>
 
-#include <nlohmann/json.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <nlohmann/json.hpp>
 
 #include "core/brdf_coords.h"
 #include "core/error.h"
@@ -154,13 +154,13 @@ struct MeshPhotoStats {
 // Whether the light reaches `point` (on the surface, normal `normal`, fit residual `fit_rms_m`):
 // kNumReasons if it does, kShadowed or kShadowEdge if not.
 Reason ShadowTest(const MeshSample& mesh, const Light& light, const Incidence& incidence, const Eigen::Vector3d& point,
-                  const Eigen::Vector3d& normal, float fit_rms_m, const DerenderOptions& options,
-                  uint64_t* rays) {
+                  const Eigen::Vector3d& normal, float fit_rms_m, const DerenderOptions& options, uint64_t* rays) {
   const double offset = 4.0 * mesh.Epsilon() + options.shadow_ray_offset_fit_rms * std::max(0.0f, fit_rms_m);
   const Eigen::Vector3d from = point + offset * normal;
-  const double distance = light.kind == Light::Kind::kPoint ? (light.position - from).norm()
-                                                             : 4.0 * mesh.BoundingRadius();
-  const Eigen::Vector3d to = light.kind == Light::Kind::kPoint ? light.position : Eigen::Vector3d(from + distance * incidence.wi);
+  const double distance =
+      light.kind == Light::Kind::kPoint ? (light.position - from).norm() : 4.0 * mesh.BoundingRadius();
+  const Eigen::Vector3d to =
+      light.kind == Light::Kind::kPoint ? light.position : Eigen::Vector3d(from + distance * incidence.wi);
   ++*rays;
   if (mesh.Occluded(from, to)) return kShadowed;
   if (options.shadow_edge_rays > 0 && options.shadow_edge_deg > 0.0) {
@@ -178,8 +178,8 @@ Reason ShadowTest(const MeshSample& mesh, const Light& light, const Incidence& i
 // The mesh path's per-pixel work for one photo: rows of pixels in blocks across threads, each row's
 // rays handed to Embree together; samples in row-major order.
 void DerenderMeshPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
-                       const std::vector<Eigen::Vector2f>& rays, const MeshPath& path,
-                       const DerenderOptions& options, std::vector<BrdfSample>* samples, MeshPhotoStats* stats) {
+                       const std::vector<Eigen::Vector2f>& rays, const MeshPath& path, const DerenderOptions& options,
+                       std::vector<BrdfSample>* samples, MeshPhotoStats* stats) {
   const MeshSample& mesh = *path.mesh;
   const PhotoSpec& photo = session.photos[photo_index];
   const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
@@ -392,8 +392,8 @@ MeshPath PrepareMeshPath(const Session& session, const DerenderOptions& options)
   }
   Log(1, "mesh " + file + ": " + std::to_string(path.mesh->NumPoints()) + " points, " +
              std::to_string(path.mesh->NumFaces()) + " faces" +
-             (path.mesh->HasFitQuality() ? "" : " (no fit quality: normals taken as they are)") +
-             "; shadow rays " + (path.shadow_rays ? "on" : "off") + ": " + path.visibility_reason);
+             (path.mesh->HasFitQuality() ? "" : " (no fit quality: normals taken as they are)") + "; shadow rays " +
+             (path.shadow_rays ? "on" : "off") + ": " + path.visibility_reason);
   return path;
 }
 
@@ -420,9 +420,10 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     any_sees |= !SampleBox(session.camera, *session.photos[group.front()].camera_from_world, sample).Empty();
   }
   if (!any_sees) {
-    ThrowError(session.manifest_path, "no photo sees the sample: its bounding sphere projects outside every "
-                                      "measurement photo (check the sample's position" +
-                                          std::string(mesh_path ? " and world_from_mesh" : "") + " and the poses)");
+    ThrowError(session.manifest_path,
+               "no photo sees the sample: its bounding sphere projects outside every "
+               "measurement photo (check the sample's position" +
+                   std::string(mesh_path ? " and world_from_mesh" : "") + " and the poses)");
   }
   session.CheckPhotos();
 
@@ -435,7 +436,8 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
     const RadianceImage image = ReadRadianceImage(session, groups[g], options.min_signal, &decode_s[g]);
     if (mesh_path) {
-      DerenderMeshPhoto(session, groups[g].front(), image, rays, *mesh_path, options, &per_group[g], &per_group_mesh[g]);
+      DerenderMeshPhoto(session, groups[g].front(), image, rays, *mesh_path, options, &per_group[g],
+                        &per_group_mesh[g]);
       AddCounts(per_group_mesh[g].counts, &per_group_rejected[g]);
     } else {
       // Room for every examined pixel: only the pages written are touched, and the vector never regrows
@@ -462,17 +464,18 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   result.summary.pixels_examined = PixelsPerImage(session.camera, options.pixel_stride) * measured;
   result.summary.accepted = result.samples.size();
   if (measured > 0 && result.summary.rejected["off_sample"] == result.summary.pixels_examined) {
-    ThrowError(session.manifest_path, "no photo sees the sample: every pixel's ray misses it (check the sample's "
-                                      "position" + std::string(mesh_path ? " and world_from_mesh" : "") +
-                                          " and the poses)");
+    ThrowError(session.manifest_path,
+               "no photo sees the sample: every pixel's ray misses it (check the sample's "
+               "position" +
+                   std::string(mesh_path ? " and world_from_mesh" : "") + " and the poses)");
   }
   if (mesh_path) {
     result.summary.mesh_faces = mesh_path->mesh->NumFaces();
     result.summary.shadow_rays_on = mesh_path->shadow_rays;
     result.summary.visibility_reason = mesh_path->visibility_reason;
     if (!mesh_path->shadow_rays) {
-      Log(1, "shadow rays skipped for " + std::to_string(result.summary.shadow_tests_skipped) +
-                 " pixels (visibility " + mesh_path->visibility_reason + ")");
+      Log(1, "shadow rays skipped for " + std::to_string(result.summary.shadow_tests_skipped) + " pixels (visibility " +
+                 mesh_path->visibility_reason + ")");
     } else {
       Log(1, std::to_string(result.summary.shadow_rays) + " shadow rays traced");
     }
@@ -519,7 +522,8 @@ bool DerenderOptions::Check(std::string* why) const {
 const std::vector<std::pair<std::string, std::string>>& RejectionReasons() {
   static const std::vector<std::pair<std::string, std::string>> kReasons = {
       {"off_sample", "the pixel's ray misses the sample (background, or a cylinder's end cap)"},
-      {"mixed_pixel", "mesh: the pixel straddles the silhouette (a corner ray misses, or hits at a very different depth)"},
+      {"mixed_pixel",
+       "mesh: the pixel straddles the silhouette (a corner ray misses, or hits at a very different depth)"},
       {"occluded_by_target", "mesh: a reference marker lies between the camera and the sample"},
       {"low_quality_normal", "mesh: no normal, or its local-plane fit is poor (fit RMS or neighbours out of bounds)"},
       {"backfacing", "mesh: the interpolated or the face normal turns away from the camera"},
@@ -548,8 +552,7 @@ std::vector<Eigen::Vector2f> PixelRays(const Camera& camera) {
   tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y) {
       for (int x = 0; x < camera.width; ++x) {
-        rays[size_t(y) * camera.width + x] =
-            camera.CamPlaneFromImage(Eigen::Vector2d(x + 0.5, y + 0.5)).cast<float>();
+        rays[size_t(y) * camera.width + x] = camera.CamPlaneFromImage(Eigen::Vector2d(x + 0.5, y + 0.5)).cast<float>();
       }
     }
   });
@@ -571,8 +574,7 @@ std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera) {
 
 void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
                    const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
-                   const DerenderOptions& options, std::vector<BrdfSample>* samples,
-                   RejectionCounts* rejected) {
+                   const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected) {
   const PhotoSpec& photo = session.photos[photo_index];
   const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
   const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
@@ -646,8 +648,7 @@ DerenderResult Derender(const Session& measured_session, const DerenderOptions& 
   return RunDerender(session, options, *path.mesh, &path);
 }
 
-nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options,
-                               const DerenderSummary& summary) {
+nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options, const DerenderSummary& summary) {
   nlohmann::json rejected = nlohmann::json::object();
   for (const auto& [reason, meaning] : RejectionReasons()) {
     const auto it = summary.rejected.find(reason);
@@ -662,7 +663,8 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
       {"units",
        {{"brdf", "1/sr"},
         {"angles", "radians"},
-        {"directions", "unit vectors in the local frame, z = surface normal; wi towards the light, wo towards the camera"}}},
+        {"directions",
+         "unit vectors in the local frame, z = surface normal; wi towards the light, wo towards the camera"}}},
       {"colour_space", "camera RGB, linear (the session's response inverted, black level subtracted)"},
       {"uncertainty", session.radiometry.noise ? "sigma: one standard deviation from the session's camera noise model"
                                                : "none: the session has no camera noise model; sigma is 0"},
@@ -679,12 +681,10 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
       {"timings_s", {{"total", summary.total_s}, {"decode_cpu", summary.decode_s}}},
   };
   if (session.sample.kind == SampleSpec::Kind::kMesh) {
-    sidecar["mesh"] = {{"file", session.sample.mesh_file},
-                       {"faces", summary.mesh_faces},
-                       {"shadow_rays", summary.shadow_rays_on},
-                       {"visibility", summary.visibility_reason},
-                       {"shadow_rays_traced", summary.shadow_rays},
-                       {"shadow_tests_skipped", summary.shadow_tests_skipped}};
+    sidecar["mesh"] = {
+        {"file", session.sample.mesh_file},          {"faces", summary.mesh_faces},
+        {"shadow_rays", summary.shadow_rays_on},     {"visibility", summary.visibility_reason},
+        {"shadow_rays_traced", summary.shadow_rays}, {"shadow_tests_skipped", summary.shadow_tests_skipped}};
     nlohmann::json& o = sidecar["options"];
     o["mask_mixed_pixels"] = options.mask_mixed_pixels;
     o["mixed_pixel_depth_factor"] = options.mixed_pixel_depth_factor;

@@ -62,20 +62,20 @@ struct DerenderOptions {
 };
 
 struct DerenderSummary {
-  bool success = false;           // false until the stage ran to the end
-  std::string sample;             // "sphere", "cylinder" or "mesh"
-  uint64_t photos = 0;            // measurement photos (alignment-only photos are skipped)
-  uint64_t pixels_examined = 0;   // pixels looked at (after the stride)
+  bool success = false;          // false until the stage ran to the end
+  std::string sample;            // "sphere", "cylinder" or "mesh"
+  uint64_t photos = 0;           // measurement photos (alignment-only photos are skipped)
+  uint64_t pixels_examined = 0;  // pixels looked at (after the stride)
   uint64_t accepted = 0;
-  RejectionCounts rejected;       // reason -> count; see RejectionReasons()
+  RejectionCounts rejected;  // reason -> count; see RejectionReasons()
   // Mesh samples: the mesh, whether shadow rays were traced and why, how many.
   uint64_t mesh_faces = 0;
   bool shadow_rays_on = false;
-  std::string visibility_reason;     // "visibility on (session)", "auto: convex (scan sidecar)" ...
-  uint64_t shadow_rays = 0;          // shadow rays traced (shadow-edge rays included)
-  uint64_t shadow_tests_skipped = 0; // pixels that would have had shadow rays, with visibility off
-  double decode_s = 0.0;          // summed over threads: time to decode the photos
-  double total_s = 0.0;           // wall clock
+  std::string visibility_reason;      // "visibility on (session)", "auto: convex (scan sidecar)" ...
+  uint64_t shadow_rays = 0;           // shadow rays traced (shadow-edge rays included)
+  uint64_t shadow_tests_skipped = 0;  // pixels that would have had shadow rays, with visibility off
+  double decode_s = 0.0;              // summed over threads: time to decode the photos
+  double total_s = 0.0;               // wall clock
   // "derender: 1234567 samples from 20 photos in 2.1 s; rejected: off_sample 10, saturated 3"
   std::string BriefReport() const;
 };
@@ -106,8 +106,7 @@ class SampleSurface;
 struct RadianceImage;
 void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
                    const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
-                   const DerenderOptions& options, std::vector<BrdfSample>* samples,
-                   RejectionCounts* rejected);
+                   const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected);
 
 // Undistorted image-plane points of every pixel centre of the session's camera, row-major.
 std::vector<Eigen::Vector2f> PixelRays(const Camera& camera);
@@ -115,7 +114,6 @@ std::vector<Eigen::Vector2f> PixelRays(const Camera& camera);
 std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera);
 
 // The sample file's sidecar: units, colour space, counts, options and the session it came from.
-nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options,
-                               const DerenderSummary& summary);
+nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options, const DerenderSummary& summary);
 
 }  // namespace ibrdf

@@ -7,20 +7,13 @@
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/light.h"
+#include "core/statistics.h"
 #include "derender/radiance_image.h"
 
 namespace ibrdf {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
-
-double Median(std::vector<double>* values) {
-  const size_t k = values->size() / 2;
-  std::nth_element(values->begin(), values->begin() + k, values->end());
-  double median = (*values)[k];
-  if (values->size() % 2 == 0) median = 0.5 * (median + *std::max_element(values->begin(), values->begin() + k));
-  return median;
-}
 
 // The pixel box holding the image of a disc (centre, normal, radius), with a 2-pixel margin; the
 // whole image where part of the disc is behind the camera.
@@ -33,7 +26,8 @@ void DiscBox(const Camera& camera, const Rigid3d& camera_from_world, const Eigen
   for (int k = 0; k < kPoints; ++k) {
     const double angle = 2.0 * M_PI * k / kPoints;
     // The 64-gon's vertices on a circle 1 % wider contain the disc.
-    const Eigen::Vector3d p = camera_from_world * (center + 1.01 * radius * (std::cos(angle) * u + std::sin(angle) * v));
+    const Eigen::Vector3d p =
+        camera_from_world * (center + 1.01 * radius * (std::cos(angle) * u + std::sin(angle) * v));
     if (!(p.z() > 1e-6)) return;
     const Eigen::Vector2d pixel = camera.ImageFromCamera(p);
     if (!pixel.allFinite()) return;
@@ -73,7 +67,8 @@ bool LightCalibrationOptions::Check(std::string* why) const {
 }
 
 std::string LightCalibrationReport::BriefReport() const {
-  if (!calibrated) return "light calibration: none (the session has no white reference; its light intensity is used as stated)";
+  if (!calibrated)
+    return "light calibration: none (the session has no white reference; its light intensity is used as stated)";
   char buffer[512];
   std::snprintf(buffer, sizeof(buffer),
                 "light calibration: white reference, %d photos, %llu of %llu interior pixels in %.2f s: "
@@ -117,7 +112,8 @@ Session ApplyLightCalibration(const Session& session, LightCalibrationReport* re
     const PhotoSpec& photo = white.photos[k];
     const std::string photo_where = where + "/photos/" + std::to_string(k);
     const std::string path = ResolvePath(session.directory, photo.file);
-    if (!photo.camera_from_world) ThrowError(photo_where, "white-reference photo " + photo.file + " has no camera_from_world pose");
+    if (!photo.camera_from_world)
+      ThrowError(photo_where, "white-reference photo " + photo.file + " has no camera_from_world pose");
     const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
     const Eigen::Vector3d camera_center = world_from_camera.translation;
     if ((camera_center - white.center).dot(white.normal) <= 0.0) {
@@ -176,26 +172,26 @@ Session ApplyLightCalibration(const Session& session, LightCalibrationReport* re
     }
   }
   if (report->interior_pixels < uint64_t(options.min_pixels)) {
-    ThrowError(where, "the white reference is not in view: its interior covers " +
-                          std::to_string(report->interior_pixels) + " pixel centres in " +
-                          std::to_string(white.photos.size()) + " photos (at least " +
-                          std::to_string(options.min_pixels) + " needed; check center, normal, size and the photos' poses)");
+    ThrowError(where,
+               "the white reference is not in view: its interior covers " + std::to_string(report->interior_pixels) +
+                   " pixel centres in " + std::to_string(white.photos.size()) + " photos (at least " +
+                   std::to_string(options.min_pixels) + " needed; check center, normal, size and the photos' poses)");
   }
   if (report->pixels_used < uint64_t(options.min_pixels)) {
     ThrowError(where, "only " + std::to_string(report->pixels_used) + " of the white reference's " +
-                          std::to_string(report->interior_pixels) + " interior pixels are measurable (rejected: " +
-                          FormatCounts(report->rejected) + "); at least " + std::to_string(options.min_pixels) +
-                          " needed");
+                          std::to_string(report->interior_pixels) +
+                          " interior pixels are measurable (rejected: " + FormatCounts(report->rejected) +
+                          "); at least " + std::to_string(options.min_pixels) + " needed");
   }
   for (int c = 0; c < 3; ++c) {
-    const double median = Median(&estimates[c]);
+    const double median = Median(estimates[c]);
     if (!(median > 0.0 && std::isfinite(median))) {
       ThrowError(where, "the white reference gives no positive light intensity in channel " + std::to_string(c));
     }
     std::vector<double> deviations(estimates[c].size());
     for (size_t i = 0; i < deviations.size(); ++i) deviations[i] = std::abs(estimates[c][i] - median);
     report->calibrated_intensity[c] = median;
-    report->spread[c] = 1.4826 * Median(&deviations) / median;
+    report->spread[c] = 1.4826 * Median(deviations) / median;
   }
   calibrated.light.intensity = report->calibrated_intensity;
   report->photos = static_cast<int>(white.photos.size());

@@ -40,7 +40,7 @@ struct LightCalibrationReport {
   Eigen::Vector3d calibrated_intensity = Eigen::Vector3d::Zero();  // the white reference's
   uint64_t interior_pixels = 0;  // pixel centres on the target's interior, over all photos
   uint64_t pixels_used = 0;
-  RejectionCounts rejected;      // non_finite, saturated, below_signal, grazing
+  RejectionCounts rejected;  // non_finite, saturated, below_signal, grazing
   // Per channel, the robust relative spread of the per-pixel estimates (1.4826 MAD / median): noise
   // plus any unevenness (a wrong pose or reflectance shows here).
   Eigen::Vector3d spread = Eigen::Vector3d::Zero();

@@ -32,7 +32,9 @@ struct Scene {
 
   explicit Scene(const std::string& source) {
     device = rtcNewDevice(nullptr);
-    if (!device) ThrowError(source, "cannot create an Embree device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    if (!device)
+      ThrowError(source,
+                 "cannot create an Embree device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(device, OnEmbreeError, &errors);
     scene = rtcNewScene(device);
     // Robust traversal: no ray slips through a shared edge or vertex of neighbouring triangles.
@@ -88,8 +90,9 @@ struct QuadOccluders::Embree {
 MeshSample::MeshSample(const ScanMesh& mesh, const Sim3d& world_from_mesh, const std::string& source) {
   const size_t n = mesh.points.size();
   if (mesh.faces.empty()) {
-    ThrowError(source, "the mesh has no faces: the derenderer intersects rays with triangles (`ibrdf scan` "
-                       "tessellates range scans and reconstructs point clouds)");
+    ThrowError(source,
+               "the mesh has no faces: the derenderer intersects rays with triangles (`ibrdf scan` "
+               "tessellates range scans and reconstructs point clouds)");
   }
   if (mesh.normals.size() != n) {
     ThrowError(source, mesh.normals.empty()
@@ -98,8 +101,10 @@ MeshSample::MeshSample(const ScanMesh& mesh, const Sim3d& world_from_mesh, const
                            : "the mesh has " + std::to_string(mesh.normals.size()) + " normals for " +
                                  std::to_string(n) + " points");
   }
-  if (!mesh.fit_rms_m.empty() && mesh.fit_rms_m.size() != n) ThrowError(source, "quality (fit RMS) is not one per point");
-  if (!mesh.fit_neighbours.empty() && mesh.fit_neighbours.size() != n) ThrowError(source, "fit_neighbours is not one per point");
+  if (!mesh.fit_rms_m.empty() && mesh.fit_rms_m.size() != n)
+    ThrowError(source, "quality (fit RMS) is not one per point");
+  if (!mesh.fit_neighbours.empty() && mesh.fit_neighbours.size() != n)
+    ThrowError(source, "fit_neighbours is not one per point");
   if (!(world_from_mesh.scale > 0.0)) ThrowError(source, "world_from_mesh scale must be positive");
   RequireFinitePoints(mesh, source);
   if (n > size_t(std::numeric_limits<int>::max()) || mesh.faces.size() > size_t(std::numeric_limits<unsigned>::max())) {
@@ -146,8 +151,8 @@ MeshSample::MeshSample(const ScanMesh& mesh, const Sim3d& world_from_mesh, const
   RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* vertices = static_cast<float*>(
       rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), n));
-  auto* indices = static_cast<unsigned*>(
-      rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), faces_.size()));
+  auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                 3 * sizeof(unsigned), faces_.size()));
   if (!vertices || !indices) {
     rtcReleaseGeometry(geometry);
     ThrowError(source, "cannot allocate the ray-tracing buffers: " + embree_->scene.errors.first);
@@ -245,7 +250,8 @@ void MeshSample::IntersectBatch(const Eigen::Vector3d& origin, const Eigen::Vect
         for (size_t k = 0; k < 8; ++k) {
           const bool active = k < lanes;
           valid[k] = active ? -1 : 0;
-          const Eigen::Vector3f d = active ? Eigen::Vector3f(directions[begin + k].cast<float>()) : Eigen::Vector3f(Eigen::Vector3f::UnitZ());
+          const Eigen::Vector3f d =
+              active ? Eigen::Vector3f(directions[begin + k].cast<float>()) : Eigen::Vector3f(Eigen::Vector3f::UnitZ());
           packet.ray.org_x[k] = o.x();
           packet.ray.org_y[k] = o.y();
           packet.ray.org_z[k] = o.z();
@@ -306,7 +312,8 @@ bool MeshSample::Occluded(const Eigen::Vector3d& from, const Eigen::Vector3d& to
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay ray;
-  InitRay((from - origin_).cast<float>(), (offset / length).cast<float>(), float(epsilon), float(length - epsilon), &ray);
+  InitRay((from - origin_).cast<float>(), (offset / length).cast<float>(), float(epsilon), float(length - epsilon),
+          &ray);
   rtcOccluded1(embree_->scene.scene, &context, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf for an occluded ray
 }

@@ -45,8 +45,8 @@ class MeshSample : public SampleSurface {
   bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const override;
   // Rays sharing one origin (a camera centre), e.g. a row of pixels: found[i] tells whether
   // directions[i] hit, hits[i] what it hit. Same results as Intersect, faster in kPacket8/kStream.
-  void IntersectBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count,
-                      SurfaceHit* hits, bool* found) const;
+  void IntersectBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count, SurfaceHit* hits,
+                      bool* found) const;
   // Inside when rays along all six axis directions leave through back faces (exact for a closed
   // mesh; an open scan has no inside and gives false almost everywhere).
   bool Contains(const Eigen::Vector3d& point) const override;
@@ -72,14 +72,14 @@ class MeshSample : public SampleSurface {
   struct Embree;
   // Fills `hit` from the face Embree reported and its float (t, u, v); false if the double
   // recomputation finds nothing usable.
-  bool CompleteHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, unsigned face, float t,
-                   float u, float v, SurfaceHit* hit) const;
+  bool CompleteHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, unsigned face, float t, float u,
+                   float v, SurfaceHit* hit) const;
 
-  Eigen::Vector3d origin_;                   // world; the local frame's origin
-  std::vector<Eigen::Vector3d> points_;      // world - origin_, double
+  Eigen::Vector3d origin_;               // world; the local frame's origin
+  std::vector<Eigen::Vector3d> points_;  // world - origin_, double
   std::vector<Eigen::Vector3i> faces_;
-  std::vector<Eigen::Vector3d> normals_;     // world orientation, unit or zero
-  std::vector<float> fit_rms_m_;             // world units (scaled)
+  std::vector<Eigen::Vector3d> normals_;  // world orientation, unit or zero
+  std::vector<float> fit_rms_m_;          // world units (scaled)
   std::vector<int> fit_neighbours_;
   Eigen::Vector3d bounding_center_;
   double bounding_radius_ = 0.0;

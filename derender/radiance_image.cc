@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/linear_image.h"
 #include "core/logging.h"
 
 namespace fs = std::filesystem;
@@ -30,68 +31,6 @@ constexpr double kTableStart = 1.0 / 64.0;
 
 bool SamePose(const Rigid3d& a, const Rigid3d& b) {
   return a.rotation.coeffs() == b.rotation.coeffs() && a.translation == b.translation;
-}
-
-// The inverse of the flat field, 3 floats per pixel, and where it came from.
-struct FlatField {
-  std::vector<float> inverse;
-};
-
-// Reads and checks a flat-field image; cached per file (path, size, modification time) so that a
-// derender that reads every photo through ReadRadianceImage decodes it once.
-std::shared_ptr<const FlatField> LoadFlatField(const Session& session) {
-  const std::string path = ResolvePath(session.directory, session.radiometry.flat_field);
-  const std::string where = session.manifest_path + ": /radiometry/flat_field";
-  RequireFile(path, "flat-field image (" + where + ")");
-  std::string key = fs::absolute(path).lexically_normal().string() + "|" + std::to_string(fs::file_size(path)) + "|" +
-                    std::to_string(fs::last_write_time(path).time_since_epoch().count()) + "|" +
-                    std::to_string(session.camera.width) + "x" + std::to_string(session.camera.height);
-  static std::mutex mutex;
-  static std::map<std::string, std::shared_ptr<const FlatField>> cache;
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    const auto it = cache.find(key);
-    if (it != cache.end()) return it->second;
-  }
-  const Image image = ReadImage(path);
-  if (image.width != session.camera.width || image.height != session.camera.height) {
-    ThrowError(path, "flat-field image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                         ", the camera is " + std::to_string(session.camera.width) + "x" +
-                         std::to_string(session.camera.height) + " (" + where + ")");
-  }
-  if (image.channels != 1 && image.channels < 3) {
-    ThrowError(path, "flat-field image: expected 1 (grey) or 3+ (RGB) channels, got " + std::to_string(image.channels));
-  }
-  auto flat = std::make_shared<FlatField>();
-  const size_t n = size_t(image.width) * image.height;
-  flat->inverse.resize(3 * n);
-  double centre_sum = 0.0;
-  size_t centre_count = 0;
-  for (size_t p = 0; p < n; ++p) {
-    for (int c = 0; c < 3; ++c) {
-      const float v = image.pixels[p * image.channels + (image.channels == 1 ? 0 : c)];
-      if (!(std::isfinite(v) && v > 0.0f)) {
-        ThrowError(path, "flat-field image: pixel (" + std::to_string(p % image.width) + ", " +
-                             std::to_string(p / image.width) + ") channel " + std::to_string(c) + " is " +
-                             std::to_string(v) + "; a relative sensitivity must be positive and finite");
-      }
-      flat->inverse[3 * p + c] = 1.0f / v;
-      const int x = int(p % image.width), y = int(p / image.width);
-      if (std::abs(x + 0.5 - 0.5 * image.width) < 0.05 * image.width &&
-          std::abs(y + 0.5 - 0.5 * image.height) < 0.05 * image.height) {
-        centre_sum += v;
-        ++centre_count;
-      }
-    }
-  }
-  const double centre = centre_count ? centre_sum / centre_count : 1.0;
-  if (std::abs(centre - 1.0) > 0.1) {
-    Log(1, "warning: flat-field image " + path + " averages " + std::to_string(centre) +
-               " at the image centre (expected about 1: radiance is divided by it as it is)");
-  }
-  std::lock_guard<std::mutex> lock(mutex);
-  cache[key] = flat;
-  return flat;
 }
 
 }  // namespace
@@ -145,7 +84,7 @@ struct RadianceReader::Impl {
   RadiometrySpec radiometry;
   std::string directory;
   int width = 0, height = 0;
-  bool table = false;            // use the lookup table (non-linear responses)
+  bool table = false;             // use the lookup table (non-linear responses)
   std::vector<double> to_linear;  // response^-1 at kTableIntervals + 1 nodes over [0, 1]
   std::shared_ptr<const FlatField> flat;
 
@@ -192,12 +131,9 @@ RadianceReader::RadianceReader(const Session& session) : impl_(std::make_unique<
 
 RadianceReader::~RadianceReader() = default;
 
-double RadianceReader::Linear(double encoded) const {
-  return impl_->ToLinear(encoded) - impl_->radiometry.black_level;
-}
+double RadianceReader::Linear(double encoded) const { return impl_->ToLinear(encoded) - impl_->radiometry.black_level; }
 
-RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, double min_signal,
-                                   double* decode_s) const {
+RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, double min_signal, double* decode_s) const {
   IBRDF_CHECK(!exposures.empty());
   IBRDF_CHECK(exposures.size() < 256) << exposures.size() << " exposures";
   const Impl& impl = *impl_;

@@ -7,10 +7,11 @@
 #include <limits>
 #include <random>
 
-#include <nlohmann/json.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <nlohmann/json.hpp>
 
+#include "align/markers.h"
 #include "core/brdf_coords.h"
 #include "core/error.h"
 #include "core/file_util.h"
@@ -18,11 +19,11 @@
 #include "core/light.h"
 #include "core/logging.h"
 #include "core/radiometry.h"
-#include "align/markers.h"
+#include "core/statistics.h"
 #include "derender/analytic_sample.h"
-#include "scan/ply_io.h"
 #include "derender/synthetic_radiometry.h"
 #include "derender/synthetic_targets.h"
+#include "scan/ply_io.h"
 
 namespace fs = std::filesystem;
 
@@ -67,10 +68,10 @@ Session BuildSession(const SynthOptions& options) {
   const double framed_radius = options.targets ? std::max(bounding_radius, options.platform_radius) : bounding_radius;
   const double half_angle = std::asin(std::min(1.0, framed_radius / options.camera_distance));
   const double focal = options.frame_fraction * 0.5 * std::min(options.width, options.height) / std::tan(half_angle);
-  session.camera = Camera::Create(CameraModelId::kOpenCV, options.width, options.height,
-                                  {focal, focal, 0.5 * options.width, 0.5 * options.height, options.k1,
-                                   options.k2, options.p1, options.p2},
-                                  "synth camera");
+  session.camera = Camera::Create(
+      CameraModelId::kOpenCV, options.width, options.height,
+      {focal, focal, 0.5 * options.width, 0.5 * options.height, options.k1, options.k2, options.p1, options.p2},
+      "synth camera");
 
   const CameraEffects& effects = options.effects;
   session.radiometry.response.kind = effects.srgb ? Response::Kind::kSrgb : Response::Kind::kLinear;
@@ -101,8 +102,8 @@ Session BuildSession(const SynthOptions& options) {
   for (int i = 0; i < options.num_photos; ++i) {
     const double t = options.num_photos == 1 ? 0.0 : double(i) / (options.num_photos - 1);
     const double azimuth = (options.arc_start_deg + t * (options.arc_end_deg - options.arc_start_deg)) * kDegree;
-    const Eigen::Vector3d direction(std::cos(elevation) * std::cos(azimuth),
-                                    std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+    const Eigen::Vector3d direction(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                                    std::sin(elevation));
     PhotoSpec photo;
     char name[32];
     std::snprintf(name, sizeof(name), "photos/%03d.%s", i, effects.bits == 0 ? "exr" : "png");
@@ -128,9 +129,10 @@ Session BuildSession(const SynthOptions& options) {
       // to 0.12 px, which the light's 2 m lever turns into millimetres).
       const Rigid3d roll(Eigen::Quaterniond(Eigen::AngleAxisd((10.0 + 4.0 * k) * kDegree, Eigen::Vector3d::UnitZ())),
                          Eigen::Vector3d::Zero());
-      photo.camera_from_world = roll * LookAtCameraFromWorld(options.origin + Eigen::Vector3d(-0.7, lateral, 0.55),
-                                                             options.origin + Eigen::Vector3d(0.35, -0.2 * lateral, -0.1),
-                                                             -Eigen::Vector3d::UnitY());
+      photo.camera_from_world =
+          roll * LookAtCameraFromWorld(options.origin + Eigen::Vector3d(-0.7, lateral, 0.55),
+                                       options.origin + Eigen::Vector3d(0.35, -0.2 * lateral, -0.1),
+                                       -Eigen::Vector3d::UnitY());
       session.photos.push_back(photo);
     }
   }
@@ -141,7 +143,8 @@ Session BuildSession(const SynthOptions& options) {
 // The platform plane's height: the sample rests on it.
 double PlatformHeight(const SynthOptions& options) {
   if (options.shape != SynthOptions::Shape::kNone) return options.origin.z() + MakeTrueShape(options)->LowestZ();
-  const double below = options.sample == SampleSpec::Kind::kCylinder ? 0.5 * options.cylinder_length : options.sample_radius;
+  const double below =
+      options.sample == SampleSpec::Kind::kCylinder ? 0.5 * options.cylinder_length : options.sample_radius;
   return options.origin.z() - below;
 }
 
@@ -151,9 +154,9 @@ struct Board {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d u_axis = Eigen::Vector3d::UnitX(), v_axis = Eigen::Vector3d::UnitY();  // in-plane, unit
-  double radius = 0.0;            // a disk of this radius when > 0, else a rectangle
+  double radius = 0.0;  // a disk of this radius when > 0, else a rectangle
   double half_u = 0.0, half_v = 0.0;
-  double background = 0.0;        // the board's value off the marker cards
+  double background = 0.0;  // the board's value off the marker cards
   std::vector<TargetSpec> markers;
   std::vector<std::vector<bool>> modules;
 };
@@ -161,7 +164,8 @@ struct Board {
 // The boards of a target session, and their appearance along a ray.
 class TargetScene {
  public:
-  explicit TargetScene(const SynthOptions& options) : options_(options), dictionary_(options.target_dictionary, "synth --target-dictionary") {
+  explicit TargetScene(const SynthOptions& options)
+      : options_(options), dictionary_(options.target_dictionary, "synth --target-dictionary") {
     Board platform;
     platform.center = Eigen::Vector3d(options.origin.x(), options.origin.y(), PlatformHeight(options));
     platform.radius = options.platform_radius;
@@ -345,17 +349,21 @@ Image RenderRadianceImpl(const Session& session, size_t photo_index, const Analy
 
 const char* SynthShapeName(SynthOptions::Shape shape) {
   switch (shape) {
-    case SynthOptions::Shape::kNone: return "none";
-    case SynthOptions::Shape::kSquash: return "squash";
-    case SynthOptions::Shape::kPot: return "pot";
-    case SynthOptions::Shape::kDent: return "dent";
+    case SynthOptions::Shape::kNone:
+      return "none";
+    case SynthOptions::Shape::kSquash:
+      return "squash";
+    case SynthOptions::Shape::kPot:
+      return "pot";
+    case SynthOptions::Shape::kDent:
+      return "dent";
   }
   return "none";
 }
 
 SynthOptions::Shape SynthShapeFromName(const std::string& name) {
-  for (SynthOptions::Shape shape : {SynthOptions::Shape::kNone, SynthOptions::Shape::kSquash,
-                                    SynthOptions::Shape::kPot, SynthOptions::Shape::kDent}) {
+  for (SynthOptions::Shape shape : {SynthOptions::Shape::kNone, SynthOptions::Shape::kSquash, SynthOptions::Shape::kPot,
+                                    SynthOptions::Shape::kDent}) {
     if (name == SynthShapeName(shape)) return shape;
   }
   ThrowError("synth shape", "unknown shape \"" + name + "\" (expected squash, pot or dent)");
@@ -363,10 +371,14 @@ SynthOptions::Shape SynthShapeFromName(const std::string& name) {
 
 std::unique_ptr<ImplicitSample> MakeTrueShape(const SynthOptions& options) {
   switch (options.shape) {
-    case SynthOptions::Shape::kNone: return nullptr;
-    case SynthOptions::Shape::kSquash: return std::make_unique<SquashSample>(options.origin, options.squash);
-    case SynthOptions::Shape::kPot: return std::make_unique<PotSample>(options.origin, options.pot);
-    case SynthOptions::Shape::kDent: return std::make_unique<DentedSphereSample>(options.origin, options.dent);
+    case SynthOptions::Shape::kNone:
+      return nullptr;
+    case SynthOptions::Shape::kSquash:
+      return std::make_unique<SquashSample>(options.origin, options.squash);
+    case SynthOptions::Shape::kPot:
+      return std::make_unique<PotSample>(options.origin, options.pot);
+    case SynthOptions::Shape::kDent:
+      return std::make_unique<DentedSphereSample>(options.origin, options.dent);
   }
   return nullptr;
 }
@@ -471,8 +483,8 @@ bool SynthOptions::Check(std::string* why) const {
     *why = "sample sizes must be positive";
     return false;
   }
-  double bounding = sample == SampleSpec::Kind::kCylinder ? std::hypot(sample_radius, 0.5 * cylinder_length)
-                                                          : sample_radius;
+  double bounding =
+      sample == SampleSpec::Kind::kCylinder ? std::hypot(sample_radius, 0.5 * cylinder_length) : sample_radius;
   if (shape != Shape::kNone) {
     if (!squash.Check(why) || !pot.Check(why) || !dent.Check(why) || !scanner.Check(why)) return false;
     if (!targets) {
@@ -530,10 +542,10 @@ bool SynthOptions::Check(std::string* why) const {
       *why = "targets: need 0 <= target_black < target_white <= 1";
       return false;
     }
-    if (light_target_photos < 0 || (light_target_photos > 0 &&
-                                    (light_marker_count < 1 || light_marker_first_id < target_count ||
-                                     !(light_marker_size > 0.0) || !(light_card_drop > 0.5 * light_marker_size *
-                                                                                           (1.0 + 2.0 * card_margin))))) {
+    if (light_target_photos < 0 ||
+        (light_target_photos > 0 &&
+         (light_marker_count < 1 || light_marker_first_id < target_count || !(light_marker_size > 0.0) ||
+          !(light_card_drop > 0.5 * light_marker_size * (1.0 + 2.0 * card_margin))))) {
       *why = "targets: light markers need ids above the ring's, a positive size, and a card below the light";
       return false;
     }
@@ -542,15 +554,17 @@ bool SynthOptions::Check(std::string* why) const {
   return effects.Check(why);
 }
 
-Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material,
-                     int supersample, std::vector<uint8_t>* hit_mask) {
+Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material, int supersample,
+                     std::vector<uint8_t>* hit_mask) {
   const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
-  return RenderRadianceImpl(session, photo_index, *sample, false, material, supersample, hit_mask, nullptr, Eigen::Vector3d::Zero());
+  return RenderRadianceImpl(session, photo_index, *sample, false, material, supersample, hit_mask, nullptr,
+                            Eigen::Vector3d::Zero());
 }
 
 Image RenderRadiance(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
                      const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask) {
-  return RenderRadianceImpl(session, photo_index, truth, shadow_rays, material, supersample, hit_mask, nullptr, Eigen::Vector3d::Zero());
+  return RenderRadianceImpl(session, photo_index, truth, shadow_rays, material, supersample, hit_mask, nullptr,
+                            Eigen::Vector3d::Zero());
 }
 
 namespace {
@@ -675,15 +689,15 @@ std::string SynthSummary::BriefReport() const {
   const int n = std::snprintf(buffer, sizeof(buffer), "synth: %d photos in %.2f s; %llu pixels clipped at saturation",
                               photos, total_s, static_cast<unsigned long long>(saturated_pixels));
   if (scan_views > 0) {
-    std::snprintf(buffer + n, sizeof(buffer) - n, "; %llu pixels in the shape's own shadow; %d range scans, %llu points",
-                  static_cast<unsigned long long>(shadowed_pixels), scan_views, static_cast<unsigned long long>(scan_points));
+    std::snprintf(
+        buffer + n, sizeof(buffer) - n, "; %llu pixels in the shape's own shadow; %d range scans, %llu points",
+        static_cast<unsigned long long>(shadowed_pixels), scan_views, static_cast<unsigned long long>(scan_points));
   }
   return buffer;
 }
 
 SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel& material,
-                                   const std::string& material_name, const std::string& out_dir,
-                                   bool overwrite) {
+                                   const std::string& material_name, const std::string& out_dir, bool overwrite) {
   Timer timer;
   std::string why;
   if (!options.Check(&why)) ThrowError("synth options", why);
@@ -708,8 +722,9 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   // Photos one after another; each renders and adds noise in parallel over rows.
   for (size_t i = 0; i < session.photos.size(); ++i) {
     std::vector<uint8_t> mask;
-    Image image = RenderRadianceImpl(session, i, *truth, shadow_rays, material, effects.supersample, &mask,
-                                     session.photos[i].role == PhotoRole::kMeasurement ? &shadowed : nullptr, fill_irradiance);
+    Image image =
+        RenderRadianceImpl(session, i, *truth, shadow_rays, material, effects.supersample, &mask,
+                           session.photos[i].role == PhotoRole::kMeasurement ? &shadowed : nullptr, fill_irradiance);
     // Auto-exposure: the 99th percentile of the brightest channel over the sample's pixels.
     std::vector<float> levels;
     for (size_t p = 0; p < mask.size(); ++p) {
@@ -720,9 +735,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
     }
     double reference = 1.0;
     if (!levels.empty()) {
-      const size_t k = static_cast<size_t>(0.99 * (levels.size() - 1));
-      std::nth_element(levels.begin(), levels.begin() + k, levels.end());
-      reference = levels[k];
+      reference = PercentileInPlace(&levels, 0.99);
     }
     PhotoSpec& photo = session.photos[i];
     photo.exposure_s *= options.exposure_target / reference;  // exposure_s holds the bracket's factor (1 without)
@@ -757,8 +770,8 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
       {"material_name", material_name},
       {"material", material.ToJson()},
       {"generator",
-       {{"sample", options.shape != SynthOptions::Shape::kNone ? SynthShapeName(options.shape)
-                                                               : SampleKindName(options.sample)},
+       {{"sample",
+         options.shape != SynthOptions::Shape::kNone ? SynthShapeName(options.shape) : SampleKindName(options.sample)},
         {"sample_radius", options.sample_radius},
         {"cylinder_length", options.cylinder_length},
         {"origin", ToJson(options.origin)},

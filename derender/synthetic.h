@@ -15,9 +15,9 @@
 #include "core/brdf_model.h"
 #include "core/image_io.h"
 #include "core/session.h"
+#include "derender/synthetic_radiometry.h"
 #include "derender/synthetic_shapes.h"
 #include "scan/synthetic_scan.h"
-#include "derender/synthetic_radiometry.h"
 
 namespace ibrdf {
 
@@ -44,16 +44,16 @@ struct CameraEffects {
 
 struct SynthOptions {
   SampleSpec::Kind sample = SampleSpec::Kind::kSphere;
-  double sample_radius = 0.04;     // metres (the paper's spheres were a few centimetres across)
+  double sample_radius = 0.04;  // metres (the paper's spheres were a few centimetres across)
   // Metres; the axis is vertical (world z), perpendicular to the plane of the light and cameras, so
   // every sample lies within about atan(length / 2 / camera_distance) of its incidence plane (the
   // paper's Figure 4: a short measured strip of a cylinder).
   double cylinder_length = 0.03;
   // Scene: the sample at `origin`, the light and cameras in the horizontal plane through it.
-  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // move the whole scene (far-from-origin tests)
-  double light_distance = 1.2;     // metres from the sample centre, along world +x
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();                  // move the whole scene (far-from-origin tests)
+  double light_distance = 1.2;                                       // metres from the sample centre, along world +x
   Eigen::Vector3d light_intensity = Eigen::Vector3d(1.0, 1.0, 1.0);  // RGB
-  double camera_distance = 0.8;    // metres from the sample centre
+  double camera_distance = 0.8;                                      // metres from the sample centre
   double camera_elevation_deg = 0.0;
   int num_photos = 20;
   // Camera azimuths from the light direction, evenly spaced: from beside the light to opposite it.
@@ -120,12 +120,12 @@ struct SynthOptions {
   SquashParams squash;
   PotParams pot;
   DentParams dent;
-  RangeScannerOptions scanner;      // the simulated range scan's views, spacing and noise
+  RangeScannerOptions scanner;  // the simulated range scan's views, spacing and noise
   // The scanner's frame: p_scan = R p_world + t, R a 35-degree turn about (1, 2, 3) and t of this length
   // along (0.6, -0.48, 0.64) (scanner coordinates are often far from the world's origin).
   double scan_offset_m = 2.0;
-  double scan_target_noise_m = 5e-5;  // the scanner's error on each marker-corner coordinate, one sigma
-  double truth_mesh_spacing_m = 5e-4; // truth-mesh.ply: surface sampling at the equator, metres
+  double scan_target_noise_m = 5e-5;   // the scanner's error on each marker-corner coordinate, one sigma
+  double truth_mesh_spacing_m = 5e-4;  // truth-mesh.ply: surface sampling at the equator, metres
 
   bool Check(std::string* why) const;
 };
@@ -142,8 +142,8 @@ Rigid3d ScanFromWorld(const SynthOptions& options);
 
 // Renders the ideal (noise-free, unclipped) radiance image of one photo; radiance is 0 off the sample.
 // `hit_mask` (optional) gets 1 where the pixel centre sees the sample.
-Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material,
-                     int supersample, std::vector<uint8_t>* hit_mask);
+Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material, int supersample,
+                     std::vector<uint8_t>* hit_mask);
 // The same for a given true shape; with `shadow_rays` a hit is lit only where the segment to the light
 // is free of the shape (non-convex truths cast shadows on themselves).
 Image RenderRadiance(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
@@ -169,7 +169,6 @@ struct SynthSummary {
   std::string BriefReport() const;
 };
 SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel& material,
-                                   const std::string& material_name, const std::string& out_dir,
-                                   bool overwrite);
+                                   const std::string& material_name, const std::string& out_dir, bool overwrite);
 
 }  // namespace ibrdf

@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <random>
 
-#include <nlohmann/json.hpp>
 #include <tbb/parallel_for.h>
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "core/file_util.h"
@@ -53,24 +53,27 @@ class BoardTexture {
 // A seeded view of the board: the camera at a random tilt and azimuth about the board's normal, aimed
 // near its centre, rolled, at a distance where the board spans a random fraction of the frame. The
 // board frame's z points into the print, so the camera sits on the -z side, the print's top (-y) up.
-Rigid3d RandomView(const Camera& camera, const CharucoPhotoOptions& options, const BoardTexture& texture, std::mt19937_64* rng) {
+Rigid3d RandomView(const Camera& camera, const CharucoPhotoOptions& options, const BoardTexture& texture,
+                   std::mt19937_64* rng) {
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const double fill = options.min_fill + (options.max_fill - options.min_fill) * uniform(*rng);
   const double distance = camera.FocalX() * texture.width_m() / (fill * camera.width);
   const double tilt = (10.0 + (options.max_tilt_deg - 10.0) * uniform(*rng)) * kDegree;
   const double azimuth = 2.0 * M_PI * uniform(*rng);
   const Eigen::Vector3d board_center(0.5 * texture.width_m(), 0.5 * texture.height_m(), 0.0);
-  const Eigen::Vector3d aim = board_center + Eigen::Vector3d((2.0 * uniform(*rng) - 1.0) * options.max_offset * texture.width_m(),
-                                                             (2.0 * uniform(*rng) - 1.0) * options.max_offset * texture.height_m(), 0.0);
-  const Eigen::Vector3d center =
-      aim + distance * Eigen::Vector3d(std::sin(tilt) * std::cos(azimuth), std::sin(tilt) * std::sin(azimuth), -std::cos(tilt));
+  const Eigen::Vector3d aim =
+      board_center + Eigen::Vector3d((2.0 * uniform(*rng) - 1.0) * options.max_offset * texture.width_m(),
+                                     (2.0 * uniform(*rng) - 1.0) * options.max_offset * texture.height_m(), 0.0);
+  const Eigen::Vector3d center = aim + distance * Eigen::Vector3d(std::sin(tilt) * std::cos(azimuth),
+                                                                  std::sin(tilt) * std::sin(azimuth), -std::cos(tilt));
   const double roll = (2.0 * uniform(*rng) - 1.0) * 30.0 * kDegree;
   const Eigen::Vector3d up(std::sin(roll), -std::cos(roll), 0.0);
   return LookAtCameraFromWorld(center, aim, up);
 }
 
 // Renders one photo's linear signal: the board plane z = 0 along each ray, distortion included.
-Image RenderBoard(const Camera& camera, const Rigid3d& camera_from_board, const BoardTexture& texture, int supersample) {
+Image RenderBoard(const Camera& camera, const Rigid3d& camera_from_board, const BoardTexture& texture,
+                  int supersample) {
   const Rigid3d board_from_camera = camera_from_board.Inverse();
   const Eigen::Matrix3d rotation = board_from_camera.rotation.toRotationMatrix();
   const Eigen::Vector3d origin = board_from_camera.translation;
@@ -96,7 +99,8 @@ Image RenderBoard(const Camera& camera, const Rigid3d& camera_from_board, const 
       if (c00 != c10 || c00 != c01 || c00 != c11) {
         double sum = 0.0;
         for (int sy = 0; sy < supersample; ++sy) {
-          for (int sx = 0; sx < supersample; ++sx) sum += value_at(x + (sx + 0.5) / supersample, y + (sy + 0.5) / supersample);
+          for (int sx = 0; sx < supersample; ++sx)
+            sum += value_at(x + (sx + 0.5) / supersample, y + (sy + 0.5) / supersample);
         }
         value = sum / (supersample * supersample);
       }
@@ -155,7 +159,8 @@ CharucoPhotosSummary WriteCharucoPhotos(const Camera& camera, const CharucoPhoto
         double v = image.at(x, y, 0);
         if (options.full_well_e > 0.0) {
           const double electrons = v * options.full_well_e;
-          v = (electrons + std::sqrt(electrons) * normal(row_rng) + options.read_noise_e * normal(row_rng)) / options.full_well_e;
+          v = (electrons + std::sqrt(electrons) * normal(row_rng) + options.read_noise_e * normal(row_rng)) /
+              options.full_well_e;
         }
         image.at(x, y, 0) = static_cast<float>(std::clamp(v, 0.0, 1.0));
       }
@@ -164,9 +169,10 @@ CharucoPhotosSummary WriteCharucoPhotos(const Camera& camera, const CharucoPhoto
     std::snprintf(name, sizeof(name), "charuco-%03d.png", i);
     WriteImage((fs::path(directory.temporary_path()) / name).string(), image, PixelFormat::kUint8);
     const Eigen::Quaterniond& q = camera_from_board.rotation;
-    photos.push_back({{"file", name},
-                      {"camera_from_board",
-                       {{"rotation", {q.w(), q.x(), q.y(), q.z()}}, {"translation", ToJson(camera_from_board.translation)}}}});
+    photos.push_back(
+        {{"file", name},
+         {"camera_from_board",
+          {{"rotation", {q.w(), q.x(), q.y(), q.z()}}, {"translation", ToJson(camera_from_board.translation)}}}});
     progress.Add(1);
   }
   progress.Finish();

@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/light.h"
 #include "core/radiometry.h"
+#include "core/statistics.h"
 #include "derender/synthetic.h"
 
 namespace fs = std::filesystem;
@@ -106,7 +107,8 @@ void ExpandBrackets(const SynthOptions& options, Session* session) {
     const fs::path file(photo.file);
     for (int k = 0; k < radiometry.brackets; ++k) {
       PhotoSpec exposure = photo;
-      exposure.file = (file.parent_path() / (file.stem().string() + "-e" + std::to_string(k) + file.extension().string())).string();
+      exposure.file =
+          (file.parent_path() / (file.stem().string() + "-e" + std::to_string(k) + file.extension().string())).string();
       exposure.bracket = pose;
       exposure.exposure_s = std::exp2(-radiometry.bracket_step_ev * k);
       photos.push_back(exposure);
@@ -136,8 +138,8 @@ Image RenderWhiteReference(const Session& session, const Rigid3d& camera_from_wo
       Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
       for (int sy = 0; sy < supersample; ++sy) {
         for (int sx = 0; sx < supersample; ++sx) {
-          const Eigen::Vector2d xy = camera.CamPlaneFromImage(
-              Eigen::Vector2d(x + (sx + 0.5) / supersample, y + (sy + 0.5) / supersample));
+          const Eigen::Vector2d xy =
+              camera.CamPlaneFromImage(Eigen::Vector2d(x + (sx + 0.5) / supersample, y + (sy + 0.5) / supersample));
           const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
           const double denominator = direction.dot(white.normal);
           if (!(denominator < 0.0)) continue;
@@ -204,18 +206,17 @@ void WriteSynthCalibration(const SynthOptions& options, const std::string& direc
       if (mask[p]) levels.push_back(std::max({image.pixels[3 * p], image.pixels[3 * p + 1], image.pixels[3 * p + 2]}));
     }
     IBRDF_CHECK(!levels.empty()) << "the white reference is out of view";
-    const size_t k = static_cast<size_t>(0.99 * (levels.size() - 1));
-    std::nth_element(levels.begin(), levels.begin() + k, levels.end());
+    const double level = PercentileInPlace(&levels, 0.99);
     PhotoSpec photo;
     photo.file = std::string("calibration/white-000.") + (effects.bits == 0 ? "exr" : "png");
     photo.camera_from_world = first->camera_from_world;
-    photo.exposure_s = radiometry.white_exposure_scale * options.exposure_target / levels[k];
+    photo.exposure_s = radiometry.white_exposure_scale * options.exposure_target / level;
     photo.gain = 1.0;
     for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
     ApplyVignetting(session->camera, effects.vignetting, &image);
     SimulateSensor(effects, options.seed, 0xFFFFull, &image);
     fs::create_directories(fs::path(directory) / "calibration");
-    const PixelFormat format = effects.bits == 0 ? PixelFormat::kFloat
+    const PixelFormat format = effects.bits == 0   ? PixelFormat::kFloat
                                : effects.bits <= 8 ? PixelFormat::kUint8
                                                    : PixelFormat::kUint16;
     WriteImage((fs::path(directory) / photo.file).string(), image, format);

@@ -22,8 +22,7 @@ Eigen::Vector3d FromPolar(double theta, double phi) {
 // ---------------------------------------------------------------------------------------------------
 // ImplicitSample
 
-bool ImplicitSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                               SurfaceHit* hit) const {
+bool ImplicitSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const {
   const Eigen::Vector3d f = origin - center_;
   // The bounding sphere's span of the ray (Haines et al.'s closest-approach form, as for the sphere).
   const double b = f.dot(direction);
@@ -77,9 +76,7 @@ bool ImplicitSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vecto
   }
 }
 
-bool ImplicitSample::Contains(const Eigen::Vector3d& point) const {
-  return Evaluate(point - center_, nullptr) <= 0.0;
-}
+bool ImplicitSample::Contains(const Eigen::Vector3d& point) const { return Evaluate(point - center_, nullptr) <= 0.0; }
 
 Eigen::Vector3d ImplicitSample::RadialPoint(const Eigen::Vector3d& u, Eigen::Vector3d* normal) const {
   // Star-shaped about the centre: the ray from outside towards the centre meets the surface once.
@@ -271,8 +268,8 @@ PotSample::PotSample(const Eigen::Vector3d& center, const PotParams& params) : I
   std::string why;
   if (!params.Check(&why)) ThrowError("synthetic pot", why);
   const PotParams& p = params;
-  hexagon_ = {{-p.foot_radius, p.bottom_z}, {p.foot_radius, p.bottom_z},  {p.body_radius, p.cone_top_z},
-              {p.body_radius, p.top_z},     {-p.body_radius, p.top_z},    {-p.body_radius, p.cone_top_z}};
+  hexagon_ = {{-p.foot_radius, p.bottom_z}, {p.foot_radius, p.bottom_z}, {p.body_radius, p.cone_top_z},
+              {p.body_radius, p.top_z},     {-p.body_radius, p.top_z},   {-p.body_radius, p.cone_top_z}};
   double far = 0.0;
   for (const Eigen::Vector2d& v : hexagon_) far = std::max(far, v.norm());
   bounding_radius_ = 1.001 * (far + p.fillet) + 1e-6;
@@ -314,7 +311,8 @@ double PotSample::Evaluate(const Eigen::Vector3d& local, Eigen::Vector3d* gradie
   Eigen::Vector2d g;
   const double value = Profile(Eigen::Vector2d(rho, local.z()), gradient ? &g : nullptr) - params_.fillet;
   if (gradient) {
-    const Eigen::Vector2d radial = rho > 1e-15 ? Eigen::Vector2d(local.x() / rho, local.y() / rho) : Eigen::Vector2d::Zero();
+    const Eigen::Vector2d radial =
+        rho > 1e-15 ? Eigen::Vector2d(local.x() / rho, local.y() / rho) : Eigen::Vector2d::Zero();
     *gradient = Eigen::Vector3d(g.x() * radial.x(), g.x() * radial.y(), g.y());
   }
   return value;

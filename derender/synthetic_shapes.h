@@ -29,8 +29,7 @@ class ImplicitSample : public AnalyticSample {
 
   explicit ImplicitSample(const Eigen::Vector3d& center) : center_(center) {}
 
-  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                 SurfaceHit* hit) const override;
+  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const override;
   bool Contains(const Eigen::Vector3d& point) const override;
   Eigen::Vector3d BoundingCenter() const override { return center_; }
   double BoundingRadius() const override { return bounding_radius_; }
@@ -79,9 +78,9 @@ class StarShapedSample : public ImplicitSample {
 // the polar angle; the stem term is C1 at u_z = stem_cos.
 struct SquashParams {
   Eigen::Vector3d semi_axes = Eigen::Vector3d(0.046, 0.042, 0.036);  // metres: x, y, z (z up)
-  double asymmetry = 0.06;        // the +x side fuller by this fraction
-  int ribs = 8;                   // ribs around the vertical axis
-  double rib_depth = 0.012;       // relative amplitude of the ribs at the equator
+  double asymmetry = 0.06;                                           // the +x side fuller by this fraction
+  int ribs = 8;                                                      // ribs around the vertical axis
+  double rib_depth = 0.012;                                          // relative amplitude of the ribs at the equator
   double stem_flattening = 0.12;  // relative flattening at the top pole (0.12: nearly flat, still convex)
   double stem_cos = 0.5;          // flattening starts at this u_z (60 degrees from the pole)
   bool Check(std::string* why) const;
@@ -101,9 +100,9 @@ class SquashSample : public StarShapedSample {
 // (1 - cos(dent_half_angle)) clamped to [0, 1], s(w) = w^2 (3 - 2 w) (smoothstep: flat at the rim and
 // at the bottom). Not convex: the dent's rim shadows its floor when the light comes from the side.
 struct DentParams {
-  double radius = 0.045;                 // metres
-  double depth = 0.4;                    // dent depth as a fraction of the radius
-  double dent_half_angle_deg = 32.0;     // angular radius of the dent seen from the centre
+  double radius = 0.045;              // metres
+  double depth = 0.4;                 // dent depth as a fraction of the radius
+  double dent_half_angle_deg = 32.0;  // angular radius of the dent seen from the centre
   // Dent axis (local frame, normalized on use): 70 degrees round from the light (+x) towards the
   // synth cameras' arc and 25 degrees up, so cameras see it and the light grazes it from the side.
   Eigen::Vector3d axis = Eigen::Vector3d(0.3100, 0.8517, 0.4226);
@@ -132,12 +131,12 @@ class DentedSphereSample : public StarShapedSample {
 // distance (the 2D distance in the meridian plane), so L = 1. Outer size: radius body_radius + fillet,
 // height top_z - bottom_z + 2 fillet.
 struct PotParams {
-  double foot_radius = 0.026;   // metres (hexagon)
-  double body_radius = 0.038;   // metres (hexagon; the cylinder's radius is this + fillet)
-  double bottom_z = -0.036;     // metres, relative to the centre
-  double cone_top_z = -0.004;   // where the cone meets the cylinder
+  double foot_radius = 0.026;  // metres (hexagon)
+  double body_radius = 0.038;  // metres (hexagon; the cylinder's radius is this + fillet)
+  double bottom_z = -0.036;    // metres, relative to the centre
+  double cone_top_z = -0.004;  // where the cone meets the cylinder
   double top_z = 0.036;
-  double fillet = 0.005;        // metres: the rounding radius of every edge
+  double fillet = 0.005;  // metres: the rounding radius of every edge
   bool Check(std::string* why) const;
 };
 

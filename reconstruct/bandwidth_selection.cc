@@ -52,8 +52,8 @@ std::string BandwidthSelection::BriefReport() const {
   std::snprintf(buffer, sizeof(buffer),
                 "bandwidth by %s: scale %.2f, radii %.2f x %.2f deg (criterion %.4f, %zu candidates, %zu samples "
                 "each, %.1f s)",
-                BandwidthCriterionName(criterion), b.scale, b.radius_h_deg, b.radius_d_deg, b.criterion,
-                curve.size(), b.score.points, seconds);
+                BandwidthCriterionName(criterion), b.scale, b.radius_h_deg, b.radius_d_deg, b.criterion, curve.size(),
+                b.score.points, seconds);
   return buffer;
 }
 
@@ -87,8 +87,8 @@ BandwidthSelection SelectBandwidth(const std::vector<BrdfSample>& samples, const
     trial.radius_d_deg = candidate.radius_d_deg = std::min(90.0, base.radius_d_deg * scale);
     const LocalRegression regression(samples, trial);
     candidate.score = regression.CrossValidate(options.samples, options.seed);
-    candidate.criterion = options.criterion == BandwidthCriterion::kLeaveOneOut ? candidate.score.loo_rms
-                                                                                 : candidate.score.gcv_rms;
+    candidate.criterion =
+        options.criterion == BandwidthCriterion::kLeaveOneOut ? candidate.score.loo_rms : candidate.score.gcv_rms;
     if (candidate.criterion < best) {
       best = candidate.criterion;
       selection.best = selection.curve.size();

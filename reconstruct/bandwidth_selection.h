@@ -27,8 +27,8 @@
 namespace ibrdf {
 
 enum class BandwidthCriterion {
-  kLeaveOneOut,                  // "loo"
-  kGeneralizedCrossValidation,   // "gcv"
+  kLeaveOneOut,                 // "loo"
+  kGeneralizedCrossValidation,  // "gcv"
 };
 // "loo" or "gcv"; false otherwise.
 bool ParseBandwidthCriterion(const std::string& name, BandwidthCriterion* criterion);
@@ -55,9 +55,9 @@ struct BandwidthCandidate {
 struct BandwidthSelection {
   bool success = false;
   BandwidthCriterion criterion = BandwidthCriterion::kLeaveOneOut;
-  LocalRegressionOptions selected;      // the base options with the best candidate's radii
+  LocalRegressionOptions selected;        // the base options with the best candidate's radii
   std::vector<BandwidthCandidate> curve;  // every candidate, in the order of `scales`
-  size_t best = 0;                       // index into curve
+  size_t best = 0;                        // index into curve
   double seconds = 0.0;
   std::string BriefReport() const;
   // The criterion curve, one line per candidate, for the log.

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/statistics.h"
 
 namespace ibrdf {
 namespace {
@@ -47,13 +48,6 @@ Eigen::Vector3d EstimateAtCenter(const std::vector<const BrdfSample*>& members, 
   // A local linear fit can extrapolate across an empty half of the bin; fall back to the mean there.
   if (!estimate.allFinite() || (estimate.array() <= 0.0).any()) estimate = values.colwise().mean().transpose();
   return estimate;
-}
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  const size_t k = static_cast<size_t>(q * (values.size() - 1) + 0.5);
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
 }
 
 void Summarize(ConsistencyFigure* figure) {

@@ -21,20 +21,20 @@ namespace ibrdf {
 struct ConsistencyOptions {
   // Bins wide enough that camera noise averages out (a bin of the default synthetic sphere session
   // holds thousands of samples); the local linear fit removes the BRDF's slope across them.
-  double theta_bin_deg = 10.0;     // bin width in theta_i and theta_e
-  double phi_bin_deg = 20.0;       // bin width in delta_phi
-  int min_samples_per_bin = 50;    // a bin with fewer samples is not compared
-  double max_theta_deg = 80.0;     // bins beyond this are not compared
+  double theta_bin_deg = 10.0;   // bin width in theta_i and theta_e
+  double phi_bin_deg = 20.0;     // bin width in delta_phi
+  int min_samples_per_bin = 50;  // a bin with fewer samples is not compared
+  double max_theta_deg = 80.0;   // bins beyond this are not compared
   bool Check(std::string* why) const;
 };
 
 // One compared pair of bins.
 struct BinComparison {
-  Eigen::Vector3d center_deg;       // (theta_i, theta_e, delta_phi) of the first bin's centre
-  int count_a = 0, count_b = 0;     // samples in the two bins
-  Eigen::Vector3d value_a, value_b; // RGB estimates at the bin centres (1/sr)
-  Eigen::Vector3d rel_error;        // per channel, |a - b| / ((a + b) / 2)
-  double mean_rel_error = 0.0;      // over the channels
+  Eigen::Vector3d center_deg;        // (theta_i, theta_e, delta_phi) of the first bin's centre
+  int count_a = 0, count_b = 0;      // samples in the two bins
+  Eigen::Vector3d value_a, value_b;  // RGB estimates at the bin centres (1/sr)
+  Eigen::Vector3d rel_error;         // per channel, |a - b| / ((a + b) / 2)
+  double mean_rel_error = 0.0;       // over the channels
 };
 
 struct ConsistencyFigure {

@@ -8,12 +8,12 @@
 #include <mutex>
 #include <random>
 
-#include <Eigen/Cholesky>
-#include <nanoflann.hpp>
-#include <nlohmann/json.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
+#include <Eigen/Cholesky>
+#include <nanoflann.hpp>
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 
@@ -49,9 +49,9 @@ struct Mirror {
 // squared weights, as that many samples at one place would.
 struct NormalEquations {
   const float* xyz = nullptr;
-  const float* values = nullptr;       // mean value of each point
-  const float* ranges = nullptr;       // low[3], high[3] of each point's samples
-  const uint32_t* counts = nullptr;    // samples of each point
+  const float* values = nullptr;     // mean value of each point
+  const float* ranges = nullptr;     // low[3], high[3] of each point's samples
+  const uint32_t* counts = nullptr;  // samples of each point
   // Leave-one-out: the point holding the left-out sample, and that sample's position and value, which
   // are taken out of the point's statistics.
   int64_t exclude = -1;
@@ -71,8 +71,8 @@ struct NormalEquations {
   double b[kMaxCoefficients][3] = {};
   double sum_w = 0.0, sum_w2 = 0.0;
   float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};  // range of the neighbours' values
-  uint32_t count = 0;   // samples with non-zero weight
-  uint32_t points = 0;  // points (bins) with non-zero weight
+  uint32_t count = 0;                             // samples with non-zero weight
+  uint32_t points = 0;                            // points (bins) with non-zero weight
 
   // nanoflann's result-set interface.
   float worstDist() const { return radius_squared; }
@@ -145,10 +145,10 @@ struct NormalEquations {
 }  // namespace
 
 struct LocalRegression::Impl {
-  Cloud cloud;                  // the points: bin centroids (every sample without binning), scaled
-  std::vector<float> values;    // 3 a point: mean value (log f in log space)
-  std::vector<float> ranges;    // 6 a point: low[3], high[3] of its samples' values
-  std::vector<uint32_t> counts; // samples a point
+  Cloud cloud;                   // the points: bin centroids (every sample without binning), scaled
+  std::vector<float> values;     // 3 a point: mean value (log f in log space)
+  std::vector<float> ranges;     // 6 a point: low[3], high[3] of its samples' values
+  std::vector<uint32_t> counts;  // samples a point
   // Every kept sample (scaled, folded coordinates and value) and the point it went to, for
   // leave-one-out.
   std::vector<float> sample_xyz, sample_values;
@@ -225,10 +225,18 @@ bool InMeasuredDomain(const Estimate& e) {
 void ReliabilityCounts::Add(const Estimate& e) {
   ++evaluations;
   switch (e.status) {
-    case EstimateStatus::kFull: ++full; break;
-    case EstimateStatus::kReducedDegree: ++reduced_degree; break;
-    case EstimateStatus::kGrown: ++grown; break;
-    case EstimateStatus::kUnsupported: ++unsupported; break;
+    case EstimateStatus::kFull:
+      ++full;
+      break;
+    case EstimateStatus::kReducedDegree:
+      ++reduced_degree;
+      break;
+    case EstimateStatus::kGrown:
+      ++grown;
+      break;
+    case EstimateStatus::kUnsupported:
+      ++unsupported;
+      break;
   }
   clamped += e.clamped;
   mean_effective_samples += (e.effective_samples - mean_effective_samples) / double(evaluations);
@@ -260,9 +268,12 @@ std::string ReliabilityCounts::Brief() const {
 }
 
 nlohmann::json ToJson(const ReliabilityCounts& counts) {
-  return {{"evaluations", counts.evaluations},   {"full", counts.full},
-          {"reduced_degree", counts.reduced_degree}, {"grown_support", counts.grown},
-          {"unsupported", counts.unsupported},   {"clamped_negative", counts.clamped},
+  return {{"evaluations", counts.evaluations},
+          {"full", counts.full},
+          {"reduced_degree", counts.reduced_degree},
+          {"grown_support", counts.grown},
+          {"unsupported", counts.unsupported},
+          {"clamped_negative", counts.clamped},
           {"mean_effective_samples", counts.mean_effective_samples}};
 }
 

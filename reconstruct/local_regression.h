@@ -41,15 +41,15 @@
 namespace ibrdf {
 
 struct LocalRegressionOptions {
-  int degree = 2;                 // 0 local constant, 1 local linear, 2 local quadratic
-  double radius_h_deg = 2.5;      // kernel radius along the sheets, in u and v (degrees of theta_h)
-  double radius_d_deg = 9.0;      // kernel radius across the sheets, in w = theta_d (degrees)
-  bool fold_reciprocity = true;   // assume f(wi, wo) = f(wo, wi) and pool both halves
-  bool fold_bilateral = true;     // assume f(delta_phi) = f(-delta_phi) and pool both halves
+  int degree = 2;                // 0 local constant, 1 local linear, 2 local quadratic
+  double radius_h_deg = 2.5;     // kernel radius along the sheets, in u and v (degrees of theta_h)
+  double radius_d_deg = 9.0;     // kernel radius across the sheets, in w = theta_d (degrees)
+  bool fold_reciprocity = true;  // assume f(wi, wo) = f(wo, wi) and pool both halves
+  bool fold_bilateral = true;    // assume f(delta_phi) = f(-delta_phi) and pool both halves
   // Fit log f instead of f (a Phong/Lafortune lobe is close to exp of a quadratic); samples <= 0 are
   // clamped to `log_floor` first. On by default: 0.84 % against 1.63 % RMS on noise-free bluepaint.
   bool log_space = true;
-  double log_floor = 1e-6;        // 1/sr
+  double log_floor = 1e-6;  // 1/sr
   // A degree is used only if the normal matrix's reciprocal condition (LDLT estimate) is above this and
   // the effective sample count is at least `min_samples_per_coefficient` times the coefficient count;
   // otherwise the next lower degree is tried.
@@ -94,23 +94,23 @@ struct Estimate {
   // 1 / sum l_i^2 for the estimate sum l_i f_i: how many samples' worth of noise averaging the fit
   // achieves ((sum w)^2 / sum w^2 for a local constant).
   float effective_samples = 0.0f;
-  float rcond = 0.0f;              // reciprocal condition estimate of the normal matrix used
-  float growth = 1.0f;             // factor applied to the radii (1 = as given)
+  float rcond = 0.0f;   // reciprocal condition estimate of the normal matrix used
+  float growth = 1.0f;  // factor applied to the radii (1 = as given)
   // Distance from the query to the weighted centroid of the samples in its kernel, in kernel radii (as
   // given, before growth). Inside sampled territory it is small; a query beside a single sheet (a
   // cylinder's incidence plane) or beyond the edge of the data is an extrapolation and has a large one.
   float centroid_offset = 0.0f;
-  uint32_t neighbors = 0;          // samples with non-zero weight (mirrored images included)
-  int8_t degree = -1;              // degree used; -1 when unsupported
+  uint32_t neighbors = 0;  // samples with non-zero weight (mirrored images included)
+  int8_t degree = -1;      // degree used; -1 when unsupported
   EstimateStatus status = EstimateStatus::kUnsupported;
-  bool clamped = false;            // a negative estimate was clamped to 0
+  bool clamped = false;  // a negative estimate was clamped to 0
 };
 
 // Cross-validation figures of one fit, each averaged over a subset of the samples and the 3 channels.
 // Residuals are taken in the fitting space: r_i = log f^(x_i) - log f_i with log values (about the
 // relative error), (f^(x_i) - f_i) / max(f_i, 1e-4) with linear values.
 struct CrossValidationScore {
-  size_t points = 0;           // samples scored
+  size_t points = 0;  // samples scored
   // Leave-one-out: RMS of the residual of the fit without sample i, at x_i.
   double loo_rms = 0.0;
   // RMS of the ordinary residual (sample i in the fit).
@@ -157,9 +157,7 @@ class LocalRegression {
   Estimate Evaluate(const HalfDiffAngles& angles) const;
   // At regression coordinates (u, v, w); `exclude` is a sample index left out of the fit (for
   // leave-one-out), or -1.
-  Estimate EvaluateAt(const Eigen::Vector3d& uvw, int64_t exclude = -1) const {
-    return Fit(uvw, exclude, -1, nullptr);
-  }
+  Estimate EvaluateAt(const Eigen::Vector3d& uvw, int64_t exclude = -1) const { return Fit(uvw, exclude, -1, nullptr); }
   // Many points, TBB-parallel; `counts` (optional) gets their reliability counts.
   std::vector<Estimate> EvaluateMany(const std::vector<Eigen::Vector3d>& uvw, ReliabilityCounts* counts) const;
 
@@ -167,8 +165,8 @@ class LocalRegression {
   // reconstruct/bandwidth_selection.h); the left-out sample is taken out of its bin exactly.
   CrossValidationScore CrossValidate(size_t count, uint64_t seed = 1) const;
 
-  size_t size() const;            // samples used
-  size_t points() const;          // points in the kd-tree: occupied bins (or samples without binning)
+  size_t size() const;    // samples used
+  size_t points() const;  // points in the kd-tree: occupied bins (or samples without binning)
   uint64_t skipped_samples() const { return skipped_; }
   const LocalRegressionOptions& options() const { return options_; }
 

@@ -100,7 +100,8 @@ MerlTable ReadMerl(const std::string& path) {
     ThrowError(path, "size " + std::to_string(size) + " bytes, expected " + std::to_string(expected));
   }
   MerlTable table;
-  in.read(reinterpret_cast<char*>(table.stored().data()), static_cast<std::streamsize>(3 * kMerlCells * sizeof(double)));
+  in.read(reinterpret_cast<char*>(table.stored().data()),
+          static_cast<std::streamsize>(3 * kMerlCells * sizeof(double)));
   if (!in) ThrowError(path, "read failed");
   return table;
 }

@@ -44,7 +44,9 @@ class MerlTable {
 
   // The cell's RGB BRDF in 1/sr (stored * scale); negative when unmeasured.
   Eigen::Vector3d Cell(size_t flat) const;
-  bool Measured(size_t flat) const { return stored_[flat] >= 0.0 && stored_[flat + kMerlCells] >= 0.0 && stored_[flat + 2 * kMerlCells] >= 0.0; }
+  bool Measured(size_t flat) const {
+    return stored_[flat] >= 0.0 && stored_[flat + kMerlCells] >= 0.0 && stored_[flat + 2 * kMerlCells] >= 0.0;
+  }
   void SetCell(size_t flat, const Eigen::Vector3d& brdf);
   void SetUnmeasured(size_t flat);
   // As BRDFRead.cpp's lookup_brdf_val: the cell of (wi, wo) in the local frame; negative if unmeasured.
@@ -63,18 +65,18 @@ void WriteMerl(const std::string& path, const MerlTable& table);
 MerlTable ReadMerl(const std::string& path);
 
 struct TabulateOptions {
-  double max_theta_deg = 90.0;        // cells with theta_i or theta_e beyond this are unmeasured (-1)
-  float min_effective_samples = 0.0f; // cells whose estimate has fewer are marked unmeasured
+  double max_theta_deg = 90.0;         // cells with theta_i or theta_e beyond this are unmeasured (-1)
+  float min_effective_samples = 0.0f;  // cells whose estimate has fewer are marked unmeasured
   bool Check(std::string* why) const;
 };
 
 struct TabulateSummary {
   bool success = false;
-  ReliabilityCounts reliability;      // of the evaluated cells
-  uint64_t cells_measured = 0;        // cells with a value
-  uint64_t cells_below_horizon = 0;   // beyond max_theta_deg (or the horizon)
-  uint64_t cells_unsupported = 0;     // evaluated but left unmeasured (no samples, too few)
-  uint64_t evaluations = 0;           // distinct regression evaluations (bilateral mirrors share one)
+  ReliabilityCounts reliability;     // of the evaluated cells
+  uint64_t cells_measured = 0;       // cells with a value
+  uint64_t cells_below_horizon = 0;  // beyond max_theta_deg (or the horizon)
+  uint64_t cells_unsupported = 0;    // evaluated but left unmeasured (no samples, too few)
+  uint64_t evaluations = 0;          // distinct regression evaluations (bilateral mirrors share one)
   double seconds = 0.0;
   std::string BriefReport() const;
 };

@@ -15,7 +15,9 @@ template <int kLobes>
 struct LafortuneResidual {
   static constexpr int kParameters = 1 + 3 * kLobes;
   LafortuneResidual(const Eigen::Vector3d& wi_in, const Eigen::Vector3d& wo_in, double value_in, double sigma)
-      : xy(wi_in.x() * wo_in.x() + wi_in.y() * wo_in.y()), z(wi_in.z() * wo_in.z()), value(value_in),
+      : xy(wi_in.x() * wo_in.x() + wi_in.y() * wo_in.y()),
+        z(wi_in.z() * wo_in.z()),
+        value(value_in),
         inv_sigma(1.0 / sigma) {}
 
   template <class T>

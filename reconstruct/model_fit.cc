@@ -44,7 +44,8 @@ std::vector<FitSample> PickSamples(const std::vector<BrdfSample>& samples, const
     if (!(f.wi.z() > 0.0 && f.wo.z() > 0.0)) continue;
     for (int c = 0; c < 3; ++c) {
       f.value[c] = s.brdf[c];
-      f.sigma[c] = std::max({double(s.sigma[c]), options.relative_floor * std::abs(f.value[c]), options.absolute_floor});
+      f.sigma[c] =
+          std::max({double(s.sigma[c]), options.relative_floor * std::abs(f.value[c]), options.absolute_floor});
     }
     picked.push_back(f);
   }
@@ -83,10 +84,9 @@ double SolveLafortuneChannel(const std::vector<FitSample>& samples, int channel,
   using Residual = LafortuneResidual<kLobes>;
   ceres::Problem problem;
   for (const FitSample& s : samples) {
-    problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<Residual, 1, Residual::kParameters>(
-            new Residual(s.wi, s.wo, s.value[channel], s.sigma[channel])),
-        new ceres::HuberLoss(options.huber_scale), parameters);
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Residual, 1, Residual::kParameters>(
+                                 new Residual(s.wi, s.wo, s.value[channel], s.sigma[channel])),
+                             new ceres::HuberLoss(options.huber_scale), parameters);
   }
   problem.SetParameterLowerBound(parameters, 0, 0.0);
   for (int k = 0; k < kLobes; ++k) {
@@ -103,8 +103,8 @@ double SolveLafortuneChannel(const std::vector<FitSample>& samples, int channel,
 }
 
 template <int kLobes>
-std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& samples,
-                                                 const ModelFitOptions& options, double* cost, int* starts) {
+std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& samples, const ModelFitOptions& options,
+                                                 double* cost, int* starts) {
   // Starting lobes: a forward (specular) lobe, a retro-reflective one and a broad one, in several
   // sharpnesses; every channel keeps the best of its starts.
   const double starts_table[][3][3] = {
@@ -180,9 +180,15 @@ ModelFitResult FitLafortune(const std::vector<BrdfSample>& samples, const ModelF
     ThrowError("lafortune fit", "only " + std::to_string(picked.size()) + " usable samples");
   }
   switch (options.lafortune_lobes) {
-    case 1: result.brdf = FitLafortuneLobes<1>(picked, options, &result.final_cost, &result.starts); break;
-    case 2: result.brdf = FitLafortuneLobes<2>(picked, options, &result.final_cost, &result.starts); break;
-    default: result.brdf = FitLafortuneLobes<3>(picked, options, &result.final_cost, &result.starts); break;
+    case 1:
+      result.brdf = FitLafortuneLobes<1>(picked, options, &result.final_cost, &result.starts);
+      break;
+    case 2:
+      result.brdf = FitLafortuneLobes<2>(picked, options, &result.final_cost, &result.starts);
+      break;
+    default:
+      result.brdf = FitLafortuneLobes<3>(picked, options, &result.final_cost, &result.starts);
+      break;
   }
   result.rel_rms = RelativeRms(*result.brdf, picked);
   result.seconds = timer.ElapsedSeconds();
@@ -212,9 +218,9 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
     }
     ceres::Problem problem;
     for (const FitSample& s : picked) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<GgxResidual, 3, 3, 3, 1>(
-                                   new GgxResidual(s.wi, s.wo, s.value, s.sigma)),
-                               new ceres::HuberLoss(options.huber_scale), diffuse, f0, alpha);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<GgxResidual, 3, 3, 3, 1>(new GgxResidual(s.wi, s.wo, s.value, s.sigma)),
+          new ceres::HuberLoss(options.huber_scale), diffuse, f0, alpha);
     }
     for (int c = 0; c < 3; ++c) {
       problem.SetParameterLowerBound(diffuse, c, 0.0);

@@ -18,25 +18,25 @@
 namespace ibrdf {
 
 struct ModelFitOptions {
-  int lafortune_lobes = 3;        // 1 to 3 lobes
-  size_t max_samples = 40000;     // a random subset (fixed seed) of at most this many samples is fitted
-  double relative_floor = 0.01;   // sigma is at least this fraction of the value (noise-free samples)
-  double absolute_floor = 1e-4;   // and at least this (1/sr)
-  double huber_scale = 3.0;       // Huber loss threshold, in sigmas
-  int max_iterations = 200;       // per Ceres solve
-  double max_theta_deg = 80.0;    // samples beyond this theta_i or theta_e are left out
+  int lafortune_lobes = 3;       // 1 to 3 lobes
+  size_t max_samples = 40000;    // a random subset (fixed seed) of at most this many samples is fitted
+  double relative_floor = 0.01;  // sigma is at least this fraction of the value (noise-free samples)
+  double absolute_floor = 1e-4;  // and at least this (1/sr)
+  double huber_scale = 3.0;      // Huber loss threshold, in sigmas
+  int max_iterations = 200;      // per Ceres solve
+  double max_theta_deg = 80.0;   // samples beyond this theta_i or theta_e are left out
   uint64_t seed = 1;
   bool Check(std::string* why) const;
 };
 
 struct ModelFitResult {
   bool success = false;
-  std::string model;              // "lafortune" or "ggx"
+  std::string model;  // "lafortune" or "ggx"
   std::unique_ptr<BrdfModel> brdf;
   size_t samples_used = 0;
-  double final_cost = 0.0;        // Ceres cost, summed over the channel fits
-  double rel_rms = 0.0;           // RMS of (f_fit - f) / f over the samples used and channels
-  int starts = 0;                 // initial guesses tried (the best is kept)
+  double final_cost = 0.0;  // Ceres cost, summed over the channel fits
+  double rel_rms = 0.0;     // RMS of (f_fit - f) / f over the samples used and channels
+  int starts = 0;           // initial guesses tried (the best is kept)
   double seconds = 0.0;
   std::string BriefReport() const;
 };

@@ -11,6 +11,7 @@
 #include "core/brdf_coords.h"
 #include "core/error.h"
 #include "core/logging.h"
+#include "core/statistics.h"
 
 namespace ibrdf {
 namespace {
@@ -21,13 +22,6 @@ Eigen::Vector3d Coordinates(double theta_i, double theta_e, double delta_phi) {
   Eigen::Vector3d wi, wo;
   FromIsotropic({theta_i, theta_e, delta_phi}, &wi, &wo);
   return RegressionCoordinates(wi, wo);
-}
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  const size_t k = static_cast<size_t>(q * (values.size() - 1) + 0.5);
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
 }
 
 // Compares the regression at point pairs (a[i], b[i]); pairs where either estimate is not a full fit
@@ -64,9 +58,9 @@ PairFigure ComparePairs(const LocalRegression& regression, const std::vector<Eig
 nlohmann::json Rgb(const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); }
 
 nlohmann::json FigureJson(const PairFigure& figure) {
-  return {{"valid", figure.valid()},       {"pairs", figure.pairs},   {"mean_rel_error", figure.mean},
-          {"per_channel_rel_error", Rgb(figure.mean_rel_error)}, {"median_rel_error", figure.median},
-          {"p95_rel_error", figure.p95}};
+  return {{"valid", figure.valid()},           {"pairs", figure.pairs},
+          {"mean_rel_error", figure.mean},     {"per_channel_rel_error", Rgb(figure.mean_rel_error)},
+          {"median_rel_error", figure.median}, {"p95_rel_error", figure.p95}};
 }
 
 }  // namespace
@@ -194,8 +188,8 @@ std::string PredictionReport::BriefReport() const {
   std::snprintf(buffer, sizeof(buffer),
                 "regression check: reciprocity near the incidence plane %.2f %% over %zu pairs; bilateral %.2f %% "
                 "over %zu pairs; %zu held-out photos, RMS prediction error R G B %.2f %.2f %.2f %%",
-                100.0 * reciprocity.mean, reciprocity.pairs, 100.0 * bilateral.mean, bilateral.pairs,
-                held_out.size(), 100.0 * held_out_rms[0], 100.0 * held_out_rms[1], 100.0 * held_out_rms[2]);
+                100.0 * reciprocity.mean, reciprocity.pairs, 100.0 * bilateral.mean, bilateral.pairs, held_out.size(),
+                100.0 * held_out_rms[0], 100.0 * held_out_rms[1], 100.0 * held_out_rms[2]);
   return buffer;
 }
 

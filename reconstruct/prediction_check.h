@@ -20,13 +20,13 @@
 namespace ibrdf {
 
 struct PredictionCheckOptions {
-  LocalRegressionOptions regression;  // folding is switched off for the symmetry figures
-  int held_out_photos = 3;            // photos to hold out, evenly spaced over the images (0: none)
+  LocalRegressionOptions regression;     // folding is switched off for the symmetry figures
+  int held_out_photos = 3;               // photos to hold out, evenly spaced over the images (0: none)
   size_t max_predicted_samples = 20000;  // of each held-out photo, a fixed-seed subset
-  double max_theta_deg = 70.0;        // points compared (both symmetry checks) stay below this
-  double near_plane_deg = 10.0;       // reciprocity: |dphi| or |pi - dphi| up to this
-  double step_deg = 5.0;              // spacing of the compared points
-  float min_effective_samples = 10.0f;  // both estimates of a pair need this many, and a full fit
+  double max_theta_deg = 70.0;           // points compared (both symmetry checks) stay below this
+  double near_plane_deg = 10.0;          // reciprocity: |dphi| or |pi - dphi| up to this
+  double step_deg = 5.0;                 // spacing of the compared points
+  float min_effective_samples = 10.0f;   // both estimates of a pair need this many, and a full fit
   bool Check(std::string* why) const;
 };
 
@@ -39,9 +39,9 @@ struct PairFigure {
 
 struct HeldOutPhoto {
   uint32_t image = 0;
-  size_t predicted = 0;                                // samples predicted
-  Eigen::Vector3d rms_rel_error = Eigen::Vector3d::Zero();    // of (prediction - sample) / sample
-  Eigen::Vector3d median_rel_error = Eigen::Vector3d::Zero(); // of |prediction - sample| / sample
+  size_t predicted = 0;                                        // samples predicted
+  Eigen::Vector3d rms_rel_error = Eigen::Vector3d::Zero();     // of (prediction - sample) / sample
+  Eigen::Vector3d median_rel_error = Eigen::Vector3d::Zero();  // of |prediction - sample| / sample
   double within_2_sigma = -1.0;  // fraction of values within 2 sigma of the prediction (-1: no sigma)
   ReliabilityCounts reliability;
 };

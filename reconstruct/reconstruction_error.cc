@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/statistics.h"
 
 namespace ibrdf {
 namespace {
@@ -51,9 +52,7 @@ class Accumulator {
       error_.rel_rms = (sum_ / double(error_.points)).cwiseSqrt();
       error_.rel_rms_all = std::sqrt(sum_.sum() / (3.0 * error_.points));
       for (int c = 0; c < 3; ++c) {
-        auto mid = abs_[c].begin() + abs_[c].size() / 2;
-        std::nth_element(abs_[c].begin(), mid, abs_[c].end());
-        error_.median[c] = *mid;
+        error_.median[c] = PercentileInPlace(&abs_[c], 0.5);
       }
     }
     return error_;
@@ -110,8 +109,8 @@ ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfMode
 
 nlohmann::json ToJson(const ReconstructionError& error) {
   auto rgb = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
-  return {{"cells_scored", error.points},     {"cells_outside", error.outside},
-          {"coverage", error.coverage()},     {"rel_rms_error", rgb(error.rel_rms)},
+  return {{"cells_scored", error.points},           {"cells_outside", error.outside},
+          {"coverage", error.coverage()},           {"rel_rms_error", rgb(error.rel_rms)},
           {"rel_rms_error_all", error.rel_rms_all}, {"median_abs_rel_error", rgb(error.median)}};
 }
 

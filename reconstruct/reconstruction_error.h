@@ -19,10 +19,10 @@
 namespace ibrdf {
 
 struct ReconstructionError {
-  size_t points = 0;         // cells scored
-  size_t outside = 0;        // cells within the theta limit left out (no samples within the kernel)
+  size_t points = 0;   // cells scored
+  size_t outside = 0;  // cells within the theta limit left out (no samples within the kernel)
   Eigen::Vector3d rel_rms = Eigen::Vector3d::Zero();  // per channel, of (f - f_true) / f_true
-  double rel_rms_all = 0.0;  // over channels
+  double rel_rms_all = 0.0;                           // over channels
   Eigen::Vector3d median = Eigen::Vector3d::Zero();   // of |f - f_true| / f_true
   double coverage() const { return points + outside ? double(points) / double(points + outside) : 0.0; }
   std::string Brief() const;

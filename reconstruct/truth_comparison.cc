@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
+#include "core/statistics.h"
 
 namespace ibrdf {
 namespace {
@@ -27,12 +28,8 @@ struct Accumulator {
     if (stats.count == 0) return stats;
     for (int c = 0; c < 3; ++c) {
       std::vector<double>& v = abs_rel[c];
-      const size_t mid = v.size() / 2;
-      std::nth_element(v.begin(), v.begin() + mid, v.end());
-      stats.median[c] = v[mid];
-      const size_t k95 = static_cast<size_t>(0.95 * (v.size() - 1) + 0.5);
-      std::nth_element(v.begin(), v.begin() + k95, v.end());
-      stats.p95[c] = v[k95];
+      stats.median[c] = PercentileInPlace(&v, 0.5);
+      stats.p95[c] = PercentileInPlace(&v, 0.95);
       stats.bias[c] = sum_rel[c] / stats.count;
     }
     return stats;
@@ -41,7 +38,9 @@ struct Accumulator {
 
 nlohmann::json StatsJson(const ErrorStats& stats) {
   auto rgb = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
-  return {{"count", stats.count}, {"median_rel_error", rgb(stats.median)}, {"p95_rel_error", rgb(stats.p95)},
+  return {{"count", stats.count},
+          {"median_rel_error", rgb(stats.median)},
+          {"p95_rel_error", rgb(stats.p95)},
           {"mean_signed_rel_error", rgb(stats.bias)}};
 }
 
@@ -67,7 +66,8 @@ TruthComparison CompareWithTruth(const std::vector<BrdfSample>& samples, const B
     const double theta_deg = std::max(s.theta_i, s.theta_e) * 180.0 / M_PI;
     for (size_t b = 0; b + 1 < band_edges_deg.size(); ++b) {
       const bool last = b + 2 == band_edges_deg.size();
-      if (theta_deg >= band_edges_deg[b] && (theta_deg < band_edges_deg[b + 1] || (last && theta_deg <= band_edges_deg[b + 1]))) {
+      if (theta_deg >= band_edges_deg[b] &&
+          (theta_deg < band_edges_deg[b + 1] || (last && theta_deg <= band_edges_deg[b + 1]))) {
         bands[b].Add(rel);
         break;
       }

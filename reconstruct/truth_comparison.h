@@ -18,7 +18,7 @@ struct ErrorStats {
   size_t count = 0;
   Eigen::Vector3d median = Eigen::Vector3d::Zero();  // of |f - f_true| / f_true, per channel
   Eigen::Vector3d p95 = Eigen::Vector3d::Zero();
-  Eigen::Vector3d bias = Eigen::Vector3d::Zero();    // mean of (f - f_true) / f_true: a scale error shows here
+  Eigen::Vector3d bias = Eigen::Vector3d::Zero();  // mean of (f - f_true) / f_true: a scale error shows here
 };
 
 struct ThetaBand {

@@ -53,7 +53,8 @@ ConvexityReport ReportConvexity(const ScanMesh& mesh, const ConvexityOptions& op
   std::string why;
   if (!options.Check(&why)) ThrowError("convexity options", why);
   if (mesh.points.size() < 4) {
-    ThrowError("convexity", "a convex hull needs at least 4 points, the sample has " + std::to_string(mesh.points.size()));
+    ThrowError("convexity",
+               "a convex hull needs at least 4 points, the sample has " + std::to_string(mesh.points.size()));
   }
   ConvexityReport report;
   const size_t n = mesh.points.size();
@@ -71,9 +72,9 @@ ConvexityReport ReportConvexity(const ScanMesh& mesh, const ConvexityOptions& op
   for (const Eigen::Vector3d& p : mesh.points) covariance += (p - centre) * (p - centre).transpose();
   covariance /= static_cast<double>(n);
   const Eigen::Vector3d eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues();
-  const scan_adapters::HullDistances hull =
-      std::sqrt(std::max(0.0, eigenvalues[0])) <= 1e-9 * diagonal ? scan_adapters::HullDistances()
-                                                                   : scan_adapters::ConvexHullDistances(mesh.points);
+  const scan_adapters::HullDistances hull = std::sqrt(std::max(0.0, eigenvalues[0])) <= 1e-9 * diagonal
+                                                ? scan_adapters::HullDistances()
+                                                : scan_adapters::ConvexHullDistances(mesh.points);
   if (!hull.valid) {
     report.flat = true;
     report.distance_m.assign(n, 0.0);

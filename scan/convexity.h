@@ -28,16 +28,16 @@ struct ConvexityOptions {
 };
 
 struct ConvexityReport {
-  bool success = false;        // false until the report ran
-  bool flat = false;           // the points span no volume (coplanar): trivially convex
+  bool success = false;  // false until the report ran
+  bool flat = false;     // the points span no volume (coplanar): trivially convex
   size_t hull_vertices = 0, hull_faces = 0;
   double tolerance_m = 0.0;
   double fraction_within = 0.0;  // of the surface area (of the points when there are no faces)
   double max_distance_m = 0.0;
   double median_distance_m = 0.0;
-  bool needs_shadow_rays = true;  // fraction_within < min_convex_fraction (true until the report ran)
-  std::string warning;            // empty when convex
-  std::vector<double> distance_m; // per point, to the hull's surface
+  bool needs_shadow_rays = true;   // fraction_within < min_convex_fraction (true until the report ran)
+  std::string warning;             // empty when convex
+  std::vector<double> distance_m;  // per point, to the hull's surface
   // "convexity: 99.8 % of the surface within 0.87 mm of the convex hull (max 0.3 mm): convex"
   std::string BriefReport() const;
   nlohmann::json ToJson() const;  // the figures, without the per-point distances

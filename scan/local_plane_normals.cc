@@ -4,12 +4,13 @@
 #include <cmath>
 #include <sstream>
 
-#include <Eigen/Eigenvalues>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <Eigen/Eigenvalues>
 
 #include "core/error.h"
 #include "core/logging.h"
+#include "core/statistics.h"
 #include "scan/point_index.h"
 
 namespace ibrdf {
@@ -37,10 +38,10 @@ bool LocalPlaneOptions::Check(std::string* why) const {
 std::string LocalPlaneResult::BriefReport() const {
   std::ostringstream out;
   out.precision(3);
-  out << "normals: " << fitted << " of " << points << " fitted (radius " << radius_m * 1e3
-      << " mm, median " << neighbours_median << " neighbours), RMS residual median " << rms_median_m * 1e3
-      << " mm, 95th percentile " << rms_p95_m * 1e3 << " mm; not fitted: too_few_neighbours " << too_few_neighbours
-      << ", collinear " << collinear << " (" << no_normal << " left without a normal)";
+  out << "normals: " << fitted << " of " << points << " fitted (radius " << radius_m * 1e3 << " mm, median "
+      << neighbours_median << " neighbours), RMS residual median " << rms_median_m * 1e3 << " mm, 95th percentile "
+      << rms_p95_m * 1e3 << " mm; not fitted: too_few_neighbours " << too_few_neighbours << ", collinear " << collinear
+      << " (" << no_normal << " left without a normal)";
   return out.str();
 }
 
@@ -76,8 +77,10 @@ LocalPlaneResult Fit(const std::vector<Eigen::Vector3d>& points, const std::vect
       Eigen::Vector3d reference = reference_normals.empty() ? Eigen::Vector3d::Zero() : reference_normals[i];
       const bool have_reference = reference.allFinite() && reference.squaredNorm() > 0.0;
       if (!have_reference) reference = Eigen::Vector3d::Zero();
-      if (result.radius_m > 0.0) index.RadiusSearch(q, result.radius_m, &near);
-      else near.assign(1, static_cast<int>(i));
+      if (result.radius_m > 0.0)
+        index.RadiusSearch(q, result.radius_m, &near);
+      else
+        near.assign(1, static_cast<int>(i));
       bool fitted = false;
       if (static_cast<int>(near.size()) >= options.min_neighbours) {
         // Offsets from the query point: small numbers wherever the scan lies.
@@ -163,8 +166,7 @@ LocalPlaneResult FitLocalPlanes(const ScanMesh& mesh, const LocalPlaneOptions& o
       const Eigen::Vector3i& f = mesh.faces[i];
       for (int k = 0; k < 3; ++k) edges.push_back((mesh.points[f[k]] - mesh.points[f[(k + 1) % 3]]).norm());
     }
-    std::nth_element(edges.begin(), edges.begin() + edges.size() / 2, edges.end());
-    spacing = edges[edges.size() / 2];
+    spacing = PercentileInPlace(&edges, 0.5);
   } else {
     spacing = MedianPointSpacing(mesh.points);
   }

@@ -40,19 +40,19 @@ enum class NormalSource : uint8_t {
 };
 
 struct LocalPlaneResult {
-  bool success = false;                 // false until the stage ran
-  double radius_m = 0.0;                // the radius used
-  double spacing_m = 0.0;               // median point spacing
-  std::vector<Eigen::Vector3d> normals; // unit and outward; zero where source is kNone
-  std::vector<float> rms_m;             // RMS distance of the neighbours to the plane (0 without fit)
-  std::vector<int> neighbours;          // points in the fit, the point itself included (0 without fit)
+  bool success = false;                  // false until the stage ran
+  double radius_m = 0.0;                 // the radius used
+  double spacing_m = 0.0;                // median point spacing
+  std::vector<Eigen::Vector3d> normals;  // unit and outward; zero where source is kNone
+  std::vector<float> rms_m;              // RMS distance of the neighbours to the plane (0 without fit)
+  std::vector<int> neighbours;           // points in the fit, the point itself included (0 without fit)
   std::vector<NormalSource> source;
-  uint64_t points = 0;                  // points examined
+  uint64_t points = 0;  // points examined
   uint64_t fitted = 0;
   uint64_t too_few_neighbours = 0;
   uint64_t collinear = 0;
-  uint64_t no_normal = 0;               // of the unfitted points, those without a reference normal
-  uint64_t flipped = 0;                 // fitted normals turned to agree with the outward reference
+  uint64_t no_normal = 0;  // of the unfitted points, those without a reference normal
+  uint64_t flipped = 0;    // fitted normals turned to agree with the outward reference
   double rms_median_m = 0.0, rms_p95_m = 0.0;
   double neighbours_median = 0.0;
   double seconds = 0.0;

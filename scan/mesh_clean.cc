@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/statistics.h"
 #include "scan/adapters.h"
 #include "scan/point_index.h"
 
@@ -60,8 +61,8 @@ bool CleanOptions::Check(std::string* why) const {
 
 std::string CleanReport::BriefReport() const {
   std::ostringstream out;
-  out << "clean: " << points_in << " -> " << points_out << " points, " << faces_in << " -> " << faces_out
-      << " faces, " << pieces << " pieces; removed " << FormatCounts(removed);
+  out << "clean: " << points_in << " -> " << points_out << " points, " << faces_in << " -> " << faces_out << " faces, "
+      << pieces << " pieces; removed " << FormatCounts(removed);
   return out.str();
 }
 
@@ -73,8 +74,8 @@ CleanReport CleanMesh(const CleanOptions& options, ScanMesh* mesh) {
   report.points_in = mesh->points.size();
   report.faces_in = mesh->faces.size();
   auto& removed = report.removed;
-  for (const char* key : {"outlier_points", "duplicate_points", "degenerate_faces", "tiny_faces",
-                          "non_manifold_faces", "small_piece_faces", "unreferenced_points", "faces_of_removed_points"}) {
+  for (const char* key : {"outlier_points", "duplicate_points", "degenerate_faces", "tiny_faces", "non_manifold_faces",
+                          "small_piece_faces", "unreferenced_points", "faces_of_removed_points"}) {
     removed[key] = 0;
   }
 
@@ -98,7 +99,8 @@ CleanReport CleanMesh(const CleanOptions& options, ScanMesh* mesh) {
         if (!keep[i]) continue;
         index.RadiusSearch(mesh->points[i], options.duplicate_distance_m, &near);
         for (int j : near) {
-          if (j > static_cast<int>(i) && keep[j] && (mesh->points[j] - mesh->points[i]).norm() <= options.duplicate_distance_m) {
+          if (j > static_cast<int>(i) && keep[j] &&
+              (mesh->points[j] - mesh->points[i]).norm() <= options.duplicate_distance_m) {
             keep[j] = false;
             target[j] = static_cast<int>(i);
           }
@@ -138,8 +140,7 @@ CleanReport CleanMesh(const CleanOptions& options, ScanMesh* mesh) {
     }
     uint64_t tiny = 0;
     if (!valid.empty() && options.tiny_face_fraction > 0.0) {
-      std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
-      const double limit = options.tiny_face_fraction * valid[valid.size() / 2];
+      const double limit = options.tiny_face_fraction * PercentileInPlace(&valid, 0.5);
       for (size_t i = 0; i < areas.size(); ++i) {
         if (keep[i] && areas[i] < limit) {
           keep[i] = false;

@@ -36,7 +36,7 @@ struct CleanReport {
   // area, or the same corners as another face), tiny_faces, non_manifold_faces, small_piece_faces,
   // unreferenced_points, plus faces_of_removed_points.
   RejectionCounts removed;
-  uint64_t pieces = 0;       // connected pieces left
+  uint64_t pieces = 0;  // connected pieces left
   double seconds = 0.0;
   // "clean: 40256 -> 40100 points, 76000 -> 75800 faces; removed outlier_points 12, ..."
   std::string BriefReport() const;

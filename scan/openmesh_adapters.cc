@@ -20,8 +20,14 @@ using TriMesh = OpenMesh::TriMesh_ArrayKernelT<>;
 // and Errors instead.
 class QuietOpenMesh {
  public:
-  QuietOpenMesh() { omerr().disable(); omlog().disable(); }
-  ~QuietOpenMesh() { omerr().enable(); omlog().enable(); }
+  QuietOpenMesh() {
+    omerr().disable();
+    omlog().disable();
+  }
+  ~QuietOpenMesh() {
+    omerr().enable();
+    omlog().enable();
+  }
 };
 }  // namespace
 
@@ -61,8 +67,9 @@ std::vector<bool> ManifoldFaces(const ScanMesh& mesh) {
   TriMesh om;
   std::vector<TriMesh::VertexHandle> handles;
   handles.reserve(mesh.points.size());
-  for (const Eigen::Vector3d& p : mesh.points) handles.push_back(om.add_vertex(TriMesh::Point(
-      static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()))));
+  for (const Eigen::Vector3d& p : mesh.points)
+    handles.push_back(
+        om.add_vertex(TriMesh::Point(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()))));
   std::vector<bool> keep(mesh.faces.size(), true);
   for (size_t i = 0; i < mesh.faces.size(); ++i) {
     const Eigen::Vector3i& f = mesh.faces[i];

@@ -1,15 +1,15 @@
 // PCL, in this one translation unit (it compiles slowly and pulls VTK).
 #include <cmath>
-#include <type_traits>
 #include <filesystem>
+#include <type_traits>
 
+#include <pcl/console/print.h>
 #include <pcl/features/normal_3d.h>
 #include <pcl/features/normal_3d_omp.h>
 #include <pcl/filters/statistical_outlier_removal.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
-#include <pcl/console/print.h>
 
 #include "core/error.h"
 #include "core/file_util.h"

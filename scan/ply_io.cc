@@ -22,11 +22,11 @@ enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, 
 
 bool ParseType(const std::string& name, PlyType* type) {
   static const std::pair<const char*, PlyType> kTypes[] = {
-      {"char", PlyType::kInt8},     {"int8", PlyType::kInt8},       {"uchar", PlyType::kUint8},
-      {"uint8", PlyType::kUint8},   {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
-      {"ushort", PlyType::kUint16}, {"uint16", PlyType::kUint16},   {"int", PlyType::kInt32},
-      {"int32", PlyType::kInt32},   {"uint", PlyType::kUint32},     {"uint32", PlyType::kUint32},
-      {"float", PlyType::kFloat32}, {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
+      {"char", PlyType::kInt8},      {"int8", PlyType::kInt8},       {"uchar", PlyType::kUint8},
+      {"uint8", PlyType::kUint8},    {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
+      {"ushort", PlyType::kUint16},  {"uint16", PlyType::kUint16},   {"int", PlyType::kInt32},
+      {"int32", PlyType::kInt32},    {"uint", PlyType::kUint32},     {"uint32", PlyType::kUint32},
+      {"float", PlyType::kFloat32},  {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
       {"float64", PlyType::kFloat64}};
   for (const auto& [type_name, value] : kTypes) {
     if (name == type_name) {
@@ -40,13 +40,17 @@ bool ParseType(const std::string& name, PlyType* type) {
 int TypeSize(PlyType type) {
   switch (type) {
     case PlyType::kInt8:
-    case PlyType::kUint8: return 1;
+    case PlyType::kUint8:
+      return 1;
     case PlyType::kInt16:
-    case PlyType::kUint16: return 2;
+    case PlyType::kUint16:
+      return 2;
     case PlyType::kInt32:
     case PlyType::kUint32:
-    case PlyType::kFloat32: return 4;
-    case PlyType::kFloat64: return 8;
+    case PlyType::kFloat32:
+      return 4;
+    case PlyType::kFloat64:
+      return 8;
   }
   return 0;
 }
@@ -220,14 +224,48 @@ class BodyReader {
     pos_ += size;
     if (format_ == Format::kBinaryBig) std::reverse(bytes, bytes + size);
     switch (type) {
-      case PlyType::kInt8: *value = static_cast<int8_t>(bytes[0]); break;
-      case PlyType::kUint8: *value = bytes[0]; break;
-      case PlyType::kInt16: { int16_t v; std::memcpy(&v, bytes, 2); *value = v; break; }
-      case PlyType::kUint16: { uint16_t v; std::memcpy(&v, bytes, 2); *value = v; break; }
-      case PlyType::kInt32: { int32_t v; std::memcpy(&v, bytes, 4); *value = v; break; }
-      case PlyType::kUint32: { uint32_t v; std::memcpy(&v, bytes, 4); *value = v; break; }
-      case PlyType::kFloat32: { float v; std::memcpy(&v, bytes, 4); *value = v; break; }
-      case PlyType::kFloat64: { double v; std::memcpy(&v, bytes, 8); *value = v; break; }
+      case PlyType::kInt8:
+        *value = static_cast<int8_t>(bytes[0]);
+        break;
+      case PlyType::kUint8:
+        *value = bytes[0];
+        break;
+      case PlyType::kInt16: {
+        int16_t v;
+        std::memcpy(&v, bytes, 2);
+        *value = v;
+        break;
+      }
+      case PlyType::kUint16: {
+        uint16_t v;
+        std::memcpy(&v, bytes, 2);
+        *value = v;
+        break;
+      }
+      case PlyType::kInt32: {
+        int32_t v;
+        std::memcpy(&v, bytes, 4);
+        *value = v;
+        break;
+      }
+      case PlyType::kUint32: {
+        uint32_t v;
+        std::memcpy(&v, bytes, 4);
+        *value = v;
+        break;
+      }
+      case PlyType::kFloat32: {
+        float v;
+        std::memcpy(&v, bytes, 4);
+        *value = v;
+        break;
+      }
+      case PlyType::kFloat64: {
+        double v;
+        std::memcpy(&v, bytes, 8);
+        *value = v;
+        break;
+      }
     }
     return true;
   }
@@ -405,7 +443,8 @@ ScanMesh ReadPly(const std::string& path) {
         if (ihull >= 0) mesh.hull_distance_m.push_back(static_cast<float>(hull));
       } else if (is_face) {
         if (list.size() < 3) {
-          ThrowError(path, "face " + std::to_string(i) + " has " + std::to_string(list.size()) + " vertices (at least 3 needed)");
+          ThrowError(path, "face " + std::to_string(i) + " has " + std::to_string(list.size()) +
+                               " vertices (at least 3 needed)");
         }
         polygons.push_back(list);
       } else if (is_grid) {

@@ -1,10 +1,10 @@
 // Strict PLY reading and writing (Turk's format: ASCII, binary little- and big-endian).
 //
 // Reads the vertex element (x, y, z; optional nx, ny, nz; the scan stage's quality, fit_neighbours and
-// hull_distance, which WritePly writes; colours and other properties are read and ignored), faces (vertex_indices or vertex_index lists; polygons are fanned into triangles), and the
-// Cyberware `range_grid` element of raw range images (one list of 0 or 1 vertex index per cell,
-// row-major, its size given by `obj_info num_cols` and `obj_info num_rows`). Any other element is read
-// and skipped. COLMAP's fused.ply (with normals) and meshed-*.ply are plain variants.
+// hull_distance, which WritePly writes; colours and other properties are read and ignored), faces (vertex_indices or
+// vertex_index lists; polygons are fanned into triangles), and the Cyberware `range_grid` element of raw range images
+// (one list of 0 or 1 vertex index per cell, row-major, its size given by `obj_info num_cols` and `obj_info num_rows`).
+// Any other element is read and skipped. COLMAP's fused.ply (with normals) and meshed-*.ply are plain variants.
 //
 // Why not PCL's or OpenMesh's reader: both report a bad file only as a failed return value with a
 // console line, and neither notices a header whose counts lie. Here every defect is an Error naming the

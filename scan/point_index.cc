@@ -1,5 +1,7 @@
 #include "scan/point_index.h"
 
+#include "core/statistics.h"
+
 #include <algorithm>
 
 #include <nanoflann.hpp>
@@ -15,7 +17,9 @@ struct PointIndex::Impl {
     size_t kdtree_get_point_count() const { return centred.size(); }
     double kdtree_get_pt(size_t i, size_t dim) const { return centred[i][static_cast<int>(dim)]; }
     template <class Box>
-    bool kdtree_get_bbox(Box&) const { return false; }
+    bool kdtree_get_bbox(Box&) const {
+      return false;
+    }
   };
   using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3, int>;
 
@@ -78,8 +82,7 @@ double MedianPointSpacing(const std::vector<Eigen::Vector3d>& points, size_t max
     }
   }
   if (spacing.empty()) return 0.0;
-  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
-  return spacing[spacing.size() / 2];
+  return PercentileInPlace(&spacing, 0.5);
 }
 
 }  // namespace ibrdf

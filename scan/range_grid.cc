@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/statistics.h"
 
 namespace ibrdf {
 
@@ -49,8 +50,7 @@ RangeGridReport TessellateRangeGrid(const RangeGridOptions& options, ScanMesh* m
     }
   }
   if (!spacing.empty()) {
-    std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
-    report.spacing_m = spacing[spacing.size() / 2];
+    report.spacing_m = PercentileInPlace(&spacing, 0.5);
   }
   const double max_edge = options.max_edge_m > 0.0 ? options.max_edge_m : options.max_edge_factor * report.spacing_m;
   report.max_edge_used_m = max_edge;

@@ -22,12 +22,12 @@ struct RangeGridOptions {
 };
 
 struct RangeGridReport {
-  bool success = false;        // false until tessellation ran
-  uint64_t cells = 0;          // grid cells
-  uint64_t points = 0;         // cells holding a point
-  uint64_t triangles = 0;      // triangles kept
+  bool success = false;                      // false until tessellation ran
+  uint64_t cells = 0;                        // grid cells
+  uint64_t points = 0;                       // cells holding a point
+  uint64_t triangles = 0;                    // triangles kept
   uint64_t dropped_depth_discontinuity = 0;  // triangles with an over-long edge
-  double spacing_m = 0.0;      // median grid-neighbour distance
+  double spacing_m = 0.0;                    // median grid-neighbour distance
   double max_edge_used_m = 0.0;
   // "range grid 512x400: 40256 points, 76000 triangles, 1234 dropped across depth discontinuities"
   std::string BriefReport() const;

@@ -62,7 +62,8 @@ std::vector<StanfordConfEntry> ReadStanfordConf(const std::string& path) {
       const std::vector<double> v = numbers(1, 7);
       const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);  // Eigen's order is (w, x, y, z)
       if (std::abs(q.norm() - 1.0) > 1e-3) {
-        ThrowError(where, "the quaternion (qx qy qz qw) is not of unit length (|q| = " + std::to_string(q.norm()) + ")");
+        ThrowError(where,
+                   "the quaternion (qx qy qz qw) is not of unit length (|q| = " + std::to_string(q.norm()) + ")");
       }
       StanfordConfEntry entry;
       entry.name = rest[0];

@@ -20,7 +20,7 @@ ScanMesh ReadScanFile(const std::string& path);
 // Stanford's scanalyze writes it, is the rotation from the common frame into the scan's; checked on
 // the bunny, whose overlapping scans agree to 0.09 mm this way and miss by 0.9 mm the other).
 struct StanfordConfEntry {
-  std::string name;          // file name as written (relative to the .conf file's folder)
+  std::string name;  // file name as written (relative to the .conf file's folder)
   Rigid3d world_from_scan;
   int line = 0;
 };

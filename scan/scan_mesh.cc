@@ -112,8 +112,8 @@ void RequireFinitePoints(const ScanMesh& mesh, const std::string& where) {
     for (int k = 0; k < 3; ++k) {
       const int v = mesh.faces[i][k];
       if (v < 0 || v >= n) {
-        ThrowError(where, "face " + std::to_string(i) + " refers to vertex " + std::to_string(v) +
-                              ", but there are " + std::to_string(n) + " vertices");
+        ThrowError(where, "face " + std::to_string(i) + " refers to vertex " + std::to_string(v) + ", but there are " +
+                              std::to_string(n) + " vertices");
       }
     }
   }

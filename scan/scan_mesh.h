@@ -30,11 +30,11 @@ struct ScanMesh {
   std::vector<Eigen::Vector3d> points;  // metres
   std::vector<Eigen::Vector3i> faces;   // counter-clockwise seen from outside; indices into points
   // Optional per-point data, each either empty or points.size() long.
-  std::vector<Eigen::Vector3d> normals;        // unit, outward (from a file, or the local-plane fit)
-  std::vector<float> fit_rms_m;                // RMS distance of the neighbours to the fitted plane
-  std::vector<int> fit_neighbours;             // number of points in the fit (0: no fit)
-  std::vector<float> hull_distance_m;          // distance to the convex hull of the sample
-  RangeGrid grid;                              // set while the mesh is one untessellated range image
+  std::vector<Eigen::Vector3d> normals;  // unit, outward (from a file, or the local-plane fit)
+  std::vector<float> fit_rms_m;          // RMS distance of the neighbours to the fitted plane
+  std::vector<int> fit_neighbours;       // number of points in the fit (0: no fit)
+  std::vector<float> hull_distance_m;    // distance to the convex hull of the sample
+  RangeGrid grid;                        // set while the mesh is one untessellated range image
 
   size_t NumPoints() const { return points.size(); }
   size_t NumFaces() const { return faces.size(); }

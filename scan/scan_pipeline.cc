@@ -114,8 +114,8 @@ ScanResult RunScan(const std::vector<ScanInput>& inputs, const ScanOptions& opti
     summary.step_seconds.emplace_back("clean", summary.clean.seconds);
   }
   if (merged.faces.empty() || merged.points.size() < 4) {
-    ThrowError(inputs.front().path, "nothing is left of the scan after cleaning (" + std::to_string(merged.points.size()) +
-                                        " points, no faces)");
+    ThrowError(inputs.front().path, "nothing is left of the scan after cleaning (" +
+                                        std::to_string(merged.points.size()) + " points, no faces)");
   }
   {
     StageLog stage("scan: local-plane normals");
@@ -168,7 +168,8 @@ std::string ScanSummary::Table() const {
     out << (first ? "" : ", ") << step << " " << count;
     first = false;
   }
-  out << "\n  result    " << clean.points_out << " points, " << clean.faces_out << " faces, " << clean.pieces << " piece(s)\n";
+  out << "\n  result    " << clean.points_out << " points, " << clean.faces_out << " faces, " << clean.pieces
+      << " piece(s)\n";
   out << "  normals   radius " << normals.radius_m * 1e3 << " mm (spacing " << normals.spacing_m * 1e3 << " mm); "
       << normals.fitted << " fitted, median " << std::setprecision(0) << normals.neighbours_median << " neighbours"
       << std::setprecision(3) << "; not fitted: " << normals.too_few_neighbours << " too few neighbours, "
@@ -176,9 +177,10 @@ std::string ScanSummary::Table() const {
   out << "            RMS residual median " << normals.rms_median_m * 1e3 << " mm, 95th percentile "
       << normals.rms_p95_m * 1e3 << " mm\n";
   out << "  convexity " << std::setprecision(2) << 100.0 * convexity.fraction_within << " % of the surface within "
-      << std::setprecision(3) << convexity.tolerance_m * 1e3 << " mm of the hull (median " << convexity.median_distance_m * 1e3
-      << " mm, max " << convexity.max_distance_m * 1e3 << " mm): "
-      << (convexity.needs_shadow_rays ? "NOT convex, shadow rays needed" : "convex, no shadow rays needed") << "\n";
+      << std::setprecision(3) << convexity.tolerance_m * 1e3 << " mm of the hull (median "
+      << convexity.median_distance_m * 1e3 << " mm, max " << convexity.max_distance_m * 1e3
+      << " mm): " << (convexity.needs_shadow_rays ? "NOT convex, shadow rays needed" : "convex, no shadow rays needed")
+      << "\n";
   if (!convexity.warning.empty()) out << "  warning   " << convexity.warning << "\n";
   out << "  time      ";
   for (const auto& [step, seconds] : step_seconds) out << step << " " << std::setprecision(2) << seconds << " s, ";
@@ -189,7 +191,8 @@ std::string ScanSummary::Table() const {
 nlohmann::json ScanSummary::ToJson() const {
   nlohmann::json input_list = nlohmann::json::array();
   for (const ScanInputReport& input : inputs) {
-    input_list.push_back({{"path", input.path}, {"kind", input.kind}, {"points", input.points}, {"faces", input.faces}});
+    input_list.push_back(
+        {{"path", input.path}, {"kind", input.kind}, {"points", input.points}, {"faces", input.faces}});
   }
   nlohmann::json removed = nlohmann::json::object();
   for (const auto& [step, count] : clean.removed) removed[step] = count;
@@ -222,12 +225,11 @@ void WriteScanOutputs(const std::string& ply_path, const ScanResult& result, con
   sidecar["format"] = "ibrdf scan 1";
   sidecar["mesh"] = std::filesystem::path(ply_path).filename().string();
   sidecar["units"] = {{"length", "m"}};
-  sidecar["vertex_properties"] = {
-      {"x y z", "position, metres (double)"},
-      {"nx ny nz", "unit outward local-plane normal (zero where none could be had)"},
-      {"quality", "RMS distance of the fit's neighbours to the plane, metres"},
-      {"fit_neighbours", "points in the fit (0: no fit; the normal is the mesh's)"},
-      {"hull_distance", "distance to the convex hull of the sample, metres"}};
+  sidecar["vertex_properties"] = {{"x y z", "position, metres (double)"},
+                                  {"nx ny nz", "unit outward local-plane normal (zero where none could be had)"},
+                                  {"quality", "RMS distance of the fit's neighbours to the plane, metres"},
+                                  {"fit_neighbours", "points in the fit (0: no fit; the normal is the mesh's)"},
+                                  {"hull_distance", "distance to the convex hull of the sample, metres"}};
   sidecar["options"] = {{"max_edge_factor", options.grid.max_edge_factor},
                         {"max_edge_m", options.grid.max_edge_m},
                         {"remove_outliers", options.clean.remove_outliers},

@@ -19,10 +19,10 @@
 namespace ibrdf {
 
 struct ScanOptions {
-  RangeGridOptions grid;        // range-grid tessellation
-  CleanOptions clean;           // cleaning steps
-  LocalPlaneOptions normals;    // local-plane normals
-  ConvexityOptions convexity;   // convexity report
+  RangeGridOptions grid;       // range-grid tessellation
+  CleanOptions clean;          // cleaning steps
+  LocalPlaneOptions normals;   // local-plane normals
+  ConvexityOptions convexity;  // convexity report
   // Unorganized points (no faces, no grid) are reconstructed with CGAL's advancing front; with false
   // they are an error.
   bool reconstruct_points = true;
@@ -52,8 +52,8 @@ struct ScanSummary {
   std::vector<ScanInputReport> inputs;
   uint64_t reconstructed_faces = 0;  // by CGAL from unorganized points
   CleanReport clean;
-  LocalPlaneResult normals;  // figures only: per-point vectors are cleared once stored in the mesh
-  ConvexityReport convexity; // likewise
+  LocalPlaneResult normals;   // figures only: per-point vectors are cleared once stored in the mesh
+  ConvexityReport convexity;  // likewise
   std::vector<std::pair<std::string, double>> step_seconds;
   double total_s = 0.0;
   // "scan: 2 inputs -> 80000 points, 150000 faces; normals RMS median 0.1 mm; convex 99.9 %"

@@ -57,7 +57,8 @@ ScanMesh MakeSyntheticRangeScan(const SyntheticRangeScanOptions& options) {
       const double s = 1.0 - x * x / (r.x() * r.x()) - y * y / (r.y() * r.y());
       if (s <= 0.0) continue;
       const double z = r.z() * std::sqrt(s);
-      const Eigen::Vector3d normal = Eigen::Vector3d(x / (r.x() * r.x()), y / (r.y() * r.y()), z / (r.z() * r.z())).normalized();
+      const Eigen::Vector3d normal =
+          Eigen::Vector3d(x / (r.x() * r.x()), y / (r.y() * r.y()), z / (r.z() * r.z())).normalized();
       if (normal.z() < cos_limit) continue;
       const double dz = options.noise_m * noise(random);
       mesh.grid.cell_point[static_cast<size_t>(row) * options.cols + col] = static_cast<int>(mesh.points.size());
@@ -183,7 +184,8 @@ std::vector<ScanMesh> SimulateRangeScans(const RayCaster& surface, const Eigen::
       std::normal_distribution<double> noise(0.0, 1.0);
       for (int col = 0; col < size; ++col) {
         const Eigen::Vector3d ray =
-            (rotation * Eigen::Vector3d((col + 0.5 - 0.5 * size) * cell, (row + 0.5 - 0.5 * size) * cell, 1.0)).normalized();
+            (rotation * Eigen::Vector3d((col + 0.5 - 0.5 * size) * cell, (row + 0.5 - 0.5 * size) * cell, 1.0))
+                .normalized();
         double t;
         Eigen::Vector3d normal;
         if (!surface(scanner, ray, &t, &normal)) continue;
@@ -217,7 +219,8 @@ void WriteRangeGridPly(const std::string& path, const ScanMesh& grid) {
     out << "ply\nformat binary_little_endian 1.0\ncomment ibrdf synth: simulated range scan (metres, scanner frame)\n";
     out << "obj_info num_cols " << grid.grid.cols << "\nobj_info num_rows " << grid.grid.rows << "\n";
     out << "element vertex " << grid.points.size() << "\nproperty double x\nproperty double y\nproperty double z\n";
-    out << "element range_grid " << grid.grid.cell_point.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+    out << "element range_grid " << grid.grid.cell_point.size()
+        << "\nproperty list uchar int vertex_indices\nend_header\n";
     auto put = [&out](const auto& value) { out.write(reinterpret_cast<const char*>(&value), sizeof(value)); };
     for (const Eigen::Vector3d& p : grid.points) {
       for (int k = 0; k < 3; ++k) put(p[k]);

@@ -20,8 +20,8 @@ namespace ibrdf {
 struct SyntheticRangeScanOptions {
   Eigen::Vector3d radii = Eigen::Vector3d(0.05, 0.05, 0.05);  // semi-axes, metres (a 100 mm sphere)
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();           // centre of the ellipsoid, metres
-  int cols = 100, rows = 100;   // range image over the silhouette's bounding box
-  double noise_m = 1e-4;        // Gaussian noise along the viewing direction (z), one sigma
+  int cols = 100, rows = 100;                                 // range image over the silhouette's bounding box
+  double noise_m = 1e-4;             // Gaussian noise along the viewing direction (z), one sigma
   double max_view_angle_deg = 75.0;  // cells whose surface is seen more obliquely are empty
   uint64_t seed = 1;
 
@@ -54,10 +54,10 @@ struct RangeScannerOptions {
   int views_around = 6;
   double around_elevation_deg = 20.0;
   bool view_above = true;
-  double distance_m = 0.5;          // scanner centre to the sample centre
-  double spacing_m = 0.0007;        // grid spacing (between neighbouring rays) at the sample centre's distance
-  double noise_m = 1e-4;            // Gaussian range noise along the ray, one sigma
-  double max_view_angle_deg = 75.0; // cells whose surface is seen more obliquely are empty
+  double distance_m = 0.5;           // scanner centre to the sample centre
+  double spacing_m = 0.0007;         // grid spacing (between neighbouring rays) at the sample centre's distance
+  double noise_m = 1e-4;             // Gaussian range noise along the ray, one sigma
+  double max_view_angle_deg = 75.0;  // cells whose surface is seen more obliquely are empty
   uint64_t seed = 1;
 
   bool Check(std::string* why) const;
@@ -65,8 +65,8 @@ struct RangeScannerOptions {
 
 // The first hit of a ray (unit direction) on a surface: its distance and outward unit normal. False
 // for a miss.
-using RayCaster = std::function<bool(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                                     double* t, Eigen::Vector3d* normal)>;
+using RayCaster = std::function<bool(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double* t,
+                                     Eigen::Vector3d* normal)>;
 
 // One range grid per view of the surface inside the sphere (`center`, `radius`, world frame), points
 // mapped into the scanner's frame by `scan_from_world` (in double: scanner coordinates may lie

@@ -16,8 +16,8 @@
 namespace ibrdf {
 
 struct MarkerCornerError {
-  MarkerCornerError(const std::array<double, 8>& intrinsics, const Eigen::Vector3d& corner_in_marker,
-                    double observed_x, double observed_y)
+  MarkerCornerError(const std::array<double, 8>& intrinsics, const Eigen::Vector3d& corner_in_marker, double observed_x,
+                    double observed_y)
       : projection_(intrinsics, observed_x, observed_y), corner_in_marker_(corner_in_marker) {}
 
   template <typename T>

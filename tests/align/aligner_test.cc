@@ -191,7 +191,8 @@ TEST(Align, LightTargetsAndPhotoRolesInTheSessionFile) {
   EXPECT_EQ(json["photos"].back()["role"], "targets");
   EXPECT_FALSE(json["photos"].front().contains("role"));
 
-  auto expect_error = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& where, const std::string& what) {
+  auto expect_error = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& where,
+                          const std::string& what) {
     nlohmann::json broken = json;
     edit(broken);
     WriteJsonFile(dir / "s/session.json", broken);

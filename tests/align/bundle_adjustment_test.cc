@@ -8,8 +8,8 @@
 #include <functional>
 #include <iostream>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "align/aligner.h"
 #include "core/error.h"
@@ -184,7 +184,8 @@ TEST(BundleAdjustment, UnknownLayoutInTheSessionFile) {
   ASSERT_TRUE(reloaded.targets->unknown_layout);
   EXPECT_EQ(*reloaded.targets->unknown_layout->origin_id, 1);
   EXPECT_EQ(reloaded.ToJson()["targets"]["unknown_layout"], json["targets"]["unknown_layout"]);
-  auto expect_error = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& where, const std::string& what) {
+  auto expect_error = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& where,
+                          const std::string& what) {
     nlohmann::json broken = json;
     edit(broken);
     WriteJsonFile(dir / "s/session.json", broken);
@@ -196,13 +197,14 @@ TEST(BundleAdjustment, UnknownLayoutInTheSessionFile) {
       EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
     }
   };
-  expect_error([](nlohmann::json& j) { j["targets"]["unknown_layout"].erase("origin_id"); }, "/targets/unknown_layout/origin_id",
-               "give origin_id");
-  expect_error([](nlohmann::json& j) { j["targets"]["unknown_layout"]["origin_id"] = 7; }, "/targets/unknown_layout/origin_id",
-               "not in ids");
+  expect_error([](nlohmann::json& j) { j["targets"]["unknown_layout"].erase("origin_id"); },
+               "/targets/unknown_layout/origin_id", "give origin_id");
+  expect_error([](nlohmann::json& j) { j["targets"]["unknown_layout"]["origin_id"] = 7; },
+               "/targets/unknown_layout/origin_id", "not in ids");
   expect_error([&](nlohmann::json& j) { j["targets"]["reference"] = session.ToJson()["targets"]["reference"]; },
                "/targets/unknown_layout/ids/0", "listed twice");
-  expect_error([](nlohmann::json& j) { j["targets"]["unknown_layout"]["size"] = -1; }, "/targets/unknown_layout/size", "");
+  expect_error([](nlohmann::json& j) { j["targets"]["unknown_layout"]["size"] = -1; }, "/targets/unknown_layout/size",
+               "");
 }
 
 // Mixed: half the ring known (fixed, the world frame), the other half estimated in that frame.

@@ -50,8 +50,9 @@ Similarity3d RandomSimilarity(uint64_t seed) {
 // camera_from_colmap of a camera whose metric pose is camera_from_world, with world = S * colmap.
 Rigid3d ColmapPose(const Rigid3d& camera_from_world, const Similarity3d& world_from_colmap) {
   const Eigen::Quaterniond rotation = camera_from_world.rotation * world_from_colmap.rotation;
-  return Rigid3d(rotation, (camera_from_world.rotation * world_from_colmap.translation + camera_from_world.translation) /
-                               world_from_colmap.scale);
+  return Rigid3d(rotation,
+                 (camera_from_world.rotation * world_from_colmap.translation + camera_from_world.translation) /
+                     world_from_colmap.scale);
 }
 
 // A COLMAP model of the session's photos (named by file name only, as COLMAP names them when its
@@ -94,7 +95,8 @@ TEST(Similarity3d, EstimateAndTransformPose) {
   }
   ExpectSimilarityNear(Similarity3d::Estimate(source, target, "test"), truth, 1e-12);
   // A point seen by a camera: the same pixel ray in both frames, the depth scaled.
-  const Rigid3d camera_from_source(Eigen::Quaterniond(0.9, 0.1, -0.3, 0.2).normalized(), Eigen::Vector3d(0.3, -0.2, 2.0));
+  const Rigid3d camera_from_source(Eigen::Quaterniond(0.9, 0.1, -0.3, 0.2).normalized(),
+                                   Eigen::Vector3d(0.3, -0.2, 2.0));
   const Rigid3d camera_from_target = truth.TransformPose(camera_from_source);
   const Eigen::Vector3d p_source(0.2, 0.1, 0.4);
   EXPECT_LT((camera_from_target * (truth * p_source) - truth.scale * (camera_from_source * p_source)).norm(), 1e-12);
@@ -170,7 +172,8 @@ TEST(ColmapAlignment, RecoversTheSimilarityOfASyntheticSession) {
 
 // The real model (23 images, one camera each): the similarity to a transformed copy of its own poses.
 TEST(ColmapAlignment, RealModelToATransformedCopyOfItself) {
-  if (!fs::exists(kModel + "/cameras.bin")) GTEST_SKIP() << "../shared/data/colmap-test-model is absent: real-data test skipped";
+  if (!fs::exists(kModel + "/cameras.bin"))
+    GTEST_SKIP() << "../shared/data/colmap-test-model is absent: real-data test skipped";
   const ColmapModel model = ColmapModel::Read(kModel);
   ASSERT_EQ(model.images.size(), 23u);
   const Similarity3d truth = RandomSimilarity(5);
@@ -218,9 +221,10 @@ TEST(ColmapAlignment, TooFewPhotosPosedBothWaysIsAnError) {
   files = {"img1.png", "img2.png", "img3.png"};
   poses = {Rigid3d(), std::nullopt, Rigid3d()};
   message = ErrorOf([&] { AlignColmapModel(model, files, poses, ColmapAlignmentOptions(), "m"); });
-  EXPECT_NE(message.find("3 of the session's 3 photos are in the COLMAP model (matched by file name) and 2 of those were "
-                         "posed by the targets; the similarity needs 3"),
-            std::string::npos)
+  EXPECT_NE(
+      message.find("3 of the session's 3 photos are in the COLMAP model (matched by file name) and 2 of those were "
+                   "posed by the targets; the similarity needs 3"),
+      std::string::npos)
       << message;
   // Poses that no similarity reconciles (every target-based centre the same): refused, not a wrong answer.
   files = {"img1.png", "img2.png", "img3.png", "img4.png"};

@@ -3,10 +3,10 @@
 #include "align/colmap_model.h"
 
 #include <cmath>
-#include <functional>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -22,8 +22,8 @@ using testing::ScratchDir;
 
 const std::string kModel = std::string(IBRDF_SHARED_DATA_DIR) + "/colmap-test-model";
 
-#define REQUIRE_SHARED_DATA()                                                                 \
-  if (!fs::exists(kModel + "/sparse/0/cameras.bin")) {                                      \
+#define REQUIRE_SHARED_DATA()                                                             \
+  if (!fs::exists(kModel + "/sparse/0/cameras.bin")) {                                    \
     GTEST_SKIP() << "../shared/data/colmap-test-model is absent: real-data test skipped"; \
   }
 

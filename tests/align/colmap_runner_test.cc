@@ -73,7 +73,8 @@ TEST(ColmapRunner, CommandsRunOnTheCpuWithTheSessionsCamera) {
   EXPECT_TRUE(Has(commands[0].arguments, "--image_list_path", "/w/image-list.txt"));
   EXPECT_TRUE(Has(commands[0].arguments, "--ImageReader.camera_model", "OPENCV"));
   EXPECT_TRUE(Has(commands[0].arguments, "--ImageReader.single_camera", "1"));
-  const auto params = std::find(commands[0].arguments.begin(), commands[0].arguments.end(), "--ImageReader.camera_params");
+  const auto params =
+      std::find(commands[0].arguments.begin(), commands[0].arguments.end(), "--ImageReader.camera_params");
   ASSERT_NE(params, commands[0].arguments.end());
   EXPECT_EQ(std::count((params + 1)->begin(), (params + 1)->end(), ','), 7);
   EXPECT_EQ(commands[1].step, "exhaustive_matcher");
@@ -85,7 +86,8 @@ TEST(ColmapRunner, CommandsRunOnTheCpuWithTheSessionsCamera) {
   options.use_session_intrinsics = false;
   const std::vector<ColmapCommand> free = ColmapCommands(session, "/w", options);
   EXPECT_FALSE(Has(free[2].arguments, "--Mapper.ba_refine_focal_length", "0"));
-  EXPECT_EQ(std::find(free[0].arguments.begin(), free[0].arguments.end(), "--ImageReader.camera_params"), free[0].arguments.end());
+  EXPECT_EQ(std::find(free[0].arguments.begin(), free[0].arguments.end(), "--ImageReader.camera_params"),
+            free[0].arguments.end());
 }
 
 TEST(ColmapRunner, MissingBinaryIsAClearError) {
@@ -105,7 +107,9 @@ TEST(ColmapRunner, FailingStepNamesItselfAndItsLog) {
   ScratchDir dir;
   const Session session = SmallSession(dir);
   ColmapRunnerOptions options;
-  options.binary = Script(dir / "colmap", "echo \"step $1\"\n[ \"$1\" = exhaustive_matcher ] && { echo 'boom: out of memory'; exit 3; }\nexit 0\n");
+  options.binary =
+      Script(dir / "colmap",
+             "echo \"step $1\"\n[ \"$1\" = exhaustive_matcher ] && { echo 'boom: out of memory'; exit 3; }\nexit 0\n");
   const std::string message = ErrorOf([&] { RunColmap(session, dir / "work", options, false); });
   EXPECT_NE(message.find("exhaustive_matcher: failed with exit code 3"), std::string::npos) << message;
   EXPECT_NE(message.find("boom: out of memory"), std::string::npos) << message;
@@ -129,18 +133,19 @@ TEST(ColmapRunner, ModelAppearsWithTheWorkFolder) {
   ScratchDir dir;
   const Session session = SmallSession(dir);
   ColmapRunnerOptions options;
-  options.binary = Script(
-      dir / "colmap",
-      "[ \"$QT_QPA_PLATFORM\" = offscreen ] || exit 9\n"
-      "if [ \"$1\" = mapper ]; then\n"
-      "  while [ $# -gt 0 ]; do case \"$1\" in --output_path) out=\"$2\";; --image_list_path) list=\"$2\";; esac; shift; done\n"
-      "  mkdir -p \"$out/0\"\n"
-      "  echo '1 PINHOLE 200 150 100 100 100 75' > \"$out/0/cameras.txt\"\n"
-      "  : > \"$out/0/images.txt\"; i=1\n"
-      "  while read name; do echo \"$i 1 0 0 0 0 0 $i 1 $name\" >> \"$out/0/images.txt\"; echo >> \"$out/0/images.txt\"; i=$((i+1)); done < \"$list\"\n"
-      "  : > \"$out/0/points3D.txt\"\n"
-      "  touch \"$out/0/images.bin\"\n"
-      "fi\nexit 0\n");
+  options.binary = Script(dir / "colmap",
+                          "[ \"$QT_QPA_PLATFORM\" = offscreen ] || exit 9\n"
+                          "if [ \"$1\" = mapper ]; then\n"
+                          "  while [ $# -gt 0 ]; do case \"$1\" in --output_path) out=\"$2\";; --image_list_path) "
+                          "list=\"$2\";; esac; shift; done\n"
+                          "  mkdir -p \"$out/0\"\n"
+                          "  echo '1 PINHOLE 200 150 100 100 100 75' > \"$out/0/cameras.txt\"\n"
+                          "  : > \"$out/0/images.txt\"; i=1\n"
+                          "  while read name; do echo \"$i 1 0 0 0 0 0 $i 1 $name\" >> \"$out/0/images.txt\"; echo >> "
+                          "\"$out/0/images.txt\"; i=$((i+1)); done < \"$list\"\n"
+                          "  : > \"$out/0/points3D.txt\"\n"
+                          "  touch \"$out/0/images.bin\"\n"
+                          "fi\nexit 0\n");
   // The stand-in writes text; the runner looks for images.bin, which it touches, and reads text when
   // cameras.bin is absent.
   const ColmapRunResult result = RunColmap(session, dir / "work", options, false);

@@ -94,7 +94,8 @@ TEST(RigidPointError, OffsetFromTheMovedPointAndGradientsCheck) {
   EXPECT_NEAR(residual[0], -1e-3, 1e-15);
   EXPECT_NEAR(residual[1], 2e-3, 1e-15);
 
-  std::unique_ptr<ceres::CostFunction> cost(RigidPointError::Create(p_in_body, p_in_world + Eigen::Vector3d(1e-3, 0, 0)));
+  std::unique_ptr<ceres::CostFunction> cost(
+      RigidPointError::Create(p_in_body, p_in_world + Eigen::Vector3d(1e-3, 0, 0)));
   ceres::NumericDiffOptions numeric;
   ceres::GradientChecker checker(cost.get(), static_cast<const std::vector<const ceres::Manifold*>*>(nullptr), numeric);
   ceres::GradientChecker::ProbeResults results;

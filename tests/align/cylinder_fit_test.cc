@@ -102,11 +102,12 @@ TEST(CylinderFit, CylinderSessionFromItsOwnPhotos) {
   const double axis_error_deg = std::acos(std::min(1.0, result.session.sample.axis.dot(truth.sample.axis))) / kDegree;
   EXPECT_LT(centre_error, 0.2e-3);
   EXPECT_LT(axis_error_deg, 0.2);
-  std::cout << "cylinder: cameras within " << 1e3 * worst_position << " mm and " << worst_rotation
-            << " deg; centre " << 1e3 * centre_error << " mm, axis " << axis_error_deg << " deg\n";
+  std::cout << "cylinder: cameras within " << 1e3 * worst_position << " mm and " << worst_rotation << " deg; centre "
+            << 1e3 * centre_error << " mm, axis " << axis_error_deg << " deg\n";
 
   const TruthComparison with_truth = CompareWithTruth(DerenderAnalytic(truth, DerenderOptions()).samples, *material);
-  const TruthComparison with_aligned = CompareWithTruth(DerenderAnalytic(result.session, DerenderOptions()).samples, *material);
+  const TruthComparison with_aligned =
+      CompareWithTruth(DerenderAnalytic(result.session, DerenderOptions()).samples, *material);
   for (int c = 0; c < 3; ++c) {
     std::cout << "channel " << c << ": median error " << 100 * with_aligned.overall.median[c] << " % aligned, "
               << 100 * with_truth.overall.median[c] << " % true pose\n";

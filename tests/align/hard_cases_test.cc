@@ -2,8 +2,8 @@
 // nearly collinear markers, a single marker, exactly three markers, a camera beside the light, markers
 // partly hidden by the sample. Each photo must come out either within the bounds (0.5 mm,
 // 0.05 degrees) or dropped with a reason: never a silent wrong pose.
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 
 #include <gtest/gtest.h>
@@ -53,9 +53,9 @@ Outcome CorrectOrRefused(const Session& truth, const AlignResult& result) {
     const double rotation = estimated.rotation.angularDistance(expected.rotation) / kDegree;
     EXPECT_LT(position, 0.5e-3) << "photo " << i << " posed, but wrong";
     EXPECT_LT(rotation, 0.05) << "photo " << i << " posed, but wrong";
-    std::cout << "photo " << i << ": " << image.markers << " markers, " << image.outlier_corners << " outlier corners, error "
-              << 1e3 * position << " mm, " << rotation << " deg; predicted sigma " << 1e3 * image.position_sigma_m << " mm, "
-              << image.rotation_sigma_deg << " deg\n";
+    std::cout << "photo " << i << ": " << image.markers << " markers, " << image.outlier_corners
+              << " outlier corners, error " << 1e3 * position << " mm, " << rotation << " deg; predicted sigma "
+              << 1e3 * image.position_sigma_m << " mm, " << image.rotation_sigma_deg << " deg\n";
     ++outcome.correct;
   }
   for (const std::string& reason : outcome.reasons) std::cout << "refused: " << reason << "\n";
@@ -116,7 +116,8 @@ TEST_F(HardCases, NearlyCollinearMarkers) {
   const AlignResult result = AlignOrNothing(WithReference(*truth_, {0, 6}), PosesOnly(), &aligned);
   if (!aligned) return;
   const Outcome outcome = CorrectOrRefused(*truth_, result);
-  for (const std::string& reason : outcome.reasons) EXPECT_NE(reason.find("poorly determined"), std::string::npos) << reason;
+  for (const std::string& reason : outcome.reasons)
+    EXPECT_NE(reason.find("poorly determined"), std::string::npos) << reason;
 }
 
 // One marker alone (allowed by the count): its four corners fix the pose badly; the uncertainty, not
@@ -130,7 +131,8 @@ TEST_F(HardCases, SingleMarkerIsRefusedByItsUncertainty) {
   const Outcome outcome = CorrectOrRefused(*truth_, result);
   EXPECT_GT(outcome.refused, 0);
   for (const std::string& reason : outcome.reasons) {
-    EXPECT_TRUE(reason.find("poorly determined") != std::string::npos || reason.find("ambiguous") != std::string::npos) << reason;
+    EXPECT_TRUE(reason.find("poorly determined") != std::string::npos || reason.find("ambiguous") != std::string::npos)
+        << reason;
   }
 }
 
@@ -178,8 +180,8 @@ TEST(HardCasesHidden, MarkersPartlyHiddenBySample) {
 TEST_F(HardCases, MarkerPartlyCoveredInAPhoto) {
   Session session = *truth_;
   // Where marker 3's top-left corner lands in photo 1.
-  const Eigen::Vector2d corner = session.camera.ImageFromCamera(*session.photos[1].camera_from_world *
-                                                                session.targets->reference[3].corners[0]);
+  const Eigen::Vector2d corner =
+      session.camera.ImageFromCamera(*session.photos[1].camera_from_world * session.targets->reference[3].corners[0]);
   Image image = ReadImage(session.PhotoPath(1));
   const int radius = 6;
   for (int y = int(corner.y()) - radius; y <= int(corner.y()) + radius; ++y) {

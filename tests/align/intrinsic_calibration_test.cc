@@ -94,8 +94,8 @@ TEST(CharucoBoard, LayoutAndDrawing) {
   const std::vector<uint8_t> texels = DrawCharucoBoard(board, 20, &width, &height);
   EXPECT_EQ(width, 180);
   EXPECT_EQ(height, 140);
-  EXPECT_EQ(texels[size_t(10) * width + 10], 0);        // the top-left square is black
-  EXPECT_EQ(texels[size_t(10) * width + 20], 255);      // its neighbour white (the marker's margin)
+  EXPECT_EQ(texels[size_t(10) * width + 10], 0);           // the top-left square is black
+  EXPECT_EQ(texels[size_t(10) * width + 20], 255);         // its neighbour white (the marker's margin)
   EXPECT_EQ(texels[size_t(height - 10) * width + 10], 0);  // rows are odd: the bottom-left is black too
 }
 
@@ -122,7 +122,8 @@ TEST(IntrinsicCalibration, RecoversTheCameraThatTookTheBoardPhotos) {
 
 TEST(IntrinsicCalibration, TooFewUsablePhotosAreRefusedWithTheReasons) {
   ScratchDir dir;
-  const Camera camera = Camera::Create(CameraModelId::kOpenCV, 320, 240, {400.0, 400.0, 160.0, 120.0, -0.05, 0.0, 0.0, 0.0});
+  const Camera camera =
+      Camera::Create(CameraModelId::kOpenCV, 320, 240, {400.0, 400.0, 160.0, 120.0, -0.05, 0.0, 0.0, 0.0});
   CharucoPhotoOptions options;
   options.num_photos = 3;
   ASSERT_TRUE(WriteCharucoPhotos(camera, options, dir / "board", false).success);
@@ -155,7 +156,8 @@ TEST(IntrinsicCalibration, AlignCommandCalibratesThenAligns) {
                       " --targets --photos 4 --light-photos 0 --charuco-photos 24");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   ASSERT_TRUE(fs::exists(dir / "s/calibration/board.json"));
-  run = RunIbrdf("align " + dir / "s" + " --calibrate " + dir / "s/calibration --no-sphere --out " + dir / "aligned", true);
+  run = RunIbrdf("align " + dir / "s" + " --calibrate " + dir / "s/calibration --no-sphere --out " + dir / "aligned",
+                 true);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("calibration: "), std::string::npos) << run.output;
   const Session truth = Session::Load(dir / "s");

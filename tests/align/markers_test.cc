@@ -18,16 +18,16 @@ TEST(MarkerDictionary, KnownAndUnknownNames) {
   const std::vector<bool> cells = dictionary.Modules(3);
   ASSERT_EQ(cells.size(), 36u);
   for (int k = 0; k < 6; ++k) {
-    EXPECT_FALSE(cells[k]);            // top border is black
-    EXPECT_FALSE(cells[30 + k]);       // bottom border
+    EXPECT_FALSE(cells[k]);       // top border is black
+    EXPECT_FALSE(cells[30 + k]);  // bottom border
   }
   EXPECT_THROW(MarkerDictionary("DICT_9X9_7"), Error);
 }
 
 // Renders marker `id` rotated by `angle` about its centre with 16 x 16 supersampling (edges exact to
 // 1/32 pixel) on a white card.
-Image RenderMarker(const MarkerDictionary& dictionary, int id, const Eigen::Vector2d& center, double side,
-                   double angle, std::array<Eigen::Vector2d, 4>* corners) {
+Image RenderMarker(const MarkerDictionary& dictionary, int id, const Eigen::Vector2d& center, double side, double angle,
+                   std::array<Eigen::Vector2d, 4>* corners) {
   Image image(240, 200, 1);
   const std::vector<bool> cells = dictionary.Modules(id);
   const int n = dictionary.modules();
@@ -63,7 +63,9 @@ TEST(DetectMarkers, FindsTheIdAndEdgeFittedCornersAreAccurate) {
     EXPECT_EQ(detections[0].id, 7);
     RefineMarkerCorners(image, camera, &detections);
     for (int k = 0; k < 4; ++k) {
-      EXPECT_LT((detections[0].corners[k] - truth[k]).norm(), 0.05) << "angle " << angle << " corner " << k << " at " << detections[0].corners[k].transpose() << " truth " << truth[k].transpose();
+      EXPECT_LT((detections[0].corners[k] - truth[k]).norm(), 0.05)
+          << "angle " << angle << " corner " << k << " at " << detections[0].corners[k].transpose() << " truth "
+          << truth[k].transpose();
     }
   }
 }

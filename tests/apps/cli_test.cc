@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <functional>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -20,11 +20,10 @@ namespace ibrdf {
 namespace {
 
 using testing::MaterialPath;
-using testing::ScratchDir;
 using testing::RunIbrdf;
 using testing::RunResult;
+using testing::ScratchDir;
 namespace fs = std::filesystem;
-
 
 nlohmann::json ReadJson(const std::string& path) {
   std::ifstream in(path);
@@ -38,7 +37,7 @@ class CliTest : public ::testing::Test {
   void SetUp() override {
     session_ = dir_ / "session";
     const RunResult synth = RunIbrdf("synth --out " + session_ + " --material " + MaterialPath("lambertian50") +
-                                " --photos 2 --width 96 --height 72");
+                                     " --photos 2 --width 96 --height 72");
     ASSERT_EQ(synth.exit_code, 0) << synth.output;
     manifest_ = session_ + "/session.json";
   }
@@ -175,8 +174,8 @@ TEST_F(CliTest, NeverOverwritesInputsOrExistingOutputs) {
 TEST(Cli, AlignWritesAnAlignedSessionThatDerenders) {
   ScratchDir dir;
   const std::string session = dir / "targets";
-  RunResult result = RunIbrdf("synth --out " + session + " --material " + MaterialPath("lambertian50") +
-                              " --targets --photos 3");
+  RunResult result =
+      RunIbrdf("synth --out " + session + " --material " + MaterialPath("lambertian50") + " --targets --photos 3");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   result = RunIbrdf("align " + session + " --out " + (dir / "aligned"));
   ASSERT_EQ(result.exit_code, 0) << result.output;

@@ -59,13 +59,17 @@ class ReportTest : public ::testing::Test {
   void MakeRunFolder() {
     const std::string s = dir_ / "s", run = dir_ / "run";
     ASSERT_EQ(RunIbrdf(std::string("synth --material ") + IBRDF_SAMPLES_DIR +
-                       "/materials/bluepaint.json --width 160 --height 120 --photos 6 --out " + s).exit_code, 0);
+                       "/materials/bluepaint.json --width 160 --height 120 --photos 6 --out " + s)
+                  .exit_code,
+              0);
     fs::create_directories(run);
     ASSERT_EQ(RunIbrdf("derender " + s + " --out " + run + "/samples.npy").exit_code, 0);
     ASSERT_EQ(RunIbrdf("check " + run + "/samples.npy --out " + run + "/consistency.json").exit_code, 0);
     ASSERT_EQ(RunIbrdf("compare " + run + "/samples.npy --out " + run + "/truth-comparison.json").exit_code, 0);
     ASSERT_EQ(RunIbrdf("reconstruct " + run + "/samples.npy --no-fits --out " + run + "/reconstruction --truth " + s +
-                       "/truth.json").exit_code, 0);
+                       "/truth.json")
+                  .exit_code,
+              0);
   }
   ScratchDir dir_;
 };
@@ -87,7 +91,8 @@ TEST_F(ReportTest, WritesEveryFigureAndTheHtmlShowsThemInHeadlessChromium) {
   EXPECT_EQ(images, embedded);
 
   const std::string chromium = Chromium();
-  if (chromium.empty()) GTEST_SKIP() << "chromium is not installed (scripts/install-deps installs it): browser check skipped";
+  if (chromium.empty())
+    GTEST_SKIP() << "chromium is not installed (scripts/install-deps installs it): browser check skipped";
   // The page plus a script that counts the images the browser decoded, and one broken image that must
   // count as failed (so the check can fail).
   std::string page = html;
@@ -101,9 +106,10 @@ TEST_F(ReportTest, WritesEveryFigureAndTheHtmlShowsThemInHeadlessChromium) {
       "</script></body>";
   page.replace(page.rfind("</body>"), 7, probe);
   { std::ofstream(dir_ / "check.html") << page; }
-  const std::string dom = Capture(chromium + " --headless --disable-gpu --no-sandbox --virtual-time-budget=5000 "
-                                  "--user-data-dir=" + dir_ / "chromium" + " --dump-dom file://" + dir_ / "check.html" +
-                                  " 2>/dev/null");
+  const std::string dom = Capture(chromium +
+                                  " --headless --disable-gpu --no-sandbox --virtual-time-budget=5000 "
+                                  "--user-data-dir=" +
+                                  dir_ / "chromium" + " --dump-dom file://" + dir_ / "check.html" + " 2>/dev/null");
   std::smatch match;
   ASSERT_TRUE(std::regex_search(dom, match, std::regex("IMAGES ok=(\\d+) bad=(\\d+) broken=(\\w+)")))
       << "chromium printed no result; DOM (first 500 characters): " << dom.substr(0, 500);

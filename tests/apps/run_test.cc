@@ -147,7 +147,8 @@ TEST(RunCommand, BadInputIsOneClearLine) {
   ScratchDir dir;
   RunResult result = RunIbrdf("run " + dir / "missing" + " --out " + dir / "run");
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.output.find("ibrdf: error: " + dir / "missing" + ": does not exist"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("ibrdf: error: " + dir / "missing" + ": does not exist"), std::string::npos)
+      << result.output;
   EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << result.output;
 
   ASSERT_EQ(RunIbrdf(kSynth + dir / "s").exit_code, 0);

@@ -6,8 +6,8 @@
 #include <random>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 namespace ibrdf {
 namespace {
@@ -22,8 +22,7 @@ Eigen::Vector3d RandomDirection(std::mt19937& rng, bool upper) {
 }
 
 bool AllFinite(const HalfDiffAngles& a) {
-  return std::isfinite(a.theta_h) && std::isfinite(a.phi_h) && std::isfinite(a.theta_d) &&
-         std::isfinite(a.phi_d);
+  return std::isfinite(a.theta_h) && std::isfinite(a.phi_h) && std::isfinite(a.theta_d) && std::isfinite(a.phi_d);
 }
 
 bool AllFinite(const IsotropicAngles& a) {
@@ -45,11 +44,19 @@ void ExpectOrthonormalRightHanded(const Eigen::Vector3d& n) {
 
 TEST(LocalFrame, OrthonormalRightHandedForSpecialNormals) {
   const std::vector<Eigen::Vector3d> normals = {
-      {0, 0, 1},  {0, 0, -1}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0},
+      {0, 0, 1},
+      {0, 0, -1},
+      {1, 0, 0},
+      {0, 1, 0},
+      {-1, 0, 0},
+      {0, -1, 0},
       {1, 0, -0.0},  // z = -0: the sign switch must still give a valid frame
-      Eigen::Vector3d(1e-9, 0, -1).normalized(),  Eigen::Vector3d(0, 1e-9, -1).normalized(),
-      Eigen::Vector3d(1e-9, 1e-9, 1).normalized(), Eigen::Vector3d(-1e-12, 3e-12, -1).normalized(),
-      Eigen::Vector3d(1, 1, 1e-15).normalized(),   Eigen::Vector3d(1, -1, -1e-15).normalized(),
+      Eigen::Vector3d(1e-9, 0, -1).normalized(),
+      Eigen::Vector3d(0, 1e-9, -1).normalized(),
+      Eigen::Vector3d(1e-9, 1e-9, 1).normalized(),
+      Eigen::Vector3d(-1e-12, 3e-12, -1).normalized(),
+      Eigen::Vector3d(1, 1, 1e-15).normalized(),
+      Eigen::Vector3d(1, -1, -1e-15).normalized(),
   };
   for (const Eigen::Vector3d& n : normals) ExpectOrthonormalRightHanded(n);
 }
@@ -174,11 +181,10 @@ TEST(Isotropic, DeltaPhiSign) {
   EXPECT_NEAR(a.delta_phi, 0.3, 1e-15);
   EXPECT_NEAR(ToIsotropic(FromSpherical(0.7, 0.3), FromSpherical(0.5, 0.0)).delta_phi, -0.3, 1e-15);
   EXPECT_NEAR(ToIsotropic(FromSpherical(0.5, 1.0), FromSpherical(0.7, 1.3)).delta_phi, 0.3, 1e-15);
-  EXPECT_NEAR(ToIsotropic(FromSpherical(0.5, 3.0), FromSpherical(0.7, -3.0)).delta_phi,
-              2 * M_PI - 6.0, 1e-14);
+  EXPECT_NEAR(ToIsotropic(FromSpherical(0.5, 3.0), FromSpherical(0.7, -3.0)).delta_phi, 2 * M_PI - 6.0, 1e-14);
   // Opposite azimuths (the plane of incidence, back-scattering side) give +pi, never -pi.
-  EXPECT_DOUBLE_EQ(ToIsotropic(Eigen::Vector3d(1, 0, 1).normalized(),
-                               Eigen::Vector3d(-1, -0.0, 1).normalized()).delta_phi, M_PI);
+  EXPECT_DOUBLE_EQ(
+      ToIsotropic(Eigen::Vector3d(1, 0, 1).normalized(), Eigen::Vector3d(-1, -0.0, 1).normalized()).delta_phi, M_PI);
 }
 
 // The isotropic form depends on the pair only through its invariants: rotating both directions about
@@ -362,8 +368,7 @@ TEST(HalfDiff, GrazingRoundTrip) {
 
 // wi = -wo leaves h undefined: false, zero angles, no NaN.
 TEST(HalfDiff, OppositeDirectionsAreRejected) {
-  for (const Eigen::Vector3d& wi :
-       {FromSpherical(M_PI / 2, 0.3), Eigen::Vector3d(0, 0, 1), FromSpherical(0.7, -1.0)}) {
+  for (const Eigen::Vector3d& wi : {FromSpherical(M_PI / 2, 0.3), Eigen::Vector3d(0, 0, 1), FromSpherical(0.7, -1.0)}) {
     HalfDiffAngles a;
     a.theta_h = a.phi_h = a.theta_d = a.phi_d = 123.0;
     EXPECT_FALSE(ToHalfDiff(wi, -wi, &a)) << wi.transpose();

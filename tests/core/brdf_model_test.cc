@@ -42,8 +42,8 @@ const LafortuneLobe kBluepaintLobes[] = {
 };
 
 LafortuneBrdf Bluepaint() {
-  return LafortuneBrdf(kBluepaintDiffuse, std::vector<LafortuneLobe>(std::begin(kBluepaintLobes),
-                                                                    std::end(kBluepaintLobes)));
+  return LafortuneBrdf(kBluepaintDiffuse,
+                       std::vector<LafortuneLobe>(std::begin(kBluepaintLobes), std::end(kBluepaintLobes)));
 }
 
 // The formula of cornell-lafortune.json, written out independently:
@@ -195,16 +195,21 @@ TEST(LafortuneBrdf, BluepaintMatchesPublishedFormula) {
     Eigen::Vector3d wi, wo, f;
   };
   const Case cases[] = {
-      {FromSpherical(30 * deg, 0), FromSpherical(30 * deg, M_PI),
+      {FromSpherical(30 * deg, 0),
+       FromSpherical(30 * deg, M_PI),
        {0.10197657086616373, 0.13001479704811958, 0.2360779485969836}},
-      {FromSpherical(45 * deg, 0), FromSpherical(45 * deg, 0),
+      {FromSpherical(45 * deg, 0),
+       FromSpherical(45 * deg, 0),
        {0.11913615572664356, 0.14893040934652677, 0.25670496933731657}},
       {FromSpherical(0, 0), FromSpherical(0, 0), {0.10699103296563059, 0.13488097049596426, 0.24837474482344285}},
-      {FromSpherical(60 * deg, 0), FromSpherical(20 * deg, 100 * deg),
+      {FromSpherical(60 * deg, 0),
+       FromSpherical(20 * deg, 100 * deg),
        {0.09856983085128881, 0.12637320895015197, 0.22607847695748076}},
-      {FromSpherical(60 * deg, 0), FromSpherical(60 * deg, M_PI),
+      {FromSpherical(60 * deg, 0),
+       FromSpherical(60 * deg, M_PI),
        {0.18347661578265229, 0.204076530965779, 0.2969423348816829}},
-      {FromSpherical(80 * deg, 0), FromSpherical(80 * deg, M_PI),
+      {FromSpherical(80 * deg, 0),
+       FromSpherical(80 * deg, M_PI),
        {4.4185145316651395, 3.6196000917199007, 2.8312280720072707}},
   };
   for (const Case& c : cases) {
@@ -282,7 +287,7 @@ TEST(MaterialFromJson, UnknownKeyIsAnErrorNamingIt) {
 
 TEST(MaterialFromJson, UnknownModelIsAnError) {
   ExpectErrorNaming({{"model", "phong"}, {"albedo", {0.5, 0.5, 0.5}}}, "/model");
-  ExpectErrorNaming({{"albedo", {0.5, 0.5, 0.5}}}, "/model");  // missing
+  ExpectErrorNaming({{"albedo", {0.5, 0.5, 0.5}}}, "/model");                // missing
   ExpectErrorNaming({{"model", 3}, {"albedo", {0.5, 0.5, 0.5}}}, "/model");  // not a string
 }
 
@@ -323,8 +328,7 @@ TEST(MaterialFromJson, ImpossibleParametersAreErrors) {
 
 // A material embedded in another file reports its own pointer prefix.
 TEST(MaterialFromJson, ErrorsCarryThePointerPrefix) {
-  ExpectErrorNaming({{"model", "lambertian"}, {"albedo", {0.5, -0.5, 0.5}}}, "/material/albedo",
-                    "/material");
+  ExpectErrorNaming({{"model", "lambertian"}, {"albedo", {0.5, -0.5, 0.5}}}, "/material/albedo", "/material");
 }
 
 // LoadMaterial reads a file; its errors name the file.

@@ -15,17 +15,21 @@ namespace ibrdf {
 namespace {
 
 constexpr CameraModelId kAllModels[] = {CameraModelId::kSimplePinhole, CameraModelId::kPinhole,
-                                        CameraModelId::kSimpleRadial, CameraModelId::kRadial,
-                                        CameraModelId::kOpenCV};
+                                        CameraModelId::kSimpleRadial, CameraModelId::kRadial, CameraModelId::kOpenCV};
 
 // A valid parameter list for each model (focal 3000 px, principal point at the image centre).
 std::vector<double> ValidParams(CameraModelId model) {
   switch (model) {
-    case CameraModelId::kSimplePinhole: return {3000, 400, 300};
-    case CameraModelId::kPinhole: return {3000, 3010, 400, 300};
-    case CameraModelId::kSimpleRadial: return {3000, 400, 300, -0.08};
-    case CameraModelId::kRadial: return {3000, 400, 300, -0.08, 0.02};
-    case CameraModelId::kOpenCV: return {3000, 3000, 400, 300, -0.08, 0.02, 5e-4, -3e-4};
+    case CameraModelId::kSimplePinhole:
+      return {3000, 400, 300};
+    case CameraModelId::kPinhole:
+      return {3000, 3010, 400, 300};
+    case CameraModelId::kSimpleRadial:
+      return {3000, 400, 300, -0.08};
+    case CameraModelId::kRadial:
+      return {3000, 400, 300, -0.08, 0.02};
+    case CameraModelId::kOpenCV:
+      return {3000, 3000, 400, 300, -0.08, 0.02, 5e-4, -3e-4};
   }
   return {};
 }
@@ -134,8 +138,7 @@ TEST(Camera, CreateRejectsNonPositiveFocal) {
   EXPECT_THROW(Camera::Create(CameraModelId::kSimplePinhole, 800, 600, {-3000, 400, 300}), Error);
   EXPECT_THROW(Camera::Create(CameraModelId::kPinhole, 800, 600, {3000, 0, 400, 300}), Error);
   EXPECT_THROW(Camera::Create(CameraModelId::kPinhole, 800, 600, {-1, 3000, 400, 300}), Error);
-  EXPECT_THROW(Camera::Create(CameraModelId::kOpenCV, 800, 600, {3000, -3000, 400, 300, 0, 0, 0, 0}),
-               Error);
+  EXPECT_THROW(Camera::Create(CameraModelId::kOpenCV, 800, 600, {3000, -3000, 400, 300, 0, 0, 0, 0}), Error);
 }
 
 // An image needs a positive width and height.
@@ -218,8 +221,7 @@ TEST(Camera, PinholeProjectionFormula) {
 // radial-tangential model; COLMAP's SIMPLE_RADIAL and RADIAL are its radial part).
 TEST(Camera, DistortionMatchesOpenCvFormula) {
   const double k1 = -0.08, k2 = 0.02, p1 = 5e-4, p2 = -3e-4;
-  const Camera camera =
-      Camera::Create(CameraModelId::kOpenCV, 800, 600, {3000, 3000, 400, 300, k1, k2, p1, p2});
+  const Camera camera = Camera::Create(CameraModelId::kOpenCV, 800, 600, {3000, 3000, 400, 300, k1, k2, p1, p2});
   const double x = 0.3, y = -0.2, r2 = x * x + y * y;
   const double radial = 1 + k1 * r2 + k2 * r2 * r2;
   const Eigen::Vector2d expected(x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
@@ -227,17 +229,14 @@ TEST(Camera, DistortionMatchesOpenCvFormula) {
   EXPECT_NEAR((camera.Distort(Eigen::Vector2d(x, y)) - expected).norm(), 0.0, 1e-15);
 
   const Camera radial_camera = Camera::Create(CameraModelId::kRadial, 800, 600, {3000, 400, 300, k1, k2});
-  EXPECT_NEAR((radial_camera.Distort(Eigen::Vector2d(x, y)) - Eigen::Vector2d(x, y) * radial).norm(), 0.0,
-              1e-15);
+  EXPECT_NEAR((radial_camera.Distort(Eigen::Vector2d(x, y)) - Eigen::Vector2d(x, y) * radial).norm(), 0.0, 1e-15);
   const Camera simple = Camera::Create(CameraModelId::kSimpleRadial, 800, 600, {3000, 400, 300, k1});
-  EXPECT_NEAR((simple.Distort(Eigen::Vector2d(x, y)) - Eigen::Vector2d(x, y) * (1 + k1 * r2)).norm(), 0.0,
-              1e-15);
+  EXPECT_NEAR((simple.Distort(Eigen::Vector2d(x, y)) - Eigen::Vector2d(x, y) * (1 + k1 * r2)).norm(), 0.0, 1e-15);
 }
 
 // Unprojection inverts projection over the whole image, for the realistic lens of the brief.
 TEST(Camera, OpenCvRoundTripOverWholeImage) {
-  ExpectRoundTrip(Camera::Create(CameraModelId::kOpenCV, 800, 600,
-                                 {3000, 3000, 400, 300, -0.08, 0.02, 5e-4, -3e-4}));
+  ExpectRoundTrip(Camera::Create(CameraModelId::kOpenCV, 800, 600, {3000, 3000, 400, 300, -0.08, 0.02, 5e-4, -3e-4}));
 }
 
 TEST(Camera, RadialRoundTripOverWholeImage) {
@@ -247,8 +246,7 @@ TEST(Camera, RadialRoundTripOverWholeImage) {
 
 // A wide-angle lens (normalized radius up to 0.83) with strong distortion still inverts exactly.
 TEST(Camera, WideAngleRoundTripOverWholeImage) {
-  ExpectRoundTrip(Camera::Create(CameraModelId::kOpenCV, 800, 600,
-                                 {600, 600, 400, 300, -0.08, 0.02, 5e-4, -3e-4}));
+  ExpectRoundTrip(Camera::Create(CameraModelId::kOpenCV, 800, 600, {600, 600, 400, 300, -0.08, 0.02, 5e-4, -3e-4}));
   ExpectRoundTrip(Camera::Create(CameraModelId::kRadial, 800, 600, {600, 400, 300, -0.08, 0.02}));
 }
 

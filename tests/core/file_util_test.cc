@@ -30,9 +30,7 @@ std::string ReadText(const std::string& path) {
 // A fresh folder per test.
 class FileUtilTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = scratch_.str();
-  }
+  void SetUp() override { dir_ = scratch_.str(); }
   testing::ScratchDir scratch_;
 
   std::string Path(const std::string& name) const { return (fs::path(dir_) / name).string(); }

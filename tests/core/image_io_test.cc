@@ -25,9 +25,7 @@ namespace {
 // A fresh, empty folder per test, removed afterwards.
 class ImageIoTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = scratch_.str();
-  }
+  void SetUp() override { dir_ = scratch_.str(); }
   testing::ScratchDir scratch_;
 
   std::string Path(const std::string& name) const { return (fs::path(dir_) / name).string(); }

@@ -185,9 +185,7 @@ TEST(ToJson, VectorIsAnArrayOfThree) {
 // A folder per test for the file-based tests.
 class JsonFileTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = scratch_.str();
-  }
+  void SetUp() override { dir_ = scratch_.str(); }
   testing::ScratchDir scratch_;
   std::string Path(const std::string& name) const { return (fs::path(dir_) / name).string(); }
   std::string dir_;

@@ -129,8 +129,7 @@ TEST(LookAtCameraFromWorld, ObliqueUpStillPointsUp) {
 
 // Looking along `up` leaves the roll undefined: an internal check, not a silent NaN pose.
 TEST(LookAtCameraFromWorld, UpParallelToViewIsAnInternalError) {
-  EXPECT_THROW(LookAtCameraFromWorld(Eigen::Vector3d(0, 0, 5), Eigen::Vector3d::Zero(),
-                                     Eigen::Vector3d(0, 0, 1)),
+  EXPECT_THROW(LookAtCameraFromWorld(Eigen::Vector3d(0, 0, 5), Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 1)),
                InternalError);
 }
 

@@ -53,9 +53,7 @@ std::string ReadBytes(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-void WriteBytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary) << bytes;
-}
+void WriteBytes(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
 
 // Replaces `from` by `to` in the header of .npy 1.0 `bytes` and updates the header length field.
 std::string EditHeader(const std::string& bytes, const std::string& from, const std::string& to) {
@@ -74,9 +72,7 @@ std::string EditHeader(const std::string& bytes, const std::string& from, const 
 // A fresh folder per test.
 class SampleFileTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = scratch_.str();
-  }
+  void SetUp() override { dir_ = scratch_.str(); }
   testing::ScratchDir scratch_;
   std::string Path(const std::string& name) const { return (fs::path(dir_) / name).string(); }
 

@@ -362,8 +362,8 @@ TEST_F(SessionTest, SaveLoadRoundTrip) {
 TEST_F(SessionTest, SaveLoadRoundTripOfVariants) {
   json manifest = ValidManifest();
   manifest["light"] = {{"kind", "directional"}, {"direction", {0.0, 0.6, 0.8}}, {"intensity", {2.0, 2.0, 2.0}}};
-  manifest["sample"] = {{"kind", "cylinder"}, {"center", {0.0, 0.0, 0.1}}, {"axis", {0.0, 0.0, 1.0}},
-                        {"radius", 0.02}, {"length", 0.1}};
+  manifest["sample"] = {
+      {"kind", "cylinder"}, {"center", {0.0, 0.0, 0.1}}, {"axis", {0.0, 0.0, 1.0}}, {"radius", 0.02}, {"length", 0.1}};
   manifest["radiometry"] = {{"response", {{"gamma", 1.8}}}};
   WriteManifest(manifest);
   const Session gamma = Session::Load(ManifestPath());

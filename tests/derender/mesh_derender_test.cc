@@ -107,9 +107,9 @@ TEST(MeshDerender, UvSphereMatchesTheAnalyticSphere) {
   std::sort(errors.begin(), errors.end());
   const double median = errors[errors.size() / 2], worst = errors.back();
   EXPECT_LT(median, 5e-4);  // measured 1.1e-4
-  EXPECT_LT(worst, 0.01);    // measured 5.3e-3
-  std::printf("mesh vs analytic sphere: %zu matched of %zu; |f_mesh / f_exact - 1| median %.2e, max %.2e\n",
-              matched, exact.samples.size(), median, worst);
+  EXPECT_LT(worst, 0.01);   // measured 5.3e-3
+  std::printf("mesh vs analytic sphere: %zu matched of %zu; |f_mesh / f_exact - 1| median %.2e, max %.2e\n", matched,
+              exact.samples.size(), median, worst);
 }
 
 // 10 km from the origin (scanner coordinates often are), the mesh placed by world_from_mesh or
@@ -173,7 +173,8 @@ ShadowScene RenderShadowScene(const ScratchDir& dir) {
     for (int y = 0; y < image.height; ++y) {
       for (int x = 0; x < image.width; ++x) {
         const Eigen::Vector2d xy = session.camera.CamPlaneFromImage(Eigen::Vector2d(x + 0.5, y + 0.5));
-        const Eigen::Vector3d direction = (world_from_camera.rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+        const Eigen::Vector3d direction =
+            (world_from_camera.rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
         SurfaceHit on_sphere, on_ball;
         const bool a = sphere.Intersect(world_from_camera.translation, direction, &on_sphere);
         const bool b = ball.Intersect(world_from_camera.translation, direction, &on_ball);
@@ -182,8 +183,8 @@ ShadowScene RenderShadowScene(const ScratchDir& dir) {
         const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
         if (!incidence.lit) continue;
         SurfaceHit blocker;
-        const bool shadowed = (&hit == &on_sphere) && ball.Intersect(hit.point, incidence.wi, &blocker) &&
-                              blocker.t < incidence.distance;
+        const bool shadowed =
+            (&hit == &on_sphere) && ball.Intersect(hit.point, incidence.wi, &blocker) && blocker.t < incidence.distance;
         scene.shadowed_pixels += shadowed;
         for (int c = 0; c < 3; ++c) {
           const double radiance = shadowed ? indirect : kAlbedo / M_PI * incidence.irradiance[c];
@@ -247,10 +248,11 @@ TEST(MeshDerender, ShadowRaysRejectWhatVisibilityOffAcceptsWrongly) {
   Session keyed = scene.session;
   keyed.sample.visibility = Visibility::kOff;
   EXPECT_EQ(Derender(keyed, DerenderOptions()).samples.size(), without.samples.size());
-  std::printf("shadow scene: %llu shadowed pixels; visibility off: %zu samples, %zu wrong by > 5 %%; on: %zu samples, "
-              "shadowed %llu, shadow_edge %llu\n",
-              (unsigned long long)scene.shadowed_pixels, without.samples.size(), wrong_without, with.samples.size(),
-              (unsigned long long)Rejected(with, "shadowed"), (unsigned long long)Rejected(with, "shadow_edge"));
+  std::printf(
+      "shadow scene: %llu shadowed pixels; visibility off: %zu samples, %zu wrong by > 5 %%; on: %zu samples, "
+      "shadowed %llu, shadow_edge %llu\n",
+      (unsigned long long)scene.shadowed_pixels, without.samples.size(), wrong_without, with.samples.size(),
+      (unsigned long long)Rejected(with, "shadowed"), (unsigned long long)Rejected(with, "shadow_edge"));
 }
 
 TEST(MeshDerender, ReferenceMarkerInFrontOfTheSampleIsMasked) {
@@ -318,7 +320,8 @@ TEST(MeshDerender, SessionMeshKeysRoundTrip) {
                                 {"scan/view-1.ply", Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 1))}};
   ScanTargetSpec target;
   target.id = 3;
-  target.corners = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(0, 1, 0)};
+  target.corners = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, 1, 0),
+                    Eigen::Vector3d(0, 1, 0)};
   session.sample.scan_targets = {target};
   session.Save(dir / "s/session.json");
   const Session back = Session::Load(dir / "s");  // the mesh file need not exist yet
@@ -327,7 +330,8 @@ TEST(MeshDerender, SessionMeshKeysRoundTrip) {
   EXPECT_EQ(back.sample.visibility, Visibility::kOn);
   EXPECT_NEAR(back.sample.world_from_mesh.scale, 0.001, 1e-15);
   EXPECT_NEAR((back.sample.world_from_mesh.translation - Eigen::Vector3d(1e4, 2.0, -3.0)).norm(), 0.0, 1e-12);
-  EXPECT_NEAR(back.sample.world_from_mesh.rotation.angularDistance(session.sample.world_from_mesh.rotation), 0.0, 1e-12);
+  EXPECT_NEAR(back.sample.world_from_mesh.rotation.angularDistance(session.sample.world_from_mesh.rotation), 0.0,
+              1e-12);
   ASSERT_EQ(back.sample.scan_inputs.size(), 2u);
   EXPECT_FALSE(back.sample.scan_inputs[0].world_from_scan.has_value());
   ASSERT_TRUE(back.sample.scan_inputs[1].world_from_scan.has_value());

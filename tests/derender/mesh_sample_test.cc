@@ -78,7 +78,8 @@ TEST(MeshSample, RaysThroughVerticesAndEdgesHit) {
   // Exactly through the midpoint of the edge from (1, 0, 0) to (0, 0, 1), shared by two faces: the
   // robust traversal cannot let it slip between them.
   const Eigen::Vector3d midpoint(0.5, 0, 0.5);
-  for (const Eigen::Vector3d& from : {Eigen::Vector3d(2, 0, 2), Eigen::Vector3d(0.5, 3, 0.5), Eigen::Vector3d(2, 1, 0.5)}) {
+  for (const Eigen::Vector3d& from :
+       {Eigen::Vector3d(2, 0, 2), Eigen::Vector3d(0.5, 3, 0.5), Eigen::Vector3d(2, 1, 0.5)}) {
     ASSERT_TRUE(mesh.Intersect(from, (midpoint - from).normalized(), &hit)) << from.transpose();
     ExpectFiniteHit(hit);
     EXPECT_NEAR((hit.point - midpoint).norm(), 0.0, 1e-9);
@@ -134,8 +135,10 @@ TEST(MeshSample, RayModesAgree) {
   }
   std::vector<SurfaceHit> reference(directions.size());
   std::unique_ptr<bool[]> reference_found(new bool[directions.size()]);
-  for (size_t i = 0; i < directions.size(); ++i) reference_found[i] = mesh.Intersect(camera, directions[i], &reference[i]);
-  for (MeshSample::RayMode mode : {MeshSample::RayMode::kSingle, MeshSample::RayMode::kPacket8, MeshSample::RayMode::kStream}) {
+  for (size_t i = 0; i < directions.size(); ++i)
+    reference_found[i] = mesh.Intersect(camera, directions[i], &reference[i]);
+  for (MeshSample::RayMode mode :
+       {MeshSample::RayMode::kSingle, MeshSample::RayMode::kPacket8, MeshSample::RayMode::kStream}) {
     mesh.set_ray_mode(mode);
     std::vector<SurfaceHit> hits(directions.size());
     std::unique_ptr<bool[]> found(new bool[directions.size()]);
@@ -180,7 +183,8 @@ TEST(MeshSample, FarFromOriginAndScaledKeepPrecision) {
     ++hits;
     for (const SurfaceHit* other : {&b, &c, &e}) {
       EXPECT_NEAR(other->t, a.t, 1e-9);
-      EXPECT_NEAR((other->point - far - (other == &e ? Eigen::Vector3d(rotation * a.point) : a.point)).norm(), 0.0, 1e-9);
+      EXPECT_NEAR((other->point - far - (other == &e ? Eigen::Vector3d(rotation * a.point) : a.point)).norm(), 0.0,
+                  1e-9);
     }
     EXPECT_NEAR(d.t, a.t, 1e-9);
     EXPECT_NEAR((b.normal - a.normal).norm(), 0.0, 1e-9);
@@ -223,8 +227,8 @@ TEST(MeshSample, MeshWithoutNormalsOrFacesIsAnError) {
 }
 
 TEST(QuadOccluders, BlockOnlyBeforeTheLimit) {
-  const QuadOccluders quads({{Eigen::Vector3d(-1, -1, 1), Eigen::Vector3d(1, -1, 1), Eigen::Vector3d(1, 1, 1),
-                              Eigen::Vector3d(-1, 1, 1)}});
+  const QuadOccluders quads(
+      {{Eigen::Vector3d(-1, -1, 1), Eigen::Vector3d(1, -1, 1), Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(-1, 1, 1)}});
   EXPECT_EQ(quads.NumQuads(), 1u);
   EXPECT_TRUE(quads.Blocks(Eigen::Vector3d(0, 0, 3), Eigen::Vector3d(0, 0, -1), 5.0));
   EXPECT_FALSE(quads.Blocks(Eigen::Vector3d(0, 0, 3), Eigen::Vector3d(0, 0, -1), 1.5));

@@ -77,9 +77,9 @@ TEST(RadianceImage, FlagsSaturatedBelowSignalAndNonFinite) {
   Session session = SmallSession(dir);
   Image image(kWidth, kHeight, 3);
   for (float& v : image.pixels) v = 0.4f;
-  image.at(1, 1, 2) = 1.0f;                          // one channel clipped
-  image.at(2, 1, 0) = 0.001f;                        // darkest channel below the floor
-  image.at(3, 1, 1) = std::nanf("");                 // not finite
+  image.at(1, 1, 2) = 1.0f;           // one channel clipped
+  image.at(2, 1, 0) = 0.001f;         // darkest channel below the floor
+  image.at(3, 1, 1) = std::nanf("");  // not finite
   WriteImage(dir / "a.exr", image, PixelFormat::kFloat);
   PhotoSpec photo;
   photo.file = "a.exr";
@@ -144,8 +144,12 @@ TEST(RadianceImage, ExposureGroupsByBracketAndByPose) {
     p.role = role;
     return p;
   };
-  session.photos = {photo(a, std::nullopt), photo(b, 7), photo(a, std::nullopt), photo(b, 7),
-                    photo(b, std::nullopt, PhotoRole::kTargets), photo(b, 8)};
+  session.photos = {photo(a, std::nullopt),
+                    photo(b, 7),
+                    photo(a, std::nullopt),
+                    photo(b, 7),
+                    photo(b, std::nullopt, PhotoRole::kTargets),
+                    photo(b, 8)};
   const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
   ASSERT_EQ(groups.size(), 3u);
   EXPECT_EQ(groups[0], (std::vector<size_t>{0, 2}));

@@ -100,7 +100,8 @@ TEST(Radiometry, CalibratedSrgbSessionMatchesLinearSession) {
     if (step == 2) partial.radiometry.flat_field.clear();
     if (step != 3) partial = ApplyLightCalibration(partial, &report);
     const TruthComparison worse = Measure(partial, *material);
-    EXPECT_GT(worse.overall.median.maxCoeff(), reference.overall.median.maxCoeff() + 0.02) << "without the " << names[step];
+    EXPECT_GT(worse.overall.median.maxCoeff(), reference.overall.median.maxCoeff() + 0.02)
+        << "without the " << names[step];
   }
 }
 
@@ -133,7 +134,8 @@ TEST(Radiometry, BracketRecoversClippedHighlight) {
   double peak = 0.0;
   for (const BrdfSample& s : merged.samples) peak = std::max(peak, truth_of(s).maxCoeff());
   // The mirror configuration's value: the merged samples reach the true peak.
-  const double mirror = material.Eval(Eigen::Vector3d(0.3, 0, 1).normalized(), Eigen::Vector3d(-0.3, 0, 1).normalized()).maxCoeff();
+  const double mirror =
+      material.Eval(Eigen::Vector3d(0.3, 0, 1).normalized(), Eigen::Vector3d(-0.3, 0, 1).normalized()).maxCoeff();
   EXPECT_GT(peak, 0.9 * mirror);
   // The peak: samples whose truth is at least 80 % of it, measured against the truth.
   Eigen::Vector3d measured_sum = Eigen::Vector3d::Zero(), truth_sum = Eigen::Vector3d::Zero();

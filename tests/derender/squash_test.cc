@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
-#include <fstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -35,8 +35,7 @@ using testing::ScratchDir;
 std::string SynthArgs(const std::string& shape, const std::string& out, double scan_offset_m) {
   return "synth --out " + out + " --material " + testing::MaterialPath("bluepaint") + " --shape " + shape +
          " --effects none --width 640 --height 480 --photos 4 --light-photos 0 --scan-spacing-m 0.0015" +
-         " --truth-mesh-spacing-m 0.0015" +
-         " --scan-offset-m " + std::to_string(scan_offset_m);
+         " --truth-mesh-spacing-m 0.0015" + " --scan-offset-m " + std::to_string(scan_offset_m);
 }
 
 void RunOk(const std::string& arguments) {
@@ -48,7 +47,8 @@ void RunOk(const std::string& arguments) {
 void ScanSession(const std::string& dir) {
   const Session session = Session::Load(dir);
   std::string inputs;
-  for (const ScanInputSpec& input : session.sample.scan_inputs) inputs += " " + ResolvePath(session.directory, input.file);
+  for (const ScanInputSpec& input : session.sample.scan_inputs)
+    inputs += " " + ResolvePath(session.directory, input.file);
   RunOk("scan" + inputs + " --out " + ResolvePath(session.directory, session.sample.mesh_file));
 }
 
@@ -99,7 +99,8 @@ TEST(Squash, ScanAlignDerenderMatchesTheTruth) {
     ASSERT_EQ(far_samples[i].pixel[0], near_samples[i].pixel[0]);
     ASSERT_EQ(far_samples[i].pixel[1], near_samples[i].pixel[1]);
     for (int c = 0; c < 3; ++c) {
-      worst = std::max(worst, double(std::abs(far_samples[i].brdf[c] - near_samples[i].brdf[c]) / near_samples[i].brdf[c]));
+      worst =
+          std::max(worst, double(std::abs(far_samples[i].brdf[c] - near_samples[i].brdf[c]) / near_samples[i].brdf[c]));
     }
   }
   std::cout << "10 km scanner offset against none: largest relative difference " << worst << "\n";
@@ -126,12 +127,14 @@ TEST(Squash, DentShadowsAreRejectedWithVisibility) {
   // Whether a sample's pixel centre truly sees a point of the dent in its own shadow.
   auto in_shadow = [&](const BrdfSample& sample) {
     const Rigid3d world_from_camera = session.photos[sample.image].camera_from_world->Inverse();
-    const Eigen::Vector2d xy = session.camera.CamPlaneFromImage(Eigen::Vector2d(sample.pixel[0] + 0.5, sample.pixel[1] + 0.5));
+    const Eigen::Vector2d xy =
+        session.camera.CamPlaneFromImage(Eigen::Vector2d(sample.pixel[0] + 0.5, sample.pixel[1] + 0.5));
     const Eigen::Vector3d direction = (world_from_camera.rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
     SurfaceHit hit, blocker;
     if (!dent.Intersect(world_from_camera.translation, direction, &hit)) return false;
     const Eigen::Vector3d to_light = session.light.position - hit.point;
-    return dent.Intersect(hit.point + 2e-6 * hit.normal, to_light.normalized(), &blocker) && blocker.t < to_light.norm();
+    return dent.Intersect(hit.point + 2e-6 * hit.normal, to_light.normalized(), &blocker) &&
+           blocker.t < to_light.norm();
   };
   std::map<std::string, std::pair<size_t, size_t>> figures;  // visibility -> (samples, in true shadow)
   std::vector<double> shadow_errors;  // visibility off: |relative error| of the green channel in true shadow
@@ -149,7 +152,8 @@ TEST(Squash, DentShadowsAreRejectedWithVisibility) {
     }
     figures[visibility] = {all.size(), shadowed};
     std::cout << "dent, visibility " << visibility << ": " << all.size() << " samples, " << shadowed
-              << " from pixels in the dent's true shadow; " << Compare(samples, s + "/truth.json").BriefReport() << "\n";
+              << " from pixels in the dent's true shadow; " << Compare(samples, s + "/truth.json").BriefReport()
+              << "\n";
   }
   // Off: the shadowed pixels are measured, and wrong by far more than the camera could explain.
   ASSERT_GT(figures["off"].second, 100u);

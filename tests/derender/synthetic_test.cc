@@ -4,17 +4,17 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <random>
-#include <fstream>
 #include <sstream>
 
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/file_util.h"
 #include "core/image_io.h"
 #include "core/json_reader.h"
-#include "core/file_util.h"
 #include "core/session.h"
 #include "derender/synthetic_shapes.h"
 #include "scan/ply_io.h"
@@ -202,7 +202,8 @@ TEST(SynthShapes, NormalsAreTheGradient) {
         const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(k);
         numeric[k] = (shape->Evaluate(p + step, nullptr) - shape->Evaluate(p - step, nullptr)) / (2 * h);
       }
-      ASSERT_LT((gradient - numeric).norm(), 1e-5 * gradient.norm()) << shape->Describe().dump() << " at " << p.transpose();
+      ASSERT_LT((gradient - numeric).norm(), 1e-5 * gradient.norm())
+          << shape->Describe().dump() << " at " << p.transpose();
       ASSERT_LE(gradient.norm(), shape->Lipschitz() * (1.0 + 1e-12));
     }
   }

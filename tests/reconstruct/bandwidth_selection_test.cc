@@ -96,14 +96,16 @@ TEST(BandwidthSelection, LooAndGcvPickNearTheBestKernel) {
   const double best = *std::min_element(truth_error.begin(), truth_error.end());
   EXPECT_LT(best, truth_error.front());
   EXPECT_LT(best, truth_error.back());
-  for (BandwidthCriterion criterion : {BandwidthCriterion::kLeaveOneOut, BandwidthCriterion::kGeneralizedCrossValidation}) {
+  for (BandwidthCriterion criterion :
+       {BandwidthCriterion::kLeaveOneOut, BandwidthCriterion::kGeneralizedCrossValidation}) {
     options.criterion = criterion;
     const BandwidthSelection selection = SelectBandwidth(samples, LocalRegressionOptions(), options);
     ASSERT_TRUE(selection.success);
     ASSERT_EQ(selection.curve.size(), options.scales.size());
     std::printf("%s\n%s", selection.BriefReport().c_str(), selection.CurveTable().c_str());
     EXPECT_LE(truth_error[selection.best], 1.5 * best) << BandwidthCriterionName(criterion);
-    EXPECT_DOUBLE_EQ(selection.selected.radius_h_deg, LocalRegressionOptions().radius_h_deg * options.scales[selection.best]);
+    EXPECT_DOUBLE_EQ(selection.selected.radius_h_deg,
+                     LocalRegressionOptions().radius_h_deg * options.scales[selection.best]);
   }
 }
 

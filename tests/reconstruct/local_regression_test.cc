@@ -14,8 +14,8 @@
 namespace ibrdf {
 namespace {
 
-using testing::MaterialPath;
 using testing::MakeSession;
+using testing::MaterialPath;
 using testing::ScratchDir;
 using testing::SessionSamples;
 
@@ -54,8 +54,8 @@ TEST(LocalRegression, FoldedEstimateIsReciprocalAndSymmetric) {
     const Eigen::Vector3d wi = FromSpherical(theta(rng), phi(rng)), wo = FromSpherical(theta(rng), phi(rng));
     const Eigen::Vector3d a = regression.Evaluate(wi, wo).value;
     const Eigen::Vector3d b = regression.Evaluate(wo, wi).value;
-    const Eigen::Vector3d mirrored = regression.Evaluate(Eigen::Vector3d(wi.x(), -wi.y(), wi.z()),
-                                                         Eigen::Vector3d(wo.x(), -wo.y(), wo.z())).value;
+    const Eigen::Vector3d mirrored =
+        regression.Evaluate(Eigen::Vector3d(wi.x(), -wi.y(), wi.z()), Eigen::Vector3d(wo.x(), -wo.y(), wo.z())).value;
     EXPECT_NEAR((a - b).norm(), 0.0, 1e-5 * (1.0 + a.norm()));
     EXPECT_NEAR((a - mirrored).norm(), 0.0, 1e-5 * (1.0 + a.norm()));
   }
@@ -85,11 +85,13 @@ TEST(LocalRegression, TwentySamplesGiveStatedReliability) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> theta(0.0, 1.3), phi(-M_PI, M_PI);
   std::vector<BrdfSample> samples;
-  for (int i = 0; i < 20; ++i) samples.push_back(MakeSample(FromSpherical(theta(rng), phi(rng)), FromSpherical(theta(rng), phi(rng)), 0.3));
+  for (int i = 0; i < 20; ++i)
+    samples.push_back(MakeSample(FromSpherical(theta(rng), phi(rng)), FromSpherical(theta(rng), phi(rng)), 0.3));
   const LocalRegression regression(samples, LocalRegressionOptions());
   ReliabilityCounts counts;
   std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < 200; ++i) points.push_back(RegressionCoordinates(FromSpherical(theta(rng), phi(rng)), FromSpherical(theta(rng), phi(rng))));
+  for (int i = 0; i < 200; ++i)
+    points.push_back(RegressionCoordinates(FromSpherical(theta(rng), phi(rng)), FromSpherical(theta(rng), phi(rng))));
   for (const Estimate& e : regression.EvaluateMany(points, &counts)) {
     ExpectFiniteWithReliability(e);
     if (e.status != EstimateStatus::kUnsupported) {
@@ -110,7 +112,8 @@ TEST(LocalRegression, OneSheetFallsBackAndStaysFinite) {
   while (samples.size() < 5000) {
     const Eigen::Vector3d wi = FromSpherical(theta(rng), phi(rng));
     const Eigen::Vector3d axis = wi.unitOrthogonal();
-    const Eigen::Vector3d wo = std::cos(g) * wi + std::sin(g) * (std::cos(phi(rng)) * axis + std::sin(phi(rng)) * wi.cross(axis)).normalized();
+    const Eigen::Vector3d wo =
+        std::cos(g) * wi + std::sin(g) * (std::cos(phi(rng)) * axis + std::sin(phi(rng)) * wi.cross(axis)).normalized();
     if (wo.z() < 0.05) continue;
     samples.push_back(MakeSample(wi, wo, 0.2 + 0.1 * wi.z()));
   }
@@ -195,8 +198,7 @@ TEST(LocalRegression, BinningAgreesWithPerSampleFit) {
   unbinned.bin_fraction_h = unbinned.bin_fraction_d = 0.0;
   LocalRegressionOptions tiny;
   tiny.bin_fraction_h = tiny.bin_fraction_d = 1e-7;
-  const LocalRegression exact(samples, unbinned), binned(samples, LocalRegressionOptions()),
-      singletons(samples, tiny);
+  const LocalRegression exact(samples, unbinned), binned(samples, LocalRegressionOptions()), singletons(samples, tiny);
   EXPECT_EQ(exact.points(), exact.size());
   EXPECT_LT(binned.points(), binned.size());
   EXPECT_EQ(binned.size(), exact.size());

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
-#include "reconstruct/npy_array.h"
+#include "core/npy.h"
 #include "tests/reconstruct/reconstruct_test_util.h"
 
 namespace ibrdf {

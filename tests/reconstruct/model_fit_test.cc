@@ -28,7 +28,8 @@ TEST(ModelFit, DefaultOptionsAreValid) {
 
 TEST(ModelFit, LafortuneCostGradientIsCorrect) {
   const Eigen::Vector3d wi = FromSpherical(0.5, 0.2), wo = FromSpherical(0.6, 2.9);
-  auto* cost = new ceres::AutoDiffCostFunction<LafortuneResidual<3>, 1, 10>(new LafortuneResidual<3>(wi, wo, 0.7, 0.05));
+  auto* cost =
+      new ceres::AutoDiffCostFunction<LafortuneResidual<3>, 1, 10>(new LafortuneResidual<3>(wi, wo, 0.7, 0.05));
   double p[10] = {0.3, -1.0, 0.8, 20.0, 0.5, 0.6, 3.0, -0.6, 0.4, 2.0};
   const double* parameters[1] = {p};
   ceres::NumericDiffOptions numeric;

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "reconstruct/npy_array.h"
+#include "core/npy.h"
 #include "tests/run_ibrdf.h"
 #include "tests/scratch_dir.h"
 #include "tests/test_util.h"
@@ -27,7 +27,8 @@ class ReconstructCommand : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     // ScratchDir needs a running test; the suite's folder is made by hand.
-    dir_ = (std::filesystem::temp_directory_path() / ("ibrdf-ReconstructCommand-" + std::to_string(::getpid()))).string();
+    dir_ =
+        (std::filesystem::temp_directory_path() / ("ibrdf-ReconstructCommand-" + std::to_string(::getpid()))).string();
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
     const std::string session = dir_ + "/session";
@@ -46,14 +47,15 @@ class ReconstructCommand : public ::testing::Test {
   ScratchDir out_dir_;
   static std::string dir_, samples_, truth_, points_;
 };
-std::string ReconstructCommand::dir_, ReconstructCommand::samples_, ReconstructCommand::truth_, ReconstructCommand::points_;
+std::string ReconstructCommand::dir_, ReconstructCommand::samples_, ReconstructCommand::truth_,
+    ReconstructCommand::points_;
 
 TEST_F(ReconstructCommand, SelectsTheBandwidthByGcv) {
   const std::string out = out_dir_ / "rec";
-  const RunResult run = RunIbrdf("reconstruct " + samples_ + " --out " + out + " --truth " + truth_ + " --eval " +
-                                     points_ + " --eval-only --bandwidth gcv --bandwidth-scales 0.7,1.4" +
-                                     " --bandwidth-samples 400",
-                                 /*quiet=*/true);
+  const RunResult run =
+      RunIbrdf("reconstruct " + samples_ + " --out " + out + " --truth " + truth_ + " --eval " + points_ +
+                   " --eval-only --bandwidth gcv --bandwidth-scales 0.7,1.4" + " --bandwidth-samples 400",
+               /*quiet=*/true);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("bandwidth criterion curve (gcv)"), std::string::npos) << run.output;
   std::ifstream in(out + "/summary.json");
@@ -77,7 +79,8 @@ TEST_F(ReconstructCommand, UnknownBandwidthCriterionIsAClearError) {
   EXPECT_NE(run.output.find("--bandwidth"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("aic"), std::string::npos) << run.output;
   EXPECT_FALSE(std::filesystem::exists(out));
-  EXPECT_NE(RunIbrdf("reconstruct " + samples_ + " --out " + out + " --bandwidth loo --bandwidth-scales 0,1").exit_code, 0);
+  EXPECT_NE(RunIbrdf("reconstruct " + samples_ + " --out " + out + " --bandwidth loo --bandwidth-scales 0,1").exit_code,
+            0);
 }
 
 }  // namespace

@@ -10,8 +10,8 @@
 
 namespace ibrdf::testing {
 
-inline std::vector<BrdfSample> SessionSamples(const BrdfModel& material, const CameraEffects& effects,
-                                              int photos = 20, int width = 400, int height = 300) {
+inline std::vector<BrdfSample> SessionSamples(const BrdfModel& material, const CameraEffects& effects, int photos = 20,
+                                              int width = 400, int height = 300) {
   ScratchDir dir;
   SynthOptions options;
   options.effects = effects;

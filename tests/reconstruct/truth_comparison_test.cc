@@ -45,7 +45,7 @@ TEST(TruthComparison, BandsByLargerTheta) {
   const LambertianBrdf truth(Eigen::Vector3d::Constant(0.5));
   const Eigen::Vector3d exact = truth.albedo() / M_PI;
   std::vector<BrdfSample> samples = {
-      MakeSample(0.1, 0.1, 0.0, exact),                      // 0-20 band, exact
+      MakeSample(0.1, 0.1, 0.0, exact),                        // 0-20 band, exact
       MakeSample(0.1, 75.0 * M_PI / 180.0, 0.0, 1.1 * exact),  // 70-80 band, 10 % high
   };
   const TruthComparison comparison = CompareWithTruth(samples, truth);

@@ -3,8 +3,8 @@
 // degenerate neighbourhoods that must give a clear result, never NaN.
 #include "scan/local_plane_normals.h"
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "core/error.h"
 #include "scan/range_grid.h"
@@ -60,7 +60,8 @@ TEST(LocalPlaneNormals, SphereBeatsFaceNormalsSeveralTimes) {
   RecordProperty("local_plane_median_deg", std::to_string(errors.local_plane_median * 180 / M_PI));
   RecordProperty("face_median_deg", std::to_string(errors.face_median * 180 / M_PI));
   EXPECT_LT(errors.local_plane_median * 3.0, errors.face_median)
-      << "local plane " << errors.local_plane_median * 180 / M_PI << " deg, faces " << errors.face_median * 180 / M_PI << " deg";
+      << "local plane " << errors.local_plane_median * 180 / M_PI << " deg, faces " << errors.face_median * 180 / M_PI
+      << " deg";
   EXPECT_LT(errors.local_plane_median, 2.0 * M_PI / 180);
 }
 
@@ -70,7 +71,8 @@ TEST(LocalPlaneNormals, EllipsoidBeatsFaceNormalsSeveralTimes) {
   synth.seed = 7;
   const Errors errors = MeasureErrors(synth);
   EXPECT_LT(errors.local_plane_median * 3.0, errors.face_median)
-      << "local plane " << errors.local_plane_median * 180 / M_PI << " deg, faces " << errors.face_median * 180 / M_PI << " deg";
+      << "local plane " << errors.local_plane_median * 180 / M_PI << " deg, faces " << errors.face_median * 180 / M_PI
+      << " deg";
 }
 
 TEST(LocalPlaneNormals, NoiseFreeSphereIsExactToCurvatureBias) {

@@ -38,7 +38,7 @@ TEST(MeshClean, CleanSphereLosesNothing) {
 TEST(MeshClean, MergesDuplicatePointsAndDropsTheFacesTheyCollapse) {
   ScanMesh mesh;
   mesh.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}};  // 4 duplicates 1
-  mesh.faces = {{0, 1, 2}, {4, 3, 2}, {1, 4, 3}};  // the last collapses onto an edge
+  mesh.faces = {{0, 1, 2}, {4, 3, 2}, {1, 4, 3}};                         // the last collapses onto an edge
   const CleanReport report = CleanMesh(OnlyStructural(), &mesh);
   EXPECT_EQ(report.removed.at("duplicate_points"), 1u);
   EXPECT_EQ(report.removed.at("degenerate_faces"), 1u);

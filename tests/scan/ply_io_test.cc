@@ -225,7 +225,8 @@ TEST(PlyIo, MalformedHeadersAreErrors) {
   ExpectPlyError(dir / "a.ply", "not a PLY file");
   WriteText(dir / "b.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n0\n");
   ExpectPlyError(dir / "b.ply", "unknown type 'quad'");
-  WriteText(dir / "c.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n");
+  WriteText(dir / "c.ply",
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n");
   ExpectPlyError(dir / "c.ply", "needs properties x, y and z");
   WriteText(dir / "d.ply", "ply\nformat ascii 1.0\nfrobnicate\nend_header\n");
   ExpectPlyError(dir / "d.ply", "unknown header line");
@@ -233,7 +234,8 @@ TEST(PlyIo, MalformedHeadersAreErrors) {
             "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
             "element range_grid 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0\n");
   ExpectPlyError(dir / "e.ply", "num_cols");
-  WriteText(dir / "f.ply", std::string(kTriangleAscii).replace(std::string(kTriangleAscii).find("1 0 0\n"), 6, "1 x 0\n"));
+  WriteText(dir / "f.ply",
+            std::string(kTriangleAscii).replace(std::string(kTriangleAscii).find("1 0 0\n"), 6, "1 x 0\n"));
   ExpectPlyError(dir / "f.ply", "'x' is not a number");
 }
 

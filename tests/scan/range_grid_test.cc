@@ -57,9 +57,9 @@ TEST(RangeGrid, NoTriangleAcrossADepthStep) {
 TEST(RangeGrid, EmptyCellsGiveOneTriangleOrNone) {
   ScanMesh mesh = StepGrid();
   for (Eigen::Vector3d& p : mesh.points) p.z() = 0.0;
-  mesh.grid.cell_point[0] = -1;                  // a corner: its cell keeps one triangle
-  mesh.grid.cell_point[5 * 20 + 5] = -1;         // an inner hole: four cells lose one triangle each ...
-  mesh.grid.cell_point[5 * 20 + 6] = -1;         // ... two holes side by side empty two cells
+  mesh.grid.cell_point[0] = -1;           // a corner: its cell keeps one triangle
+  mesh.grid.cell_point[5 * 20 + 5] = -1;  // an inner hole: four cells lose one triangle each ...
+  mesh.grid.cell_point[5 * 20 + 6] = -1;  // ... two holes side by side empty two cells
   TessellateRangeGrid(RangeGridOptions(), &mesh);
   EXPECT_EQ(mesh.faces.size(), 2u * 19 * 19 - 1 - 2 * 2 - 2 * 2);
 }
@@ -92,7 +92,7 @@ TEST(RangeGrid, BunnyTessellatesWithoutFacesAcrossSilhouettes) {
     ScanMesh mesh = ReadPly(testing::BunnyDir() + "/" + name);
     const RangeGridReport report = TessellateRangeGrid(RangeGridOptions(), &mesh);
     std::cerr << name << ": " << report.BriefReport() << "\n";
-    EXPECT_GT(mesh.faces.size(), 1.5 * report.points) << name;  // nearly two triangles per point
+    EXPECT_GT(mesh.faces.size(), 1.5 * report.points) << name;    // nearly two triangles per point
     EXPECT_GT(report.dropped_depth_discontinuity, 100u) << name;  // silhouettes exist and were cut
     // Grid spacing is about 0.75 mm; a face bridging a silhouette would have an edge of centimetres.
     EXPECT_NEAR(report.spacing_m, 0.75e-3, 0.15e-3) << name;

@@ -11,19 +11,18 @@
 
 #include "scan/ply_io.h"
 #include "scan/synthetic_scan.h"
-#include "tests/scan/scan_test_util.h"
 #include "tests/run_ibrdf.h"
+#include "tests/scan/scan_test_util.h"
 #include "tests/scratch_dir.h"
 
 namespace ibrdf {
 namespace {
 
-using testing::ScratchDir;
 using testing::RunIbrdf;
 using testing::RunResult;
+using testing::ScratchDir;
 using testing::WriteText;
 namespace fs = std::filesystem;
-
 
 std::string SphereMesh(const ScratchDir& dir) {
   ScanMesh mesh = MakeUvEllipsoid(Eigen::Vector3d(0.05, 0.05, 0.05), 40, 80);
@@ -55,15 +54,18 @@ TEST(ScanCommand, WritesMeshSidecarAndSummary) {
 TEST(ScanCommand, BadInputExitsNonZeroNamingTheFile) {
   ScratchDir dir;
   WriteText(dir / "empty.ply", "");
-  WriteText(dir / "truncated.ply",
-            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
-            "0 0 0\n1 0 0\n");
-  WriteText(dir / "lying.ply",
-            "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
-            "0 0 0\n1 0 0\n0 1 0\n");
-  WriteText(dir / "nan.ply",
-            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
-            "0 0 0\n1 NaN 0\n0 1 0\n");
+  WriteText(
+      dir / "truncated.ply",
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+      "0 0 0\n1 0 0\n");
+  WriteText(
+      dir / "lying.ply",
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n");
+  WriteText(
+      dir / "nan.ply",
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+      "0 0 0\n1 NaN 0\n0 1 0\n");
   for (const char* name : {"empty.ply", "truncated.ply", "lying.ply", "nan.ply", "missing.ply"}) {
     const RunResult run = RunIbrdf("scan " + dir / name + " --out " + dir / "out.ply");
     EXPECT_EQ(run.exit_code, 1) << name << ": " << run.output;

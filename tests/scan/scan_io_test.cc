@@ -67,7 +67,8 @@ TEST(ScanIo, BadFilesOfEveryFormatAreErrors) {
 
 TEST(ScanIo, ReadsStanfordConf) {
   ScratchDir dir;
-  WriteText(dir / "a.conf", "camera 0 0 1 0 0 0 1\n\nbmesh a.ply 1 2 3 0 0 0 1\nbmesh b.ply 0 0 0 0 0 0.7071068 0.7071068\n");
+  WriteText(dir / "a.conf",
+            "camera 0 0 1 0 0 0 1\n\nbmesh a.ply 1 2 3 0 0 0 1\nbmesh b.ply 0 0 0 0 0 0.7071068 0.7071068\n");
   const std::vector<StanfordConfEntry> entries = ReadStanfordConf(dir / "a.conf");
   ASSERT_EQ(entries.size(), 2u);
   EXPECT_EQ(entries[0].name, "a.ply");
@@ -98,8 +99,8 @@ TEST(ScanIo, BadConfIsAnErrorNamingTheLine) {
 // points whose nearest bun000 point is within 2 mm (the overlap).
 TEST(ScanIo, BunnyScansMergedWithConfAgreeInTheOverlap) {
   IBRDF_REQUIRE_BUNNY();
-  const std::vector<ScanInput> inputs = InputsFromConf(testing::BunnyDir() + "/bun.conf",
-                                                       {testing::BunnyDir() + "/bun000.ply", testing::BunnyDir() + "/bun045.ply"});
+  const std::vector<ScanInput> inputs = InputsFromConf(
+      testing::BunnyDir() + "/bun.conf", {testing::BunnyDir() + "/bun000.ply", testing::BunnyDir() + "/bun045.ply"});
   ScanMesh scans[2];
   for (int k = 0; k < 2; ++k) {
     scans[k] = ReadScanFile(inputs[k].path);
@@ -119,8 +120,8 @@ TEST(ScanIo, BunnyScansMergedWithConfAgreeInTheOverlap) {
   const double median = Median(distances);
   RecordProperty("overlap_points", std::to_string(distances.size()));
   RecordProperty("median_distance_mm", std::to_string(median * 1e3));
-  std::cerr << "bun045 against bun000: " << distances.size() << " points in the overlap, median point-to-surface distance "
-            << median * 1e3 << " mm\n";
+  std::cerr << "bun045 against bun000: " << distances.size()
+            << " points in the overlap, median point-to-surface distance " << median * 1e3 << " mm\n";
   EXPECT_GT(distances.size(), 10000u);
   EXPECT_LT(median, 1e-3);
 }

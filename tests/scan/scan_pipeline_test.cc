@@ -74,8 +74,8 @@ TEST(ScanPipeline, NothingLeftIsAnError) {
 TEST(ScanPipeline, BunnyMergedWithConf) {
   IBRDF_REQUIRE_BUNNY();
   SetVerbosity(0);
-  const std::vector<ScanInput> inputs = InputsFromConf(testing::BunnyDir() + "/bun.conf",
-                                                       {testing::BunnyDir() + "/bun000.ply", testing::BunnyDir() + "/bun045.ply"});
+  const std::vector<ScanInput> inputs = InputsFromConf(
+      testing::BunnyDir() + "/bun.conf", {testing::BunnyDir() + "/bun000.ply", testing::BunnyDir() + "/bun045.ply"});
   const ScanResult result = RunScan(inputs, ScanOptions());
   EXPECT_EQ(result.summary.inputs.size(), 2u);
   EXPECT_EQ(result.summary.inputs[0].kind, "range grid");

@@ -8,16 +8,16 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
 #include <gtest/gtest.h>
+#include <Eigen/Core>
 
 namespace ibrdf::testing {
 
 inline std::string BunnyDir() { return std::string(IBRDF_SHARED_DATA_DIR) + "/bunny-range-scans"; }
 inline bool HaveBunny() { return std::filesystem::exists(BunnyDir() + "/bun000.ply"); }
-#define IBRDF_REQUIRE_BUNNY()                                                                           \
-  if (!::ibrdf::testing::HaveBunny())                                                                   \
-  GTEST_SKIP() << "the Stanford bunny range scans are not in " << ::ibrdf::testing::BunnyDir()          \
+#define IBRDF_REQUIRE_BUNNY()                                                                  \
+  if (!::ibrdf::testing::HaveBunny())                                                          \
+  GTEST_SKIP() << "the Stanford bunny range scans are not in " << ::ibrdf::testing::BunnyDir() \
                << " (../shared/data is absent in a fresh clone)"
 
 // Angle between two directions in radians, accurate for tiny angles (atan2 of cross and dot).

@@ -1,7 +1,6 @@
-// Runs another program as a child process of this one (the stages of `ibrdf run`, the report's Python
-// plotting script), with the child's output going straight to this process's stdout and stderr.
-#pragma once
+#include "core/subprocess.h"
 
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
@@ -10,22 +9,18 @@
 #include <cerrno>
 #include <chrono>
 #include <cstdlib>
-#include <string>
 #include <thread>
-#include <vector>
 
 #include "core/error.h"
 
 namespace ibrdf {
 
-// Runs argv[0] (a path) with `argv`; the child is killed if this process dies. Returns the child's exit
-// code, or 128 + the signal that killed it. Test hook: when the environment variable
-// IBRDF_RUN_INTERRUPT equals `hook_name`, the child is killed with SIGKILL after
-// IBRDF_RUN_INTERRUPT_AFTER_S seconds (default 0.05), as an interruption would.
-inline int RunChildProcess(const std::vector<std::string>& argv, const std::string& hook_name = "") {
+int RunSubprocess(const std::vector<std::string>& argv, const SubprocessOptions& options) {
   IBRDF_CHECK(!argv.empty());
+  // Everything the child needs is prepared before fork: only async-signal-safe calls after it.
+  std::vector<std::string> args = argv;
   std::vector<char*> raw;
-  for (const std::string& arg : argv) raw.push_back(const_cast<char*>(arg.c_str()));
+  for (std::string& arg : args) raw.push_back(arg.data());
   raw.push_back(nullptr);
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
@@ -33,11 +28,19 @@ inline int RunChildProcess(const std::vector<std::string>& argv, const std::stri
   if (pid == 0) {
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (::getppid() != parent) ::_exit(127);
+    if (!options.log_path.empty()) {
+      const int log = ::open(options.log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (log < 0) ::_exit(126);
+      ::dup2(log, STDOUT_FILENO);
+      ::dup2(log, STDERR_FILENO);
+      ::close(log);
+    }
+    for (const auto& [name, value] : options.environment) ::setenv(name.c_str(), value.c_str(), 1);
     ::execv(raw[0], raw.data());
     ::_exit(127);
   }
   const char* interrupt = std::getenv("IBRDF_RUN_INTERRUPT");
-  if (interrupt && !hook_name.empty() && hook_name == interrupt) {
+  if (interrupt && !options.interrupt_hook.empty() && options.interrupt_hook == interrupt) {
     const char* after = std::getenv("IBRDF_RUN_INTERRUPT_AFTER_S");
     std::this_thread::sleep_for(std::chrono::duration<double>(after ? std::atof(after) : 0.05));
     ::kill(pid, SIGKILL);
