@@ -14,6 +14,7 @@
 
 #include "align/cost_functions/marker_corner_error.h"
 #include "align/cost_functions/reprojection_error.h"
+#include "core/error.h"
 #include "core/logging.h"
 #include "core/statistics.h"
 
@@ -228,10 +229,10 @@ void BundleMarker::UpdateCorners() {
 }
 
 bool BundleAdjustmentOptions::Check(std::string* why) const {
-  if (!(huber_px > 0.0) || max_num_iterations < 1 || !(tolerance > 0.0) || !(min_outlier_px > 0.0)) {
-    *why = "huber_px > 0, max_num_iterations >= 1, tolerance > 0, min_outlier_px > 0";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GT(huber_px, 0.0);
+  IBRDF_CHECK_OPTION_GE(max_num_iterations, 1);
+  IBRDF_CHECK_OPTION_GT(tolerance, 0.0);
+  IBRDF_CHECK_OPTION_GT(min_outlier_px, 0.0);
   return true;
 }
 
