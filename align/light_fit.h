@@ -20,6 +20,7 @@
 
 namespace ibrdf {
 
+// Options of FitLightToMarkers.
 struct LightFitOptions {
   double huber_px = 1.0;     // robust loss scale for marker corners, pixels
   double tolerance = 1e-14;  // Ceres function and parameter tolerance of the joint refinement
@@ -51,6 +52,7 @@ struct LightMarkerFit {
   Eigen::Vector3d light_in_world = Eigen::Vector3d::Zero();
 };
 
+// What FitLightToMarkers found; reads as not fitted until it ran.
 struct LightFit {
   bool fitted = false;                                 // false: the light stays as given (see `reason`)
   std::string reason;                                  // why not fitted

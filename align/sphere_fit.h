@@ -16,6 +16,7 @@
 
 namespace ibrdf {
 
+// Options of FitSphereToSilhouettes and FitSphereToTangentRays (the defaults are the align stage's).
 struct SphereFitOptions {
   int silhouette_lines = 360;         // radial search lines per photo
   double first_band_fraction = 0.15;  // round 1: limb points searched within this fraction of the radius
@@ -40,6 +41,7 @@ struct SilhouettePhoto {
   Rigid3d camera_from_world;
 };
 
+// What the sphere fit found; reads as not fitted until it ran.
 struct SphereFit {
   bool fitted = false;
   std::string reason;  // why not fitted
