@@ -350,13 +350,15 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     result.light =
         FitLightToMarkers(session.camera, *targets.light,
                           LightFitPhotos(bundle_images, light_detections, pose.markers, result), light_options);
-    for (const auto& [i, camera_from_world] : result.light.refined_camera_from_world)
+    for (const auto& [i, camera_from_world] : result.light.refined_camera_from_world) {
       result.images[i].camera_from_world = camera_from_world;
+    }
   }
   result.session = AlignedSession(session, result, pose.markers);
   if (result.session.photos.empty()) {
-    for (const ImageAlignment& image : result.images)
+    for (const ImageAlignment& image : result.images) {
       Log(1, "dropped photo " + session.photos[image.photo].file + ": " + image.dropped_reason);
+    }
     ThrowError(session.manifest_path, "no photo could be aligned (see the reasons above)");
   }
 

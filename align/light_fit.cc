@@ -42,8 +42,9 @@ class LightProblem {
         const auto it = photo.light_markers.find(spec.markers[m].id);
         if (it == photo.light_markers.end()) continue;
         sightings_[m].push_back({photo.photo, it->second});
-        if (!cameras_.count(photo.photo))
+        if (!cameras_.count(photo.photo)) {
           AngleAxisFromPose(photo.camera_from_world, cameras_[photo.photo].data(), cameras_[photo.photo].data() + 3);
+        }
       }
     }
   }
@@ -183,8 +184,9 @@ LightFit FitLightToMarkers(const Camera& camera, const LightTargetsSpec& spec, c
   if (!solved) {
     fit.reason = "the light markers' refinement failed (" + message + "); the light stays as given";
   } else {
-    for (const auto& [i, pose] : problem.cameras())
+    for (const auto& [i, pose] : problem.cameras()) {
       fit.refined_camera_from_world[i] = PoseFromAngleAxis(pose.data(), pose.data() + 3);
+    }
   }
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int estimated = 0;

@@ -137,8 +137,9 @@ SphereFit FitSphereToTangentRays(const std::vector<TangentRay>& rays, const Eige
     fit.silhouette_points = count;
     fit.rejected_points = static_cast<int>(rays.size()) - count;
     if (pass == 0 && reject_outliers) {
-      for (size_t k = 0; k < rays.size(); ++k)
+      for (size_t k = 0; k < rays.size(); ++k) {
         keep[k] = std::abs(residuals[k]) <= options.outlier_rms_factor * fit.rms_m;
+      }
     }
   }
   fit.center = Eigen::Vector3d(center[0], center[1], center[2]);
