@@ -394,16 +394,10 @@ json ManifestWithEveryFile() {
                                {"normal", {0.0, 0.0, 1.0}},
                                {"size", 0.1},
                                {"photos", {{{"file", "calibration/white.png"}, {"exposure_s", 0.25}}}}}}};
-  manifest["sample"] = {
-    {"kind", "mesh"},
-    {"file", "scan/mesh.ply"},
-    {"scan_inputs",
-     {"scan/view-0.ply",
-      {{"file", "scan/view-1.ply"},
-       {"world_from_scan", {{"rotation", {1.0, 0.0, 0.0, 0.0}}, {"translation", {0.0, 0.0, 0.1}}}}}}}
-  }
-};
-return manifest;
+  const json view1 = {{"file", "scan/view-1.ply"},
+                      {"world_from_scan", {{"rotation", {1.0, 0.0, 0.0, 0.0}}, {"translation", {0.0, 0.0, 0.1}}}}};
+  manifest["sample"] = {{"kind", "mesh"}, {"file", "scan/mesh.ply"}, {"scan_inputs", {"scan/view-0.ply", view1}}};
+  return manifest;
 }
 
 class SessionFilesTest : public SessionTest {
