@@ -34,7 +34,7 @@ Stamp Stamp::Read(const std::string& path) {
   if (!json) ThrowError(path, "no such stamp");
   Stamp stamp;
   stamp.stage = json->String("/stage");
-  stamp.build_id = json->String("/build_id");
+  stamp.build_id = json->String("/build_id", "");  // absent in stamps written before build ids
   stamp.version = json->String("/version", "");
   stamp.arguments = json->Strings("/args");
   const nlohmann::json& inputs = json->Value("/inputs");

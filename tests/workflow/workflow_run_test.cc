@@ -149,6 +149,15 @@ TEST_F(FakeStages, ResumesAfterAnInterruptedStage) {
   EXPECT_TRUE(fs::exists(live));
 }
 
+// A stamp of an older ibrdf (keyed on the version string, no build id) counts as another binary's.
+TEST_F(FakeStages, StampWithoutBuildIdCountsAsAnotherBinary) {
+  RunCopy();
+  nlohmann::json stamp = Stamp::Read(StampPath(RunDir(), "copy")).ToJson();
+  stamp.erase("build_id");
+  WriteText(StampPath(RunDir(), "copy"), stamp.dump());
+  EXPECT_EQ(RunCopy().reason, "the ibrdf binary changed");
+}
+
 TEST_F(FakeStages, UnreadableStampRerunsTheStage) {
   RunCopy();
   WriteText(StampPath(RunDir(), "copy"), R"({"stage": "copy", "args": ["copy"]})");  // no build_id
