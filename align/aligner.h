@@ -1,10 +1,11 @@
 // The align stage (the paper's section 3.2, in part): camera poses from coded targets, by a bundle
 // adjustment over every photo's marker corners (align/bundle_adjustment.h) in which markers of known
 // layout stay fixed and markers of unknown layout are rigid squares whose poses are estimated; the
-// light's position from the markers attached to it; a sphere sample's centre and radius from its
-// silhouettes (rays tangent to the sphere, Ceres); a cylinder's centre and axis from the markers fixed
-// to it (align/cylinder_fit.h). A photo whose pose is unreliable (too few markers, a high residual, a
-// pose its corners determine poorly, or a planar pose ambiguity) is dropped with a reason, never used.
+// light's position from the markers attached to it (align/light_fit.h); a sphere sample's centre and
+// radius from its silhouettes (align/sphere_fit.h); a cylinder's centre and axis from the markers fixed
+// to it (align/cylinder_fit.h); AlignSession runs these steps in turn. A photo whose pose is unreliable
+// (too few markers, a high residual, a pose its corners determine poorly, or a planar pose ambiguity)
+// is dropped with a reason, never used.
 #pragma once
 
 #include <array>
@@ -15,6 +16,8 @@
 
 #include "align/bundle_adjustment.h"
 #include "align/cylinder_fit.h"
+#include "align/light_fit.h"
+#include "align/sphere_fit.h"
 #include "core/session.h"
 
 namespace ibrdf {
@@ -36,9 +39,10 @@ struct AlignOptions {
   bool fit_sphere = true;          // refine a sphere sample's centre and radius from silhouettes
   bool fit_cylinder = true;        // a cylinder's centre and axis from its markers (targets.sample)
   bool fit_light = true;           // the light's position from its markers, when the session has them
-  int silhouette_lines = 360;      // radial search lines per photo
   BundleAdjustmentOptions bundle;  // huber_px is taken from above
-  CylinderFitOptions cylinder;
+  CylinderFitOptions cylinder;     // the cylinder fit (align/cylinder_fit.h)
+  SphereFitOptions sphere;         // the sphere fit (align/sphere_fit.h)
+  LightFitOptions light;           // the light fit (align/light_fit.h); huber_px is taken from above
   bool Check(std::string* why) const;
 };
 
@@ -65,36 +69,9 @@ struct MarkerResidual {
   std::array<Eigen::Vector3d, 4> corners;  // world frame (estimated, for "unknown" and "sample")
 };
 
-struct SphereFit {
-  bool fitted = false;
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();
-  double radius = 0.0;
-  int silhouette_points = 0;  // tangent rays used
-  int rejected_points = 0;    // outliers removed after the first solve
-  double rms_m = 0.0;         // RMS of ray-to-sphere distances, metres
-};
-
-// One marker on the light: its pose from every posed photo that sees it (square PnP, the candidate that
-// best explains all those photos, then one Ceres problem over all light markers and the poses of the
-// photos that see them, their reference corners included), and the light's position it implies.
-struct LightMarkerFit {
-  int id = -1;
-  int photos = 0;       // posed photos that see it; 0 = not seen, no estimate
-  double rms_px = 0.0;  // corner reprojection RMS after refinement
-  Rigid3d world_from_marker;
-  Eigen::Vector3d light_in_world = Eigen::Vector3d::Zero();
-};
-
-struct LightFit {
-  bool fitted = false;                                 // false: the light stays as given (see `reason`)
-  std::string reason;                                  // why not fitted
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // metres, world frame: the markers' mean
-  double spread_m = 0.0;                               // largest distance of one marker's estimate from the mean
-  std::vector<LightMarkerFit> markers;
-};
-
+// What the stage did. AlignSession throws Error for bad input (options, targets, photos) and when no
+// photo could be posed; a returned result always has at least one used photo.
 struct AlignResult {
-  bool success = false;
   Session session;  // the input session with poses (and sphere) replaced; dropped photos removed
   std::vector<ImageAlignment> images;
   std::vector<MarkerResidual> markers;

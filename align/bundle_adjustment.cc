@@ -14,6 +14,7 @@
 
 #include "align/cost_functions/marker_corner_error.h"
 #include "align/cost_functions/reprojection_error.h"
+#include "core/error.h"
 #include "core/logging.h"
 #include "core/statistics.h"
 
@@ -228,10 +229,10 @@ void BundleMarker::UpdateCorners() {
 }
 
 bool BundleAdjustmentOptions::Check(std::string* why) const {
-  if (!(huber_px > 0.0) || max_num_iterations < 1 || !(tolerance > 0.0) || !(min_outlier_px > 0.0)) {
-    *why = "huber_px > 0, max_num_iterations >= 1, tolerance > 0, min_outlier_px > 0";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GT(huber_px, 0.0);
+  IBRDF_CHECK_OPTION_GE(max_num_iterations, 1);
+  IBRDF_CHECK_OPTION_GT(tolerance, 0.0);
+  IBRDF_CHECK_OPTION_GT(min_outlier_px, 0.0);
   return true;
 }
 
@@ -249,81 +250,87 @@ std::string BundleAdjustmentSummary::BriefReport() const {
   return buffer;
 }
 
-BundleAdjustmentSummary BundleAdjust(const Camera& camera, const BundleAdjustmentOptions& options,
-                                     std::vector<BundleImage>* images, std::map<int, BundleMarker>* markers) {
-  Timer timer;
-  BundleAdjustmentSummary summary;
-  const std::array<double, 8> intrinsics = ProjectionIntrinsics(camera);
-  std::vector<std::array<double, 6>> camera_poses(images->size());
-  std::map<int, std::array<double, 6>> marker_poses;
-  std::map<int, std::array<std::array<double, 3>, 4>> fixed_points;
-  for (size_t i = 0; i < images->size(); ++i) {
-    if ((*images)[i].posed)
-      AngleAxisFromPose((*images)[i].camera_from_world, camera_poses[i].data(), camera_poses[i].data() + 3);
-  }
-  for (auto& [id, marker] : *markers) {
-    if (!marker.posed) continue;
-    if (marker.fixed) {
-      for (int c = 0; c < 4; ++c)
-        fixed_points[id][c] = {marker.corners[c].x(), marker.corners[c].y(), marker.corners[c].z()};
-    } else {
-      AngleAxisFromPose(marker.world_from_marker, marker_poses[id].data(), marker_poses[id].data() + 3);
+namespace {
+
+// The bundle adjustment's parameters as Ceres blocks: the posed photos' poses, the free markers' poses
+// and the fixed markers' corners, over the photos and markers it adjusts.
+class BundleParameters {
+ public:
+  BundleParameters(const Camera& camera, std::vector<BundleImage>* images, std::map<int, BundleMarker>* markers)
+      : intrinsics_(ProjectionIntrinsics(camera)), images_(images), markers_(markers), camera_poses_(images->size()) {
+    for (size_t i = 0; i < images->size(); ++i) {
+      if ((*images)[i].posed)
+        AngleAxisFromPose((*images)[i].camera_from_world, camera_poses_[i].data(), camera_poses_[i].data() + 3);
+    }
+    for (auto& [id, marker] : *markers) {
+      if (!marker.posed) continue;
+      if (marker.fixed) {
+        for (int c = 0; c < 4; ++c)
+          fixed_points_[id][c] = {marker.corners[c].x(), marker.corners[c].y(), marker.corners[c].z()};
+      } else {
+        AngleAxisFromPose(marker.world_from_marker, marker_poses_[id].data(), marker_poses_[id].data() + 3);
+      }
     }
   }
-  auto usable = [&](const CornerObservation& o) {
-    const auto it = markers->find(o.marker_id);
-    return it != markers->end() && it->second.posed;
-  };
+
+  // A corner of a posed marker.
+  bool Usable(const CornerObservation& o) const {
+    const auto it = markers_->find(o.marker_id);
+    return it != markers_->end() && it->second.posed;
+  }
+
   // A corner's residual under the current parameters.
-  auto residual = [&](size_t i, const CornerObservation& o, double* r) {
-    const BundleMarker& marker = markers->at(o.marker_id);
-    const double* pose = camera_poses[i].data();
+  void Residual(size_t i, const CornerObservation& o, double* r) const {
+    const BundleMarker& marker = markers_->at(o.marker_id);
+    const double* pose = camera_poses_[i].data();
     if (marker.fixed) {
-      ReprojectionError(intrinsics, o.pixel.x(), o.pixel.y())(pose, pose + 3,
-                                                              fixed_points.at(o.marker_id)[o.corner].data(), r);
+      ReprojectionError(intrinsics_, o.pixel.x(), o.pixel.y())(pose, pose + 3,
+                                                               fixed_points_.at(o.marker_id)[o.corner].data(), r);
     } else {
-      const double* m = marker_poses.at(o.marker_id).data();
-      MarkerCornerError(intrinsics, MarkerCornersInMarker(marker.size)[o.corner], o.pixel.x(), o.pixel.y())(
+      const double* m = marker_poses_.at(o.marker_id).data();
+      MarkerCornerError(intrinsics_, MarkerCornersInMarker(marker.size)[o.corner], o.pixel.x(), o.pixel.y())(
           pose, pose + 3, m, m + 3, r);
     }
-  };
-  auto inlier_rms = [&]() {
+  }
+
+  // The RMS over the inlier corners of posed photos.
+  double InlierRms() const {
     double squared = 0.0;
     size_t count = 0;
-    for (size_t i = 0; i < images->size(); ++i) {
-      if (!(*images)[i].posed) continue;
-      for (const CornerObservation& o : (*images)[i].corners) {
-        if (!o.inlier || !usable(o)) continue;
+    for (size_t i = 0; i < images_->size(); ++i) {
+      if (!(*images_)[i].posed) continue;
+      for (const CornerObservation& o : (*images_)[i].corners) {
+        if (!o.inlier || !Usable(o)) continue;
         double r[2];
-        residual(i, o, r);
+        Residual(i, o, r);
         squared += r[0] * r[0] + r[1] * r[1];
         ++count;
       }
     }
     return count ? std::sqrt(squared / count) : 0.0;
-  };
-  summary.initial_rms_px = inlier_rms();
+  }
 
-  for (int solve = 0; solve < 2; ++solve) {
+  // One solve over the inlier corners of posed photos (Huber loss), fixed corners constant. False,
+  // with summary->message, when no fixed marker is seen or Ceres finds no usable solution.
+  bool Solve(const BundleAdjustmentOptions& options, BundleAdjustmentSummary* summary) {
     ceres::Problem problem;
     std::set<int> fixed_seen, free_seen;
-    int parameters = 0;
-    for (size_t i = 0; i < images->size(); ++i) {
-      BundleImage& image = (*images)[i];
+    for (size_t i = 0; i < images_->size(); ++i) {
+      BundleImage& image = (*images_)[i];
       if (!image.posed) continue;
-      double* pose = camera_poses[i].data();
+      double* pose = camera_poses_[i].data();
       for (const CornerObservation& o : image.corners) {
-        if (!o.inlier || !usable(o)) continue;
-        const BundleMarker& marker = markers->at(o.marker_id);
+        if (!o.inlier || !Usable(o)) continue;
+        const BundleMarker& marker = markers_->at(o.marker_id);
         if (marker.fixed) {
-          double* point = fixed_points.at(o.marker_id)[o.corner].data();
-          problem.AddResidualBlock(ReprojectionError::Create(intrinsics, o.pixel.x(), o.pixel.y()),
+          double* point = fixed_points_.at(o.marker_id)[o.corner].data();
+          problem.AddResidualBlock(ReprojectionError::Create(intrinsics_, o.pixel.x(), o.pixel.y()),
                                    new ceres::HuberLoss(options.huber_px), pose, pose + 3, point);
           problem.SetParameterBlockConstant(point);
           fixed_seen.insert(o.marker_id);
         } else {
-          double* m = marker_poses.at(o.marker_id).data();
-          problem.AddResidualBlock(MarkerCornerError::Create(intrinsics, MarkerCornersInMarker(marker.size)[o.corner],
+          double* m = marker_poses_.at(o.marker_id).data();
+          problem.AddResidualBlock(MarkerCornerError::Create(intrinsics_, MarkerCornersInMarker(marker.size)[o.corner],
                                                              o.pixel.x(), o.pixel.y()),
                                    new ceres::HuberLoss(options.huber_px), pose, pose + 3, m, m + 3);
           free_seen.insert(o.marker_id);
@@ -331,43 +338,44 @@ BundleAdjustmentSummary BundleAdjust(const Camera& camera, const BundleAdjustmen
       }
     }
     if (fixed_seen.empty()) {
-      summary.message = "no marker of fixed layout is seen by a posed photo: the gauge is free";
-      summary.total_s = timer.ElapsedSeconds();
-      return summary;
+      summary->message = "no marker of fixed layout is seen by a posed photo: the gauge is free";
+      return false;
     }
-    parameters = 6 * static_cast<int>(
-                         std::count_if(images->begin(), images->end(), [](const BundleImage& b) { return b.posed; })) +
-                 6 * static_cast<int>(free_seen.size());
+    const int parameters = 6 * static_cast<int>(std::count_if(images_->begin(), images_->end(),
+                                                              [](const BundleImage& b) { return b.posed; })) +
+                           6 * static_cast<int>(free_seen.size());
     ceres::Solver::Summary solver_summary;
     ceres::Solve(SolverOptions(parameters, options.max_num_iterations, options.tolerance), &problem, &solver_summary);
-    summary.iterations += static_cast<int>(solver_summary.iterations.size());
+    summary->iterations += static_cast<int>(solver_summary.iterations.size());
     if (!solver_summary.IsSolutionUsable()) {
-      summary.message = solver_summary.message;
-      summary.total_s = timer.ElapsedSeconds();
-      return summary;
+      summary->message = solver_summary.message;
+      return false;
     }
-    summary.fixed_markers = static_cast<int>(fixed_seen.size());
-    summary.free_markers = static_cast<int>(free_seen.size());
-    if (solve == 1) break;
-    // The outlier pass: per photo, corners beyond max(min_outlier_px, 3 robust sigmas).
-    for (size_t i = 0; i < images->size(); ++i) {
-      BundleImage& image = (*images)[i];
+    summary->fixed_markers = static_cast<int>(fixed_seen.size());
+    summary->free_markers = static_cast<int>(free_seen.size());
+    return true;
+  }
+
+  // The outlier pass: per photo, corners beyond max(min_outlier_px, 3 robust sigmas). A corner beyond
+  // the limit condemns its marker in this photo: its corners come from lines fitted to its sides, and a
+  // partly hidden side shifts both of that side's corners.
+  void MarkOutliers(double min_outlier_px) {
+    for (size_t i = 0; i < images_->size(); ++i) {
+      BundleImage& image = (*images_)[i];
       if (!image.posed) continue;
       std::vector<double> norms;
       for (const CornerObservation& o : image.corners) {
-        if (!o.inlier || !usable(o)) continue;
+        if (!o.inlier || !Usable(o)) continue;
         double r[2];
-        residual(i, o, r);
+        Residual(i, o, r);
         norms.push_back(std::hypot(r[0], r[1]));
       }
       if (norms.empty()) continue;
-      const double limit = std::max(options.min_outlier_px, 3.0 * 1.4826 * Median(norms));
-      // A corner beyond the limit condemns its marker in this photo: its corners come from lines fitted
-      // to its sides, and a partly hidden side shifts both of that side's corners.
+      const double limit = std::max(min_outlier_px, 3.0 * 1.4826 * Median(norms));
       size_t k = 0;
       std::set<int> condemned;
       for (const CornerObservation& o : image.corners) {
-        if (!o.inlier || !usable(o)) continue;
+        if (!o.inlier || !Usable(o)) continue;
         if (norms[k++] > limit) condemned.insert(o.marker_id);
       }
       for (CornerObservation& o : image.corners) {
@@ -376,48 +384,76 @@ BundleAdjustmentSummary BundleAdjust(const Camera& camera, const BundleAdjustmen
     }
   }
 
-  // Write back, and the residuals per photo and per marker.
-  for (auto& [id, pose] : marker_poses) {
-    BundleMarker& marker = markers->at(id);
-    marker.world_from_marker = PoseFromAngleAxis(pose.data(), pose.data() + 3);
-    marker.UpdateCorners();
-  }
-  std::map<int, std::pair<int, double>> marker_sums;
-  std::map<int, std::set<size_t>> marker_images;
-  double all_squared = 0.0;
-  for (size_t i = 0; i < images->size(); ++i) {
-    BundleImage& image = (*images)[i];
-    if (!image.posed) continue;
-    image.camera_from_world = PoseFromAngleAxis(camera_poses[i].data(), camera_poses[i].data() + 3);
-    double squared = 0.0;
-    image.inliers = image.outliers = 0;
-    for (const CornerObservation& o : image.corners) {
-      if (!usable(o)) continue;
-      if (!o.inlier) {
-        ++image.outliers;
-        continue;
-      }
-      double r[2];
-      residual(i, o, r);
-      const double r2 = r[0] * r[0] + r[1] * r[1];
-      squared += r2;
-      ++image.inliers;
-      ++marker_sums[o.marker_id].first;
-      marker_sums[o.marker_id].second += r2;
-      marker_images[o.marker_id].insert(i);
+  // Writes the poses back, and the residuals per photo and per marker.
+  void WriteBack(BundleAdjustmentSummary* summary) {
+    for (auto& [id, pose] : marker_poses_) {
+      BundleMarker& marker = markers_->at(id);
+      marker.world_from_marker = PoseFromAngleAxis(pose.data(), pose.data() + 3);
+      marker.UpdateCorners();
     }
-    image.rms_px = image.inliers ? std::sqrt(squared / image.inliers) : 0.0;
-    all_squared += squared;
-    summary.corners += image.inliers;
-    summary.outliers += image.outliers;
-    ++summary.images;
+    std::map<int, std::pair<int, double>> marker_sums;
+    std::map<int, std::set<size_t>> marker_images;
+    double all_squared = 0.0;
+    for (size_t i = 0; i < images_->size(); ++i) {
+      BundleImage& image = (*images_)[i];
+      if (!image.posed) continue;
+      image.camera_from_world = PoseFromAngleAxis(camera_poses_[i].data(), camera_poses_[i].data() + 3);
+      double squared = 0.0;
+      image.inliers = image.outliers = 0;
+      for (const CornerObservation& o : image.corners) {
+        if (!Usable(o)) continue;
+        if (!o.inlier) {
+          ++image.outliers;
+          continue;
+        }
+        double r[2];
+        Residual(i, o, r);
+        const double r2 = r[0] * r[0] + r[1] * r[1];
+        squared += r2;
+        ++image.inliers;
+        ++marker_sums[o.marker_id].first;
+        marker_sums[o.marker_id].second += r2;
+        marker_images[o.marker_id].insert(i);
+      }
+      image.rms_px = image.inliers ? std::sqrt(squared / image.inliers) : 0.0;
+      all_squared += squared;
+      summary->corners += image.inliers;
+      summary->outliers += image.outliers;
+      ++summary->images;
+    }
+    for (auto& [id, marker] : *markers_) {
+      const auto it = marker_sums.find(id);
+      marker.images = it == marker_sums.end() ? 0 : static_cast<int>(marker_images[id].size());
+      marker.rms_px = it == marker_sums.end() ? 0.0 : std::sqrt(it->second.second / it->second.first);
+    }
+    summary->final_rms_px = summary->corners ? std::sqrt(all_squared / summary->corners) : 0.0;
   }
-  for (auto& [id, marker] : *markers) {
-    const auto it = marker_sums.find(id);
-    marker.images = it == marker_sums.end() ? 0 : static_cast<int>(marker_images[id].size());
-    marker.rms_px = it == marker_sums.end() ? 0.0 : std::sqrt(it->second.second / it->second.first);
+
+ private:
+  const std::array<double, 8> intrinsics_;
+  std::vector<BundleImage>* images_;
+  std::map<int, BundleMarker>* markers_;
+  std::vector<std::array<double, 6>> camera_poses_;
+  std::map<int, std::array<double, 6>> marker_poses_;
+  std::map<int, std::array<std::array<double, 3>, 4>> fixed_points_;
+};
+
+}  // namespace
+
+BundleAdjustmentSummary BundleAdjust(const Camera& camera, const BundleAdjustmentOptions& options,
+                                     std::vector<BundleImage>* images, std::map<int, BundleMarker>* markers) {
+  Timer timer;
+  BundleAdjustmentSummary summary;
+  BundleParameters parameters(camera, images, markers);
+  summary.initial_rms_px = parameters.InlierRms();
+  for (int solve = 0; solve < 2; ++solve) {
+    if (!parameters.Solve(options, &summary)) {
+      summary.total_s = timer.ElapsedSeconds();
+      return summary;
+    }
+    if (solve == 0) parameters.MarkOutliers(options.min_outlier_px);
   }
-  summary.final_rms_px = summary.corners ? std::sqrt(all_squared / summary.corners) : 0.0;
+  parameters.WriteBack(&summary);
   summary.total_s = timer.ElapsedSeconds();
   summary.success = true;
   return summary;

@@ -77,6 +77,8 @@ struct BundleAdjustmentOptions {
 };
 
 struct BundleAdjustmentSummary {
+  // False when Ceres found no usable solution (`message` says why; the poses are then unchanged), and
+  // until BundleAdjust ran. Bad input throws instead.
   bool success = false;
   int images = 0;         // posed photos in the problem
   int free_markers = 0;   // markers whose pose was adjusted

@@ -12,13 +12,13 @@
 
 #include "align/colmap_model.h"
 #include "core/error.h"
-#include "core/statistics.h"
-#include "core/subprocess.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
 #include "core/linear_image.h"
 #include "core/logging.h"
 #include "core/radiometry.h"
+#include "core/statistics.h"
+#include "core/subprocess.h"
 
 namespace fs = std::filesystem;
 
@@ -86,10 +86,10 @@ std::string ColmapImageName(const std::string& photo_file) {
 }  // namespace
 
 bool ColmapRunnerOptions::Check(std::string* why) const {
-  if (binary.empty() || num_threads == 0 || num_threads < -1 || max_image_size < 100) {
-    *why = "a binary, num_threads -1 or >= 1, max_image_size >= 100";
-    return false;
-  }
+  IBRDF_CHECK_OPTION(!binary.empty());
+  IBRDF_CHECK_OPTION_GE(num_threads, -1);
+  IBRDF_CHECK_OPTION(num_threads != 0);  // -1: all cores
+  IBRDF_CHECK_OPTION_GE(max_image_size, 100);
   return true;
 }
 
@@ -211,7 +211,6 @@ ColmapRunResult RunColmap(const Session& session, const std::string& work_dir, c
   result.work_dir = work_dir;
   result.model_dir = (fs::path(work_dir) / "sparse" / best).string();
   result.total_s = timer.ElapsedSeconds();
-  result.success = true;
   return result;
 }
 

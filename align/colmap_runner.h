@@ -42,8 +42,8 @@ struct ColmapStepTime {
   double seconds = 0.0;
 };
 
+// What RunColmap did. A step that fails throws Error; a returned result names a committed model.
 struct ColmapRunResult {
-  bool success = false;
   std::string work_dir;       // the committed work folder
   std::string model_dir;      // its largest model, work_dir/sparse/N
   int models = 0;             // models the mapper wrote

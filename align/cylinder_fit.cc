@@ -8,14 +8,14 @@
 #include <Eigen/Geometry>
 
 #include "align/cost_functions/rigid_point_error.h"
+#include "core/error.h"
 
 namespace ibrdf {
 
 bool CylinderFitOptions::Check(std::string* why) const {
-  if (min_markers < 1 || !(cauchy_m > 0.0) || !(max_marker_rms_m > 0.0)) {
-    *why = "min_markers >= 1, cauchy_m > 0, max_marker_rms_m > 0";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(min_markers, 1);
+  IBRDF_CHECK_OPTION_GT(cauchy_m, 0.0);
+  IBRDF_CHECK_OPTION_GT(max_marker_rms_m, 0.0);
   return true;
 }
 
@@ -31,12 +31,9 @@ std::string CylinderFit::BriefReport() const {
 
 CylinderFit FitCylinderToMarkers(const SampleTargetsSpec& spec, const std::map<int, BundleMarker>& markers,
                                  const SampleSpec& given, const CylinderFitOptions& options) {
-  CylinderFit fit;
   std::string why;
-  if (!options.Check(&why)) {
-    fit.reason = "bad options: " + why;
-    return fit;
-  }
+  if (!options.Check(&why)) ThrowError("cylinder fit options", why);
+  CylinderFit fit;
   std::vector<const TargetSpec*> used;
   for (const TargetSpec& target : spec.markers) {
     const auto it = markers.find(target.id);

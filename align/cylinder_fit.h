@@ -36,7 +36,9 @@ struct CylinderFit {
   std::string BriefReport() const;
 };
 
-// Fits the sample's pose to the posed sample markers among `markers` (ids of spec.markers).
+// Fits the sample's pose to the posed sample markers among `markers` (ids of spec.markers). Too few
+// posed markers, a failed solve or markers that disagree: not fitted, with the reason. Throws Error
+// for bad options.
 CylinderFit FitCylinderToMarkers(const SampleTargetsSpec& spec, const std::map<int, BundleMarker>& markers,
                                  const SampleSpec& given, const CylinderFitOptions& options);
 

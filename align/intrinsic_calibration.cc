@@ -99,19 +99,16 @@ ViewCorners FindCorners(const Image& image, const cv::Ptr<cv::aruco::CharucoBoar
 }  // namespace
 
 bool CharucoBoardSpec::Check(std::string* why) const {
-  if (squares_x < 3 || squares_y < 3) {
-    *why = "a ChArUco board needs at least 3 x 3 squares";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(squares_x, 3);
+  IBRDF_CHECK_OPTION_GE(squares_y, 3);
   if (squares_y % 2 == 0) {
     *why = "squares_y must be odd (got " + std::to_string(squares_y) +
            "): boards with an even number of rows differ between OpenCV versions";
     return false;
   }
-  if (!(square_size > 0.0) || !(marker_size > 0.0) || !(marker_size < square_size)) {
-    *why = "need 0 < marker_size < square_size";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GT(square_size, 0.0);
+  IBRDF_CHECK_OPTION_GT(marker_size, 0.0);
+  IBRDF_CHECK_OPTION_LT(marker_size, square_size);
   return true;
 }
 
@@ -162,10 +159,10 @@ std::vector<uint8_t> DrawCharucoBoard(const CharucoBoardSpec& board, int texels_
 }
 
 bool IntrinsicCalibrationOptions::Check(std::string* why) const {
-  if (min_corners_per_view < 6 || min_views < 3 || !(max_view_rms_px > 0.0) || corner_window_px < 2) {
-    *why = "min_corners_per_view >= 6, min_views >= 3, max_view_rms_px > 0, corner_window_px >= 2";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(min_corners_per_view, 6);
+  IBRDF_CHECK_OPTION_GE(min_views, 3);
+  IBRDF_CHECK_OPTION_GT(max_view_rms_px, 0.0);
+  IBRDF_CHECK_OPTION_GE(corner_window_px, 2);
   return true;
 }
 
@@ -277,7 +274,6 @@ IntrinsicCalibrationResult CalibrateIntrinsics(const std::string& directory,
     result.corners_used += view.corners;
   }
   result.total_s = timer.ElapsedSeconds();
-  result.success = true;
   return result;
 }
 

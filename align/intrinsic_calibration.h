@@ -66,8 +66,9 @@ struct CalibrationView {
   double rms_px = 0.0;         // reprojection RMS of its corners in the final calibration
 };
 
+// What CalibrateIntrinsics found. Bad photos, too few views or a calibration that does not converge
+// throw Error; a returned result holds a calibrated camera.
 struct IntrinsicCalibrationResult {
-  bool success = false;
   Camera camera;                // OPENCV model, COLMAP's pixel convention
   std::vector<double> std_dev;  // one-sigma uncertainty of fx, fy, cx, cy, k1, k2, p1, p2
   double rms_px = 0.0;          // reprojection RMS over every corner used

@@ -82,15 +82,12 @@ std::string IdList(const std::vector<Correspondence>& pairs, const std::vector<s
 }  // namespace
 
 bool MeshRegistrationOptions::Check(std::string* why) const {
-  if (min_markers < 3) {
-    *why = "min_markers must be at least 3";
-    return false;
-  }
-  if (!(max_marker_rms_m > 0.0) || !(min_spread_ratio > 0.0 && min_spread_ratio < 1.0) ||
-      !(max_outlier_fraction >= 0.0 && max_outlier_fraction < 1.0)) {
-    *why = "max_marker_rms_m must be positive, min_spread_ratio and max_outlier_fraction in (0, 1)";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(min_markers, 3);
+  IBRDF_CHECK_OPTION_GT(max_marker_rms_m, 0.0);
+  IBRDF_CHECK_OPTION_GT(min_spread_ratio, 0.0);
+  IBRDF_CHECK_OPTION_LT(min_spread_ratio, 1.0);
+  IBRDF_CHECK_OPTION_GE(max_outlier_fraction, 0.0);
+  IBRDF_CHECK_OPTION_LT(max_outlier_fraction, 1.0);
   return true;
 }
 
@@ -190,7 +187,6 @@ MeshRegistration RegisterMeshToTargets(const std::vector<ScanTargetSpec>& scan_t
   result.used_markers = static_cast<int>(use.size());
   result.rms_m = std::sqrt(sum / use.size());
   result.world_from_mesh = sim;
-  result.success = true;
   return result;
 }
 

@@ -44,8 +44,8 @@ struct MarkerRegistrationResidual {
   std::string dropped_reason;     // empty when used
 };
 
+// A registration that passed every check (RegisterMeshToTargets throws Error otherwise).
 struct MeshRegistration {
-  bool success = false;  // false until a transform passed every check
   Sim3d world_from_mesh;
   std::vector<MarkerRegistrationResidual> markers;  // the shared markers, in scan_targets' order
   std::vector<int> unmatched_ids;                   // scan targets whose id is not in the layout (ignored)

@@ -7,82 +7,50 @@
 #include "scan/scan_pipeline.h"
 
 namespace ibrdf {
-
 namespace {
+
 void AddScanCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "scan",
       "Read range scans (PLY range grids), meshes (PLY, OBJ, OFF, STL; COLMAP meshed-*.ply) and point clouds\n"
-      "(PLY, PCD; COLMAP fused.ply), bring them into one frame (--conf, the Stanford .conf format), tessellate,\n"
-      "clean, fit a local plane at every point for its normal, and report convexity. Writes a PLY with normals\n"
-      "and quality, and a JSON sidecar <out>.json (docs/scan.md).");
+      "(PLY, PCD; COLMAP fused.ply), bring them into one frame (--conf, the Stanford .conf format, or a\n"
+      "session's scan_inputs), tessellate, clean, fit a local plane at every point for its normal, and report\n"
+      "convexity. Writes a PLY with normals and quality, and a JSON sidecar <out>.json (docs/scan.md).");
   struct Args {
-    std::vector<std::string> inputs;
-    std::string out, conf;
+    ScanSources sources;
+    std::string out;
     ScanOptions options;
-    bool no_outliers = false;
-    bool overwrite = false;
+    bool no_outliers = false, overwrite = false;
   };
   auto args = std::make_shared<Args>();
-  command->add_option("inputs", args->inputs,
-                      "Scan files (with --conf: each must be listed there; none: all it lists)");
+  ScanOptions& o = args->options;
+  auto option = [command](const char* name, auto& value, const char* help) {
+    command->add_option(name, value, help)->capture_default_str();
+  };
+  command->add_option("inputs", args->sources.files, "Scan files (with --conf: each must be listed there; none: all)");
   command->add_option("--out", args->out, "Mesh to write (.ply); the sidecar goes to <out>.json")->required();
-  command->add_option("--conf", args->conf, "Stanford .conf file: per-scan transforms into one frame");
-  command
-      ->add_option("--max-edge-factor", args->options.grid.max_edge_factor,
-                   "Range grids: drop triangles with an edge longer than this times the grid spacing")
-      ->capture_default_str();
-  command
-      ->add_option("--max-edge-m", args->options.grid.max_edge_m,
-                   "Range grids: absolute edge limit in metres (0: use the factor)")
-      ->capture_default_str();
+  command->add_option("--conf", args->sources.conf, "Stanford .conf file: per-scan transforms into one frame");
+  command->add_option("--session", args->sources.session, "Session (folder or session.json): its scan_inputs");
+  option("--max-edge-factor", o.grid.max_edge_factor, "Range grids: drop edges longer than this x the grid spacing");
+  option("--max-edge-m", o.grid.max_edge_m, "Range grids: absolute edge limit in metres (0: use the factor)");
   command->add_flag("--no-outliers", args->no_outliers, "Skip the statistical outlier removal");
-  command
-      ->add_option("--outlier-neighbours", args->options.clean.outlier_neighbours,
-                   "Outlier removal: neighbours per point")
-      ->capture_default_str();
-  command
-      ->add_option("--outlier-stddev", args->options.clean.outlier_stddev,
-                   "Outlier removal: standard deviations above the mean distance")
-      ->capture_default_str();
-  command
-      ->add_option("--min-piece-fraction", args->options.clean.min_piece_fraction,
-                   "Remove connected pieces with fewer than this fraction of the faces")
-      ->capture_default_str();
-  command
-      ->add_option("--radius-m", args->options.normals.radius_m,
-                   "Local-plane radius in metres (0: --radius-factor times the point spacing)")
-      ->capture_default_str();
-  command
-      ->add_option("--radius-factor", args->options.normals.radius_spacing_factor,
-                   "Local-plane radius as a multiple of the median point spacing")
-      ->capture_default_str();
-  command
-      ->add_option("--hull-tolerance-m", args->options.convexity.tolerance_m,
-                   "Convexity: distance to the hull counted as on it (0: a fraction of the size)")
-      ->capture_default_str();
-  command
-      ->add_option("--min-convex-fraction", args->options.convexity.min_convex_fraction,
-                   "Convexity: surface fraction within the tolerance for a convex sample")
-      ->capture_default_str();
+  option("--outlier-neighbours", o.clean.outlier_neighbours, "Outlier removal: neighbours per point");
+  option("--outlier-stddev", o.clean.outlier_stddev, "Outlier removal: standard deviations above the mean distance");
+  option("--min-piece-fraction", o.clean.min_piece_fraction, "Remove pieces with under this fraction of the faces");
+  option("--radius-m", o.normals.radius_m, "Local-plane radius in metres (0: --radius-factor x the point spacing)");
+  option("--radius-factor", o.normals.radius_spacing_factor, "Local-plane radius in median point spacings");
+  option("--hull-tolerance-m", o.convexity.tolerance_m, "Convexity: distance counted as on the hull (0: auto)");
+  option("--min-convex-fraction", o.convexity.min_convex_fraction, "Convexity: surface fraction on the hull");
   command->add_flag("--overwrite", args->overwrite, "Replace existing output files");
   command->callback([args] {
     StageLog stage("scan");
     args->options.clean.remove_outliers = !args->no_outliers;
     std::string why;
     if (!args->options.Check(&why)) ThrowError("ibrdf scan", "bad option: " + why);
-    std::vector<ScanInput> inputs;
-    if (!args->conf.empty()) {
-      inputs = InputsFromConf(args->conf, args->inputs);
-    } else {
-      if (args->inputs.empty()) ThrowError("ibrdf scan", "no input files (give scan files, or --conf)");
-      for (const std::string& path : args->inputs) inputs.push_back({path, std::nullopt});
-    }
-    std::vector<std::string> input_paths;
-    for (const ScanInput& input : inputs) input_paths.push_back(input.path);
-    if (!args->conf.empty()) input_paths.push_back(args->conf);
-    RequireWritableOutput(args->out, args->overwrite, input_paths);
-    RequireWritableOutput(ScanSidecarPath(args->out), args->overwrite, input_paths);
+    std::vector<std::string> read;
+    const std::vector<ScanInputSpec> inputs = ResolveScanInputs(args->sources, &read);
+    RequireWritableOutput(args->out, args->overwrite, read);
+    RequireWritableOutput(ScanSidecarPath(args->out), args->overwrite, read);
     const ScanResult result = RunScan(inputs, args->options);
     WriteScanOutputs(args->out, result, args->options);
     if (Verbosity() >= 1) std::cout << result.summary.Table();

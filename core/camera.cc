@@ -160,20 +160,16 @@ bool Camera::Check(std::string* why) const {
            std::to_string(params.size());
     return false;
   }
-  if (width <= 0 || height <= 0) {
-    *why = "width and height must be positive, got " + std::to_string(width) + "x" + std::to_string(height);
-    return false;
-  }
-  for (double p : params) {
-    if (!std::isfinite(p)) {
-      *why = "parameters must be finite numbers";
+  IBRDF_CHECK_OPTION_GT(width, 0);
+  IBRDF_CHECK_OPTION_GT(height, 0);
+  for (size_t i = 0; i < params.size(); ++i) {
+    if (!std::isfinite(params[i])) {
+      *why = "params[" + std::to_string(i) + "] must be a finite number, got " + std::to_string(params[i]);
       return false;
     }
   }
-  if (!(FocalX() > 0) || !(FocalY() > 0)) {
-    *why = "focal lengths must be positive";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GT(FocalX(), 0.0);
+  IBRDF_CHECK_OPTION_GT(FocalY(), 0.0);
   return true;
 }
 

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+
+#include "core/error.h"
 
 namespace ibrdf {
 
@@ -61,18 +64,18 @@ std::string Response::Describe() const {
 }
 
 bool Response::Check(std::string* why) const {
-  if (kind == Kind::kGamma && !(gamma > 0.0 && std::isfinite(gamma))) {
-    *why = "gamma must be a positive number";
-    return false;
+  if (kind == Kind::kGamma) {
+    IBRDF_CHECK_OPTION_GT(gamma, 0.0);
+    IBRDF_CHECK_OPTION(std::isfinite(gamma));
   }
   if (kind == Kind::kTable) {
-    if (table.size() < 2) {
-      *why = "a response table needs at least 2 entries";
-      return false;
-    }
+    IBRDF_CHECK_OPTION_GE(table.size(), 2u);
     for (size_t i = 1; i < table.size(); ++i) {
       if (!(table[i] > table[i - 1])) {
-        *why = "a response table must be strictly increasing (entry " + std::to_string(i) + ")";
+        std::ostringstream message;
+        message << "table must be strictly increasing: table[" << i << "] = " << table[i] << " after table[" << i - 1
+                << "] = " << table[i - 1];
+        *why = message.str();
         return false;
       }
     }

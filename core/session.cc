@@ -588,6 +588,53 @@ nlohmann::json Session::ToJson() const {
 
 void Session::Save(const std::string& path) const { WriteJsonFile(path, ToJson()); }
 
+std::string Session::AbsolutePath(const std::string& file) const {
+  return fs::absolute(ResolvePath(directory, file)).lexically_normal().string();
+}
+
+Session Session::Rebased(const std::string& dir, PathStyle style) const {
+  const fs::path folder = fs::absolute(dir).lexically_normal();
+  auto rebase = [&](std::string* file) {
+    if (file->empty()) return;
+    const fs::path absolute = AbsolutePath(*file);
+    const fs::path relative = absolute.lexically_relative(folder);
+    *file = style == PathStyle::kAbsolute || relative.empty() ? absolute.string() : relative.string();
+  };
+  Session rebased = *this;
+  for (PhotoSpec& photo : rebased.photos) rebase(&photo.file);
+  rebase(&rebased.radiometry.flat_field);
+  if (rebased.calibration && rebased.calibration->white_reference) {
+    for (PhotoSpec& photo : rebased.calibration->white_reference->photos) rebase(&photo.file);
+  }
+  if (rebased.sample.kind == SampleSpec::Kind::kMesh) {
+    rebase(&rebased.sample.mesh_file);
+    for (ScanInputSpec& input : rebased.sample.scan_inputs) rebase(&input.file);
+  }
+  rebased.directory = folder.string();
+  rebased.manifest_path = (folder / "session.json").string();
+  return rebased;
+}
+
+std::string Session::SaveRebased(const std::string& dir, PathStyle style) const {
+  const Session rebased = Rebased(dir, style);
+  rebased.Save(rebased.manifest_path);
+  return rebased.manifest_path;
+}
+
+std::vector<std::string> Session::InputFiles() const {
+  std::vector<std::string> files;
+  for (const PhotoSpec& photo : photos) files.push_back(AbsolutePath(photo.file));
+  if (!radiometry.flat_field.empty()) files.push_back(AbsolutePath(radiometry.flat_field));
+  if (calibration && calibration->white_reference) {
+    for (const PhotoSpec& photo : calibration->white_reference->photos) files.push_back(AbsolutePath(photo.file));
+  }
+  if (sample.kind == SampleSpec::Kind::kMesh) {
+    files.push_back(AbsolutePath(sample.mesh_file));
+    for (const ScanInputSpec& input : sample.scan_inputs) files.push_back(AbsolutePath(input.file));
+  }
+  return files;
+}
+
 std::string Session::PhotoPath(size_t i) const { return ResolvePath(directory, photos.at(i).file); }
 
 void Session::CheckPhotos() const {

@@ -37,9 +37,10 @@ struct RadiometrySpec {
   std::string flat_field;
 };
 
-// One raw range scan of a mesh sample (what `ibrdf scan` merges into the sample's mesh file).
+// One raw range scan of a mesh sample (what `ibrdf scan` merges into the sample's mesh file); also the
+// input type of the scan stage (scan/scan_pipeline.h), where `file` is resolved.
 struct ScanInputSpec {
-  std::string file;                        // relative to the session folder
+  std::string file;                        // relative to the session folder (or absolute)
   std::optional<Rigid3d> world_from_scan;  // into the mesh's (scan) frame; identity when absent
 };
 
@@ -173,6 +174,28 @@ struct Session {
   nlohmann::json ToJson() const;
   // Writes the manifest to `path` atomically.
   void Save(const std::string& path) const;
+
+  // How SaveRebased and Rebased write the manifest's path fields.
+  enum class PathStyle {
+    kRelative,  // relative to the new folder (absolute only where no relative path exists)
+    kAbsolute,  // absolute, normalized
+  };
+  // A copy of the session whose manifest lives in folder `dir`: `directory` and `manifest_path` name
+  // `dir` and `dir`/session.json, and every path field (photos, the flat field, the white-reference
+  // photos, the mesh file, the raw scans) is rewritten, field by field, to name the same file from
+  // there. For a caller that writes the manifest elsewhere first (e.g. into a temporary folder that
+  // becomes `dir`): `session.Rebased(dir).Save(temporary_manifest)`.
+  Session Rebased(const std::string& dir, PathStyle style = PathStyle::kRelative) const;
+  // Writes Rebased(dir, style) to `dir`/session.json atomically (the folder must exist); returns that
+  // path. The files the session names stay where they are.
+  std::string SaveRebased(const std::string& dir, PathStyle style = PathStyle::kRelative) const;
+
+  // A path field of the manifest (relative to `directory`, or absolute) as an absolute, normalized path.
+  std::string AbsolutePath(const std::string& file) const;
+  // Every file the session references, absolute and normalized, in manifest order: the photos, the
+  // flat field, the white-reference photos, and for a mesh sample the mesh file and its raw scans.
+  // Not the manifest itself. The mesh file need not exist yet (the scan stage writes it).
+  std::vector<std::string> InputFiles() const;
 
   // Absolute or session-relative path of photo i.
   std::string PhotoPath(size_t i) const;

@@ -481,41 +481,26 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     }
   }
   result.summary.total_s = timer.ElapsedSeconds();
-  result.summary.success = true;
   return result;
 }
 
 }  // namespace
 
 bool DerenderOptions::Check(std::string* why) const {
-  if (!(max_theta_i_deg > 0.0 && max_theta_i_deg <= 90.0) || !(max_theta_e_deg > 0.0 && max_theta_e_deg <= 90.0)) {
-    *why = "grazing limits must be in (0, 90] degrees";
-    return false;
-  }
-  if (!(min_signal >= 0.0)) {
-    *why = "min_signal must not be negative";
-    return false;
-  }
-  if (pixel_stride < 1) {
-    *why = "pixel_stride must be at least 1";
-    return false;
-  }
-  if (!(mixed_pixel_depth_factor > 0.0)) {
-    *why = "mixed_pixel_depth_factor must be positive";
-    return false;
-  }
-  if (!(max_normal_fit_rms_m >= 0.0) || min_fit_neighbours < 0) {
-    *why = "max_normal_fit_rms_m and min_fit_neighbours must not be negative";
-    return false;
-  }
-  if (!(shadow_ray_offset_fit_rms >= 0.0)) {
-    *why = "shadow_ray_offset_fit_rms must not be negative";
-    return false;
-  }
-  if (!(shadow_edge_deg >= 0.0 && shadow_edge_deg < 45.0) || shadow_edge_rays < 0 || shadow_edge_rays > 64) {
-    *why = "shadow_edge_deg must be in [0, 45) and shadow_edge_rays in [0, 64]";
-    return false;
-  }
+  // Grazing limits in (0, 90] degrees.
+  IBRDF_CHECK_OPTION_GT(max_theta_i_deg, 0.0);
+  IBRDF_CHECK_OPTION_LE(max_theta_i_deg, 90.0);
+  IBRDF_CHECK_OPTION_GT(max_theta_e_deg, 0.0);
+  IBRDF_CHECK_OPTION_LE(max_theta_e_deg, 90.0);
+  IBRDF_CHECK_OPTION_GE(min_signal, 0.0);
+  IBRDF_CHECK_OPTION_GE(pixel_stride, 1);
+  IBRDF_CHECK_OPTION_GT(mixed_pixel_depth_factor, 0.0);
+  IBRDF_CHECK_OPTION_GE(max_normal_fit_rms_m, 0.0);
+  IBRDF_CHECK_OPTION_GE(min_fit_neighbours, 0);
+  IBRDF_CHECK_OPTION_GE(shadow_ray_offset_fit_rms, 0.0);
+  IBRDF_CHECK_OPTION_GE(shadow_edge_deg, 0.0);
+  IBRDF_CHECK_OPTION_LT(shadow_edge_deg, 45.0);
+  IBRDF_CHECK_OPTION_RANGE(shadow_edge_rays, 0, 64);
   return true;
 }
 

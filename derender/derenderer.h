@@ -61,8 +61,8 @@ struct DerenderOptions {
   bool Check(std::string* why) const;
 };
 
+// What the derender stage did (it throws Error for bad input; a returned summary is complete).
 struct DerenderSummary {
-  bool success = false;          // false until the stage ran to the end
   std::string sample;            // "sphere", "cylinder" or "mesh"
   uint64_t photos = 0;           // measurement photos (alignment-only photos are skipped)
   uint64_t pixels_examined = 0;  // pixels looked at (after the stride)

@@ -43,26 +43,14 @@ void DiscBox(const Camera& camera, const Rigid3d& camera_from_world, const Eigen
 }  // namespace
 
 bool LightCalibrationOptions::Check(std::string* why) const {
-  if (!(interior_fraction > 0.0 && interior_fraction <= 1.0)) {
-    *why = "interior_fraction must be in (0, 1]";
-    return false;
-  }
-  if (!(min_signal >= 0.0)) {
-    *why = "min_signal must not be negative";
-    return false;
-  }
-  if (!(max_saturated_fraction >= 0.0 && max_saturated_fraction < 1.0)) {
-    *why = "max_saturated_fraction must be in [0, 1)";
-    return false;
-  }
-  if (min_pixels < 1) {
-    *why = "min_pixels must be at least 1";
-    return false;
-  }
-  if (!(max_theta_deg > 0.0 && max_theta_deg < 90.0)) {
-    *why = "max_theta_deg must be in (0, 90)";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GT(interior_fraction, 0.0);
+  IBRDF_CHECK_OPTION_LE(interior_fraction, 1.0);
+  IBRDF_CHECK_OPTION_GE(min_signal, 0.0);
+  IBRDF_CHECK_OPTION_GE(max_saturated_fraction, 0.0);
+  IBRDF_CHECK_OPTION_LT(max_saturated_fraction, 1.0);
+  IBRDF_CHECK_OPTION_GE(min_pixels, 1);
+  IBRDF_CHECK_OPTION_GT(max_theta_deg, 0.0);
+  IBRDF_CHECK_OPTION_LT(max_theta_deg, 90.0);
   return true;
 }
 

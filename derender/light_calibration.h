@@ -33,7 +33,9 @@ struct LightCalibrationOptions {
 };
 
 struct LightCalibrationReport {
-  bool success = false;     // false until the step ran
+  // The report is filled as the step goes: true once ApplyLightCalibration returned; false when it
+  // threw (the report then holds what was counted before the error).
+  bool success = false;
   bool calibrated = false;  // false where the session has no white reference (the light is unchanged)
   int photos = 0;           // white-reference photos
   Eigen::Vector3d stated_intensity = Eigen::Vector3d::Zero();      // the session's light intensity

@@ -13,18 +13,12 @@
 namespace ibrdf {
 
 bool ConvexityOptions::Check(std::string* why) const {
-  if (!(tolerance_m >= 0.0) || !std::isfinite(tolerance_m)) {
-    *why = "tolerance_m must be >= 0 (0: a fraction of the size)";
-    return false;
-  }
-  if (!(tolerance_fraction > 0.0 && tolerance_fraction < 1.0)) {
-    *why = "tolerance_fraction must be in (0, 1)";
-    return false;
-  }
-  if (!(min_convex_fraction > 0.0 && min_convex_fraction <= 1.0)) {
-    *why = "min_convex_fraction must be in (0, 1]";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(tolerance_m, 0.0);  // 0: a fraction of the size
+  IBRDF_CHECK_OPTION(std::isfinite(tolerance_m));
+  IBRDF_CHECK_OPTION_GT(tolerance_fraction, 0.0);
+  IBRDF_CHECK_OPTION_LT(tolerance_fraction, 1.0);
+  IBRDF_CHECK_OPTION_GT(min_convex_fraction, 0.0);
+  IBRDF_CHECK_OPTION_LE(min_convex_fraction, 1.0);
   return true;
 }
 
@@ -104,7 +98,6 @@ ConvexityReport ReportConvexity(const ScanMesh& mesh, const ConvexityOptions& op
                "shadow rays";
     report.warning = warning.str();
   }
-  report.success = true;
   return report;
 }
 

@@ -28,8 +28,7 @@ struct ConvexityOptions {
 };
 
 struct ConvexityReport {
-  bool success = false;  // false until the report ran
-  bool flat = false;     // the points span no volume (coplanar): trivially convex
+  bool flat = false;  // the points span no volume (coplanar): trivially convex
   size_t hull_vertices = 0, hull_faces = 0;
   double tolerance_m = 0.0;
   double fraction_within = 0.0;  // of the surface area (of the points when there are no faces)

@@ -16,22 +16,12 @@
 namespace ibrdf {
 
 bool LocalPlaneOptions::Check(std::string* why) const {
-  if (!(radius_m >= 0.0) || !std::isfinite(radius_m)) {
-    *why = "radius_m must be >= 0 (0: from the point spacing)";
-    return false;
-  }
-  if (!(radius_spacing_factor > 0.0)) {
-    *why = "radius_spacing_factor must be > 0";
-    return false;
-  }
-  if (min_neighbours < 3) {
-    *why = "min_neighbours must be >= 3 (a plane needs three points)";
-    return false;
-  }
-  if (!(collinear_ratio > 0.0 && collinear_ratio < 1.0)) {
-    *why = "collinear_ratio must be in (0, 1)";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(radius_m, 0.0);  // 0: from the point spacing
+  IBRDF_CHECK_OPTION(std::isfinite(radius_m));
+  IBRDF_CHECK_OPTION_GT(radius_spacing_factor, 0.0);
+  IBRDF_CHECK_OPTION_GE(min_neighbours, 3);  // a plane needs three points
+  IBRDF_CHECK_OPTION_GT(collinear_ratio, 0.0);
+  IBRDF_CHECK_OPTION_LT(collinear_ratio, 1.0);
   return true;
 }
 
@@ -62,10 +52,7 @@ LocalPlaneResult Fit(const std::vector<Eigen::Vector3d>& points, const std::vect
   result.points = n;
   result.spacing_m = spacing_m;
   result.radius_m = options.radius_m > 0.0 ? options.radius_m : options.radius_spacing_factor * result.spacing_m;
-  if (n == 0) {
-    result.success = true;
-    return result;
-  }
+  if (n == 0) return result;
   const Eigen::Vector3d centre = Centroid(points);
   const PointIndex index(points);
   std::vector<uint8_t> flipped(n, 0), collinear(n, 0);
@@ -143,7 +130,6 @@ LocalPlaneResult Fit(const std::vector<Eigen::Vector3d>& points, const std::vect
     result.neighbours_median = counts[counts.size() / 2];
   }
   result.seconds = timer.ElapsedSeconds();
-  result.success = true;
   return result;
 }
 

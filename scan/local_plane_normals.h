@@ -40,7 +40,6 @@ enum class NormalSource : uint8_t {
 };
 
 struct LocalPlaneResult {
-  bool success = false;                  // false until the stage ran
   double radius_m = 0.0;                 // the radius used
   double spacing_m = 0.0;                // median point spacing
   std::vector<Eigen::Vector3d> normals;  // unit and outward; zero where source is kNone

@@ -36,26 +36,13 @@ int Find(std::vector<int>& parent, int x) {
 }  // namespace
 
 bool CleanOptions::Check(std::string* why) const {
-  if (outlier_neighbours < 1) {
-    *why = "outlier_neighbours must be >= 1";
-    return false;
-  }
-  if (!(outlier_stddev > 0.0)) {
-    *why = "outlier_stddev must be > 0";
-    return false;
-  }
-  if (!(duplicate_distance_m >= 0.0)) {
-    *why = "duplicate_distance_m must be >= 0";
-    return false;
-  }
-  if (!(tiny_face_fraction >= 0.0 && tiny_face_fraction < 1.0)) {
-    *why = "tiny_face_fraction must be in [0, 1)";
-    return false;
-  }
-  if (!(min_piece_fraction >= 0.0 && min_piece_fraction < 1.0)) {
-    *why = "min_piece_fraction must be in [0, 1)";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(outlier_neighbours, 1);
+  IBRDF_CHECK_OPTION_GT(outlier_stddev, 0.0);
+  IBRDF_CHECK_OPTION_GE(duplicate_distance_m, 0.0);
+  IBRDF_CHECK_OPTION_GE(tiny_face_fraction, 0.0);
+  IBRDF_CHECK_OPTION_LT(tiny_face_fraction, 1.0);
+  IBRDF_CHECK_OPTION_GE(min_piece_fraction, 0.0);
+  IBRDF_CHECK_OPTION_LT(min_piece_fraction, 1.0);
   return true;
 }
 
@@ -193,7 +180,6 @@ CleanReport CleanMesh(const CleanOptions& options, ScanMesh* mesh) {
   report.points_out = mesh->points.size();
   report.faces_out = mesh->faces.size();
   report.seconds = timer.ElapsedSeconds();
-  report.success = true;
   return report;
 }
 

@@ -30,7 +30,6 @@ struct CleanOptions {
 };
 
 struct CleanReport {
-  bool success = false;  // false until cleaning ran
   uint64_t points_in = 0, faces_in = 0, points_out = 0, faces_out = 0;
   // Removed items by step: outlier_points, duplicate_points, degenerate_faces (repeated corner, zero
   // area, or the same corners as another face), tiny_faces, non_manifold_faces, small_piece_faces,

@@ -334,6 +334,172 @@ int FindProperty(const Element& element, const char* name) {
   return -1;
 }
 
+// Which of an element's properties ReadPly keeps (-1: absent), and what the element is.
+struct ElementLayout {
+  bool is_vertex = false, is_face = false, is_grid = false;
+  std::string what;  // "vertices" or "<name> entries", for messages
+  int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ilist = -1;
+  int iquality = -1, ineighbours = -1, ihull = -1;  // the scan stage's fit quality (WritePly)
+};
+
+// The values of one element instance that ReadPly keeps.
+struct InstanceValues {
+  double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0}, quality = 0, neighbours = 0, hull = 0;
+  std::vector<int> list;  // vertex_indices
+};
+
+// Finds the properties of `element` and prepares `mesh` for it (reserves vertices, sizes the grid).
+ElementLayout PrepareElement(const Element& element, const Header& header, const std::string& path, bool* have_grid,
+                             ScanMesh* mesh) {
+  ElementLayout layout;
+  layout.what = element.name == "vertex" ? "vertices" : element.name + " entries";
+  layout.is_vertex = element.name == "vertex";
+  layout.is_face = element.name == "face";
+  layout.is_grid = element.name == "range_grid";
+  if (layout.is_vertex) {
+    if (!mesh->points.empty()) ThrowError(path, "more than one vertex element");
+    layout.ix = FindProperty(element, "x");
+    layout.iy = FindProperty(element, "y");
+    layout.iz = FindProperty(element, "z");
+    if (layout.ix < 0 || layout.iy < 0 || layout.iz < 0)
+      ThrowError(path, "the vertex element needs properties x, y and z");
+    layout.inx = FindProperty(element, "nx");
+    layout.iny = FindProperty(element, "ny");
+    layout.inz = FindProperty(element, "nz");
+    if (!(layout.inx >= 0 && layout.iny >= 0 && layout.inz >= 0)) layout.inx = layout.iny = layout.inz = -1;
+    layout.iquality = FindProperty(element, "quality");
+    layout.ineighbours = FindProperty(element, "fit_neighbours");
+    layout.ihull = FindProperty(element, "hull_distance");
+    if (element.count > 500000000ull) ThrowError(path, "implausible vertex count " + std::to_string(element.count));
+    mesh->points.reserve(element.count);
+    if (layout.inx >= 0) mesh->normals.reserve(element.count);
+  }
+  if (layout.is_face || layout.is_grid) {
+    layout.ilist = FindProperty(element, "vertex_indices");
+    if (layout.ilist < 0) layout.ilist = FindProperty(element, "vertex_index");
+    if (layout.ilist < 0 || !element.properties[layout.ilist].is_list ||
+        !IsInteger(element.properties[layout.ilist].type)) {
+      ThrowError(path, "the " + element.name + " element needs an integer list 'vertex_indices'");
+    }
+  }
+  if (layout.is_grid) {
+    if (*have_grid) ThrowError(path, "more than one range_grid element");
+    if (header.num_cols <= 0 || header.num_rows <= 0) {
+      ThrowError(path, "a range_grid element needs 'obj_info num_cols' and 'obj_info num_rows' in the header");
+    }
+    if (element.count != static_cast<uint64_t>(header.num_cols) * header.num_rows) {
+      ThrowError(path, "range_grid has " + std::to_string(element.count) + " cells, but num_cols x num_rows is " +
+                           std::to_string(header.num_cols) + " x " + std::to_string(header.num_rows));
+    }
+    *have_grid = true;
+    mesh->grid.rows = header.num_rows;
+    mesh->grid.cols = header.num_cols;
+    mesh->grid.cell_point.assign(element.count, -1);
+  }
+  return layout;
+}
+
+// Reads instance `i` of `element` into `values` (values of properties ReadPly does not keep are read
+// and dropped; `values` keeps those of the previous instance where this one has none).
+void ReadInstance(const Element& element, const ElementLayout& layout, uint64_t i, const std::string& path,
+                  BodyReader* reader, InstanceValues* values) {
+  if (!reader->BeginInstance()) {
+    ThrowError(path, "the file ends after " + std::to_string(i) + " of " + std::to_string(element.count) + " " +
+                         layout.what + " (truncated, or the header's count is wrong)");
+  }
+  for (size_t p = 0; p < element.properties.size(); ++p) {
+    const Property& property = element.properties[p];
+    auto fail = [&] {
+      ThrowError(path, "the file ends inside " + element.name + " " + std::to_string(i) + " of " +
+                           std::to_string(element.count) + " (truncated, or the header's count is wrong)" +
+                           reader->Context());
+    };
+    double value = 0.0;
+    if (!property.is_list) {
+      if (!reader->Read(property.type, &value)) fail();
+      const int ip = static_cast<int>(p);
+      if (ip == layout.ix) values->point[0] = value;
+      if (ip == layout.iy) values->point[1] = value;
+      if (ip == layout.iz) values->point[2] = value;
+      if (ip == layout.inx) values->normal[0] = value;
+      if (ip == layout.iny) values->normal[1] = value;
+      if (ip == layout.inz) values->normal[2] = value;
+      if (ip == layout.iquality) values->quality = value;
+      if (ip == layout.ineighbours) values->neighbours = value;
+      if (ip == layout.ihull) values->hull = value;
+      continue;
+    }
+    double count = 0.0;
+    if (!reader->Read(property.count_type, &count)) fail();
+    if (count < 0 || count > 1000) {
+      ThrowError(path, element.name + " " + std::to_string(i) + ": bad list length " + std::to_string(count) +
+                           reader->Context());
+    }
+    if (static_cast<int>(p) == layout.ilist) values->list.clear();
+    for (int k = 0; k < static_cast<int>(count); ++k) {
+      if (!reader->Read(property.type, &value)) fail();
+      if (static_cast<int>(p) == layout.ilist) values->list.push_back(static_cast<int>(value));
+    }
+  }
+  if (reader->ascii() && reader->LineHasMore()) {
+    ThrowError(
+        path, element.name + " " + std::to_string(i) + " has more values than the header declares" + reader->Context());
+  }
+}
+
+// Adds instance `i`'s values to the mesh: a vertex, a polygon (to `polygons`) or a grid cell.
+void StoreInstance(const ElementLayout& layout, uint64_t i, const InstanceValues& values, const std::string& path,
+                   std::vector<std::vector<int>>* polygons, ScanMesh* mesh) {
+  if (layout.is_vertex) {
+    mesh->points.emplace_back(values.point[0], values.point[1], values.point[2]);
+    if (layout.inx >= 0) mesh->normals.emplace_back(values.normal[0], values.normal[1], values.normal[2]);
+    if (layout.iquality >= 0) mesh->fit_rms_m.push_back(static_cast<float>(values.quality));
+    if (layout.ineighbours >= 0) mesh->fit_neighbours.push_back(static_cast<int>(values.neighbours));
+    if (layout.ihull >= 0) mesh->hull_distance_m.push_back(static_cast<float>(values.hull));
+  } else if (layout.is_face) {
+    if (values.list.size() < 3) {
+      ThrowError(path, "face " + std::to_string(i) + " has " + std::to_string(values.list.size()) +
+                           " vertices (at least 3 needed)");
+    }
+    polygons->push_back(values.list);
+  } else if (layout.is_grid) {
+    if (values.list.size() > 1) {
+      ThrowError(path, "range_grid cell " + std::to_string(i) + " lists " + std::to_string(values.list.size()) +
+                           " vertices (0 or 1 expected)");
+    }
+    if (!values.list.empty()) mesh->grid.cell_point[i] = values.list[0];
+  }
+}
+
+// Checks the indices (faces, grid cells) and coordinates; triangulates the polygons into mesh->faces.
+void FinishMesh(const std::vector<std::vector<int>>& polygons, const std::string& path, ScanMesh* mesh) {
+  const int n = static_cast<int>(mesh->points.size());
+  for (size_t i = 0; i < polygons.size(); ++i) {
+    for (int v : polygons[i]) {
+      if (v < 0 || v >= n) {
+        ThrowError(path, "face " + std::to_string(i) + " refers to vertex " + std::to_string(v) + ", but there are " +
+                             std::to_string(n) + " vertices");
+      }
+    }
+    for (size_t k = 1; k + 1 < polygons[i].size(); ++k) {
+      mesh->faces.emplace_back(polygons[i][0], polygons[i][k], polygons[i][k + 1]);
+    }
+  }
+  for (size_t c = 0; c < mesh->grid.cell_point.size(); ++c) {
+    const int v = mesh->grid.cell_point[c];
+    if (v >= n) {
+      ThrowError(path, "range_grid cell " + std::to_string(c) + " refers to vertex " + std::to_string(v) +
+                           ", but there are " + std::to_string(n) + " vertices");
+    }
+  }
+  RequireFinitePoints(*mesh, path);
+  for (size_t i = 0; i < mesh->normals.size(); ++i) {
+    if (!mesh->normals[i].allFinite())
+      ThrowError(path, "vertex " + std::to_string(i) + " has a NaN or infinite normal");
+  }
+  if (mesh->points.empty()) ThrowError(path, "no vertices");
+}
+
 }  // namespace
 
 ScanMesh ReadPly(const std::string& path) {
@@ -343,147 +509,18 @@ ScanMesh ReadPly(const std::string& path) {
   BodyReader reader(data, header, path);
   bool have_grid = false;
   std::vector<std::vector<int>> polygons;
-
   for (const Element& element : header.elements) {
-    const std::string what = element.name == "vertex" ? "vertices" : element.name + " entries";
-    const bool is_vertex = element.name == "vertex";
-    const bool is_face = element.name == "face";
-    const bool is_grid = element.name == "range_grid";
-    int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ilist = -1;
-    int iquality = -1, ineighbours = -1, ihull = -1;  // the scan stage's fit quality (WritePly)
-    if (is_vertex) {
-      if (!mesh.points.empty()) ThrowError(path, "more than one vertex element");
-      ix = FindProperty(element, "x");
-      iy = FindProperty(element, "y");
-      iz = FindProperty(element, "z");
-      if (ix < 0 || iy < 0 || iz < 0) ThrowError(path, "the vertex element needs properties x, y and z");
-      inx = FindProperty(element, "nx");
-      iny = FindProperty(element, "ny");
-      inz = FindProperty(element, "nz");
-      if (!(inx >= 0 && iny >= 0 && inz >= 0)) inx = iny = inz = -1;
-      iquality = FindProperty(element, "quality");
-      ineighbours = FindProperty(element, "fit_neighbours");
-      ihull = FindProperty(element, "hull_distance");
-      if (element.count > 500000000ull) ThrowError(path, "implausible vertex count " + std::to_string(element.count));
-      mesh.points.reserve(element.count);
-      if (inx >= 0) mesh.normals.reserve(element.count);
-    }
-    if (is_face || is_grid) {
-      ilist = FindProperty(element, "vertex_indices");
-      if (ilist < 0) ilist = FindProperty(element, "vertex_index");
-      if (ilist < 0 || !element.properties[ilist].is_list || !IsInteger(element.properties[ilist].type)) {
-        ThrowError(path, "the " + element.name + " element needs an integer list 'vertex_indices'");
-      }
-    }
-    if (is_grid) {
-      if (have_grid) ThrowError(path, "more than one range_grid element");
-      if (header.num_cols <= 0 || header.num_rows <= 0) {
-        ThrowError(path, "a range_grid element needs 'obj_info num_cols' and 'obj_info num_rows' in the header");
-      }
-      if (element.count != static_cast<uint64_t>(header.num_cols) * header.num_rows) {
-        ThrowError(path, "range_grid has " + std::to_string(element.count) + " cells, but num_cols x num_rows is " +
-                             std::to_string(header.num_cols) + " x " + std::to_string(header.num_rows));
-      }
-      have_grid = true;
-      mesh.grid.rows = header.num_rows;
-      mesh.grid.cols = header.num_cols;
-      mesh.grid.cell_point.assign(element.count, -1);
-    }
-
-    double values[3] = {0, 0, 0}, normal[3] = {0, 0, 0}, quality = 0, neighbours = 0, hull = 0;
-    std::vector<int> list;
+    const ElementLayout layout = PrepareElement(element, header, path, &have_grid, &mesh);
+    InstanceValues values;
     for (uint64_t i = 0; i < element.count; ++i) {
-      if (!reader.BeginInstance()) {
-        ThrowError(path, "the file ends after " + std::to_string(i) + " of " + std::to_string(element.count) + " " +
-                             what + " (truncated, or the header's count is wrong)");
-      }
-      for (size_t p = 0; p < element.properties.size(); ++p) {
-        const Property& property = element.properties[p];
-        auto fail = [&] {
-          ThrowError(path, "the file ends inside " + element.name + " " + std::to_string(i) + " of " +
-                               std::to_string(element.count) + " (truncated, or the header's count is wrong)" +
-                               reader.Context());
-        };
-        double value = 0.0;
-        if (!property.is_list) {
-          if (!reader.Read(property.type, &value)) fail();
-          const int ip = static_cast<int>(p);
-          if (ip == ix) values[0] = value;
-          if (ip == iy) values[1] = value;
-          if (ip == iz) values[2] = value;
-          if (ip == inx) normal[0] = value;
-          if (ip == iny) normal[1] = value;
-          if (ip == inz) normal[2] = value;
-          if (ip == iquality) quality = value;
-          if (ip == ineighbours) neighbours = value;
-          if (ip == ihull) hull = value;
-          continue;
-        }
-        double count = 0.0;
-        if (!reader.Read(property.count_type, &count)) fail();
-        if (count < 0 || count > 1000) {
-          ThrowError(path, element.name + " " + std::to_string(i) + ": bad list length " + std::to_string(count) +
-                               reader.Context());
-        }
-        if (static_cast<int>(p) == ilist) list.clear();
-        for (int k = 0; k < static_cast<int>(count); ++k) {
-          if (!reader.Read(property.type, &value)) fail();
-          if (static_cast<int>(p) == ilist) list.push_back(static_cast<int>(value));
-        }
-      }
-      if (reader.ascii() && reader.LineHasMore()) {
-        ThrowError(path, element.name + " " + std::to_string(i) + " has more values than the header declares" +
-                             reader.Context());
-      }
-      if (is_vertex) {
-        mesh.points.emplace_back(values[0], values[1], values[2]);
-        if (inx >= 0) mesh.normals.emplace_back(normal[0], normal[1], normal[2]);
-        if (iquality >= 0) mesh.fit_rms_m.push_back(static_cast<float>(quality));
-        if (ineighbours >= 0) mesh.fit_neighbours.push_back(static_cast<int>(neighbours));
-        if (ihull >= 0) mesh.hull_distance_m.push_back(static_cast<float>(hull));
-      } else if (is_face) {
-        if (list.size() < 3) {
-          ThrowError(path, "face " + std::to_string(i) + " has " + std::to_string(list.size()) +
-                               " vertices (at least 3 needed)");
-        }
-        polygons.push_back(list);
-      } else if (is_grid) {
-        if (list.size() > 1) {
-          ThrowError(path, "range_grid cell " + std::to_string(i) + " lists " + std::to_string(list.size()) +
-                               " vertices (0 or 1 expected)");
-        }
-        if (!list.empty()) mesh.grid.cell_point[i] = list[0];
-      }
+      ReadInstance(element, layout, i, path, &reader, &values);
+      StoreInstance(layout, i, values, path, &polygons, &mesh);
     }
   }
   if (reader.HasTrailingData()) {
     ThrowError(path, "data after the last element: the header's counts are wrong" + reader.Context());
   }
-  // Indices and coordinates.
-  const int n = static_cast<int>(mesh.points.size());
-  for (size_t i = 0; i < polygons.size(); ++i) {
-    for (int v : polygons[i]) {
-      if (v < 0 || v >= n) {
-        ThrowError(path, "face " + std::to_string(i) + " refers to vertex " + std::to_string(v) + ", but there are " +
-                             std::to_string(n) + " vertices");
-      }
-    }
-    for (size_t k = 1; k + 1 < polygons[i].size(); ++k) {
-      mesh.faces.emplace_back(polygons[i][0], polygons[i][k], polygons[i][k + 1]);
-    }
-  }
-  for (size_t c = 0; c < mesh.grid.cell_point.size(); ++c) {
-    const int v = mesh.grid.cell_point[c];
-    if (v >= n) {
-      ThrowError(path, "range_grid cell " + std::to_string(c) + " refers to vertex " + std::to_string(v) +
-                           ", but there are " + std::to_string(n) + " vertices");
-    }
-  }
-  RequireFinitePoints(mesh, path);
-  for (size_t i = 0; i < mesh.normals.size(); ++i) {
-    if (!mesh.normals[i].allFinite()) ThrowError(path, "vertex " + std::to_string(i) + " has a NaN or infinite normal");
-  }
-  if (mesh.points.empty()) ThrowError(path, "no vertices");
+  FinishMesh(polygons, path, &mesh);
   return mesh;
 }
 

@@ -9,14 +9,8 @@
 namespace ibrdf {
 
 bool RangeGridOptions::Check(std::string* why) const {
-  if (!(max_edge_factor > 1.0)) {
-    *why = "max_edge_factor must be > 1 (a factor of the grid spacing)";
-    return false;
-  }
-  if (!(max_edge_m >= 0.0)) {
-    *why = "max_edge_m must be >= 0 (0: use the factor)";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GT(max_edge_factor, 1.0);  // a factor of the grid spacing
+  IBRDF_CHECK_OPTION_GE(max_edge_m, 0.0);       // 0: use the factor
   return true;
 }
 
@@ -86,7 +80,6 @@ RangeGridReport TessellateRangeGrid(const RangeGridOptions& options, ScanMesh* m
   }
   report.triangles = mesh->faces.size();
   OrientFacesOutward(mesh);
-  report.success = true;
   return report;
 }
 

@@ -22,7 +22,6 @@ struct RangeGridOptions {
 };
 
 struct RangeGridReport {
-  bool success = false;                      // false until tessellation ran
   uint64_t cells = 0;                        // grid cells
   uint64_t points = 0;                       // cells holding a point
   uint64_t triangles = 0;                    // triangles kept

@@ -19,10 +19,10 @@ bool ScanOptions::Check(std::string* why) const {
   return grid.Check(why) && clean.Check(why) && normals.Check(why) && convexity.Check(why);
 }
 
-std::vector<ScanInput> InputsFromConf(const std::string& conf_path, const std::vector<std::string>& files) {
+std::vector<ScanInputSpec> InputsFromConf(const std::string& conf_path, const std::vector<std::string>& files) {
   const std::vector<StanfordConfEntry> entries = ReadStanfordConf(conf_path);
   const std::filesystem::path folder = std::filesystem::path(conf_path).parent_path();
-  std::vector<ScanInput> inputs;
+  std::vector<ScanInputSpec> inputs;
   if (files.empty()) {
     for (const StanfordConfEntry& entry : entries) {
       const std::string path = (folder / entry.name).string();
@@ -43,9 +43,45 @@ std::vector<ScanInput> InputsFromConf(const std::string& conf_path, const std::v
   return inputs;
 }
 
+std::vector<ScanInputSpec> InputsFromSession(const Session& session) {
+  const SampleSpec& sample = session.sample;
+  if (sample.kind != SampleSpec::Kind::kMesh) {
+    ThrowError(session.manifest_path + ": /sample/kind",
+               "the sample is a " + std::string(SampleKindName(sample.kind)) + ", not a scanned mesh");
+  }
+  if (sample.scan_inputs.empty()) {
+    ThrowError(session.manifest_path + ": /sample/scan_inputs", "the session's mesh sample has no scan_inputs");
+  }
+  std::vector<ScanInputSpec> inputs;
+  for (const ScanInputSpec& input : sample.scan_inputs) {
+    inputs.push_back({session.AbsolutePath(input.file), input.world_from_scan});
+  }
+  return inputs;
+}
+
+std::vector<ScanInputSpec> ResolveScanInputs(const ScanSources& sources, std::vector<std::string>* read) {
+  std::vector<ScanInputSpec> inputs;
+  if (!sources.session.empty()) {
+    if (!sources.files.empty() || !sources.conf.empty()) {
+      ThrowError("ibrdf scan", "--session takes neither scan files nor --conf");
+    }
+    const Session session = Session::Load(sources.session);
+    inputs = InputsFromSession(session);
+    read->push_back(session.manifest_path);
+  } else if (!sources.conf.empty()) {
+    inputs = InputsFromConf(sources.conf, sources.files);
+    read->push_back(sources.conf);
+  } else {
+    if (sources.files.empty()) ThrowError("ibrdf scan", "no input files (give scan files, or --conf, or --session)");
+    for (const std::string& path : sources.files) inputs.push_back({path, std::nullopt});
+  }
+  for (const ScanInputSpec& input : inputs) read->push_back(input.file);
+  return inputs;
+}
+
 std::string ScanSidecarPath(const std::string& ply_path) { return ply_path + ".json"; }
 
-ScanResult RunScan(const std::vector<ScanInput>& inputs, const ScanOptions& options) {
+ScanResult RunScan(const std::vector<ScanInputSpec>& inputs, const ScanOptions& options) {
   std::string why;
   if (!options.Check(&why)) ThrowError("scan options", why);
   if (inputs.empty()) ThrowError("scan", "no input files");
@@ -59,10 +95,10 @@ ScanResult RunScan(const std::vector<ScanInput>& inputs, const ScanOptions& opti
   {
     StageLog stage("scan: read and tessellate");
     const Timer timer;
-    for (const ScanInput& input : inputs) {
-      ScanMesh mesh = ReadScanFile(input.path);
+    for (const ScanInputSpec& input : inputs) {
+      ScanMesh mesh = ReadScanFile(input.file);
       ScanInputReport report;
-      report.path = input.path;
+      report.path = input.file;
       report.points = mesh.points.size();
       if (!mesh.grid.Empty()) {
         const RangeGridReport grid = TessellateRangeGrid(options.grid, &mesh);
@@ -76,7 +112,7 @@ ScanResult RunScan(const std::vector<ScanInput>& inputs, const ScanOptions& opti
         report.kind = "points";
       }
       report.faces = mesh.faces.size();
-      Log(1, "   " + input.path + ": " + report.kind + ", " + std::to_string(report.points) + " points, " +
+      Log(1, "   " + input.file + ": " + report.kind + ", " + std::to_string(report.points) + " points, " +
                  std::to_string(report.faces) + " faces" + (report.detail.empty() ? "" : "; " + report.detail));
       if (input.world_from_scan) TransformMesh(*input.world_from_scan, &mesh);
       all_have_normals &= mesh.normals.size() == mesh.points.size();
@@ -90,7 +126,7 @@ ScanResult RunScan(const std::vector<ScanInput>& inputs, const ScanOptions& opti
     summary.step_seconds.emplace_back("read and tessellate", timer.ElapsedSeconds());
   }
   if (!unorganized.points.empty()) {
-    if (!options.reconstruct_points) ThrowError(inputs.front().path, "unorganized points, and reconstruction is off");
+    if (!options.reconstruct_points) ThrowError(inputs.front().file, "unorganized points, and reconstruction is off");
     StageLog stage("scan: reconstruct unorganized points (CGAL advancing front)");
     const Timer timer;
     unorganized.faces = scan_adapters::AdvancingFrontReconstruction(unorganized.points);
@@ -114,7 +150,7 @@ ScanResult RunScan(const std::vector<ScanInput>& inputs, const ScanOptions& opti
     summary.step_seconds.emplace_back("clean", summary.clean.seconds);
   }
   if (merged.faces.empty() || merged.points.size() < 4) {
-    ThrowError(inputs.front().path, "nothing is left of the scan after cleaning (" +
+    ThrowError(inputs.front().file, "nothing is left of the scan after cleaning (" +
                                         std::to_string(merged.points.size()) + " points, no faces)");
   }
   {

@@ -10,6 +10,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "core/rigid3.h"
+#include "core/session.h"
 #include "scan/convexity.h"
 #include "scan/local_plane_normals.h"
 #include "scan/mesh_clean.h"
@@ -30,15 +31,30 @@ struct ScanOptions {
   bool Check(std::string* why) const;
 };
 
-// One input scan: a file and the transform into the common frame (identity when absent).
-struct ScanInput {
-  std::string path;
-  std::optional<Rigid3d> world_from_scan;
-};
+// The inputs of the stage are the session's type, ScanInputSpec (core/session.h): a file and its
+// transform into the common frame (identity when absent). Here `file` is a path as the stage opens it
+// (absolute, or relative to the working folder).
 
 // Inputs listed in a Stanford .conf file: each of `files` must appear in it (by file name); an
 // empty `files` takes every bmesh of the .conf that exists beside it. Throws Error otherwise.
-std::vector<ScanInput> InputsFromConf(const std::string& conf_path, const std::vector<std::string>& files);
+std::vector<ScanInputSpec> InputsFromConf(const std::string& conf_path, const std::vector<std::string>& files);
+
+// The raw scans of a session's mesh sample (/sample/scan_inputs), with absolute paths and their
+// world_from_scan transforms. Throws Error naming the manifest unless the sample is a mesh with scans.
+std::vector<ScanInputSpec> InputsFromSession(const Session& session);
+
+// Where the stage's inputs come from (one of): a session's scan_inputs; a Stanford .conf, with or
+// without `files`; plain `files`.
+struct ScanSources {
+  std::vector<std::string> files;  // scan files
+  std::string conf;                // Stanford .conf file ("": none)
+  std::string session;             // session folder or manifest ("": none)
+};
+
+// The inputs `sources` name (InputsFromSession, InputsFromConf or the files as given); `read` receives
+// every file the stage reads (the scans, the .conf or the manifest), none of which may be an output.
+// Throws Error for no inputs, or a session together with files or a .conf.
+std::vector<ScanInputSpec> ResolveScanInputs(const ScanSources& sources, std::vector<std::string>* read);
 
 struct ScanInputReport {
   std::string path;
@@ -69,7 +85,7 @@ struct ScanResult {
 };
 
 // Runs the stage. Throws Error for unreadable inputs or an empty result.
-ScanResult RunScan(const std::vector<ScanInput>& inputs, const ScanOptions& options);
+ScanResult RunScan(const std::vector<ScanInputSpec>& inputs, const ScanOptions& options);
 
 // Writes the mesh (ply_io.h WritePly) and its JSON sidecar <ply>.json (summary, options, units),
 // both atomically.

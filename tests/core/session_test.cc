@@ -383,6 +383,108 @@ TEST_F(SessionTest, SaveLoadRoundTripOfVariants) {
   ExpectSameFields(table, Session::Load(Path("table.json")));
 }
 
+// A manifest that references every kind of file: photos, a flat field, white-reference photos, and a
+// mesh with raw scans (the mesh itself not written yet, as before the scan stage).
+json ManifestWithEveryFile() {
+  json manifest = ValidManifest();
+  manifest["radiometry"]["flat_field"] = "calibration/flat.exr";
+  manifest["calibration"] = {{"white_reference",
+                              {{"reflectance", {0.9, 0.9, 0.9}},
+                               {"center", {0.0, 0.0, 0.0}},
+                               {"normal", {0.0, 0.0, 1.0}},
+                               {"size", 0.1},
+                               {"photos", {{{"file", "calibration/white.png"}, {"exposure_s", 0.25}}}}}}};
+  const json view1 = {{"file", "scan/view-1.ply"},
+                      {"world_from_scan", {{"rotation", {1.0, 0.0, 0.0, 0.0}}, {"translation", {0.0, 0.0, 0.1}}}}};
+  manifest["sample"] = {{"kind", "mesh"}, {"file", "scan/mesh.ply"}, {"scan_inputs", {"scan/view-0.ply", view1}}};
+  return manifest;
+}
+
+class SessionFilesTest : public SessionTest {
+ protected:
+  void SetUp() override {
+    SessionTest::SetUp();
+    fs::create_directories(Path("calibration"));
+    fs::create_directories(Path("scan"));
+    WriteImage(Path("calibration/flat.exr"), Image(kWidth, kHeight, 3), PixelFormat::kFloat);
+    WriteImage(Path("calibration/white.png"), Image(kWidth, kHeight, 3), PixelFormat::kUint8);
+    std::ofstream(Path("scan/view-0.ply")) << "ply\n";
+    std::ofstream(Path("scan/view-1.ply")) << "ply\n";
+    WriteManifest(ManifestWithEveryFile());
+  }
+  std::string Absolute(const std::string& name) const { return fs::absolute(Path(name)).lexically_normal().string(); }
+};
+
+// InputFiles lists every referenced file, absolute, in manifest order; not the manifest itself.
+TEST_F(SessionFilesTest, InputFilesNamesEveryReferencedFile) {
+  const Session session = Session::Load(ManifestPath());
+  const std::vector<std::string> expected = {Absolute("photos/img0.png"),      Absolute("photos/img1.png"),
+                                             Absolute("calibration/flat.exr"), Absolute("calibration/white.png"),
+                                             Absolute("scan/mesh.ply"),        Absolute("scan/view-0.ply"),
+                                             Absolute("scan/view-1.ply")};
+  EXPECT_EQ(session.InputFiles(), expected);
+
+  // A sphere session: only its photos.
+  WriteManifest(ValidManifest());
+  const std::vector<std::string> photos = {Absolute("photos/img0.png"), Absolute("photos/img1.png")};
+  EXPECT_EQ(Session::Load(ManifestPath()).InputFiles(), photos);
+}
+
+// SaveRebased into another folder: every path field names the same file from there, by field; the
+// rebased manifest loads (its photos and flat field found) and lists the same input files.
+TEST_F(SessionFilesTest, SaveRebasedRewritesEveryPathFieldRelativeToTheNewFolder) {
+  const Session session = Session::Load(ManifestPath());
+  fs::create_directories(Path("runs/one"));
+  const std::string written = session.SaveRebased(Path("runs/one"));
+  EXPECT_EQ(written, Absolute("runs/one/session.json"));
+  const Session rebased = Session::Load(written);
+  EXPECT_EQ(rebased.photos[0].file, "../../photos/img0.png");
+  EXPECT_EQ(rebased.radiometry.flat_field, "../../calibration/flat.exr");
+  EXPECT_EQ(rebased.calibration->white_reference->photos[0].file, "../../calibration/white.png");
+  EXPECT_EQ(rebased.sample.mesh_file, "../../scan/mesh.ply");
+  ASSERT_EQ(rebased.sample.scan_inputs.size(), 2u);
+  EXPECT_EQ(rebased.sample.scan_inputs[1].file, "../../scan/view-1.ply");
+  EXPECT_TRUE(rebased.sample.scan_inputs[1].world_from_scan.has_value());
+  EXPECT_EQ(rebased.InputFiles(), session.InputFiles());
+  // Nothing but path fields changes.
+  json original = session.ToJson(), moved = rebased.ToJson();
+  for (json* j : {&original, &moved}) {
+    for (json& photo : (*j)["photos"]) photo.erase("file");
+    (*j)["radiometry"].erase("flat_field");
+    (*j)["calibration"]["white_reference"]["photos"][0].erase("file");
+    (*j)["sample"].erase("file");
+    for (json& input : (*j)["sample"]["scan_inputs"]) {
+      if (input.is_string())
+        input = "";
+      else
+        input.erase("file");
+    }
+  }
+  EXPECT_EQ(moved, original);
+}
+
+// With PathStyle::kAbsolute every path field is absolute; Rebased alone writes nothing and can be
+// saved under another name (a temporary folder that becomes `dir`).
+TEST_F(SessionFilesTest, RebasedAbsoluteAndSavedElsewhere) {
+  const Session session = Session::Load(ManifestPath());
+  fs::create_directories(Path("out"));
+  session.SaveRebased(Path("out"), Session::PathStyle::kAbsolute);
+  const Session absolute = Session::Load(Path("out/session.json"));
+  EXPECT_EQ(absolute.photos[1].file, Absolute("photos/img1.png"));
+  EXPECT_EQ(absolute.radiometry.flat_field, Absolute("calibration/flat.exr"));
+  EXPECT_EQ(absolute.sample.scan_inputs[0].file, Absolute("scan/view-0.ply"));
+  EXPECT_EQ(absolute.InputFiles(), session.InputFiles());
+
+  const Session rebased = session.Rebased(Path("final"));
+  EXPECT_FALSE(fs::exists(Path("final")));
+  EXPECT_EQ(rebased.directory, Absolute("final"));
+  EXPECT_EQ(rebased.photos[0].file, "../photos/img0.png");
+  fs::create_directories(Path("staging"));
+  rebased.Save(Path("staging/session.json"));
+  fs::rename(Path("staging"), Path("final"));
+  EXPECT_EQ(Session::Load(Path("final")).InputFiles(), session.InputFiles());
+}
+
 TEST(SampleKindName, NamesEveryKind) {
   EXPECT_STREQ(SampleKindName(SampleSpec::Kind::kSphere), "sphere");
   EXPECT_STREQ(SampleKindName(SampleSpec::Kind::kCylinder), "cylinder");

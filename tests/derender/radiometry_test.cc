@@ -37,7 +37,7 @@ SynthOptions Small() {
 
 TruthComparison Measure(const Session& session, const BrdfModel& truth) {
   const DerenderResult result = DerenderAnalytic(session, DerenderOptions());
-  EXPECT_TRUE(result.summary.success);
+  EXPECT_GT(result.summary.accepted, 0u);
   return CompareWithTruth(result.samples, truth);
 }
 

@@ -74,6 +74,47 @@ TEST(ScanCommand, BadInputExitsNonZeroNamingTheFile) {
   }
 }
 
+// `ibrdf scan --session`: the session's scan_inputs (with their transforms) are the inputs; a session
+// whose sample has no scans is one clear error naming the field.
+TEST(ScanCommand, ReadsTheSessionsScanInputs) {
+  ScratchDir dir;
+  SphereMesh(dir);
+  WriteText(dir / "photo.png", "not read");
+  nlohmann::json manifest = {
+      {"format", "ibrdf-session"},
+      {"version", 1},
+      {"camera", {{"model", "PINHOLE"}, {"width", 8}, {"height", 6}, {"params", {10.0, 10.0, 4.0, 3.0}}}},
+      {"light", {{"kind", "point"}, {"position", {0.0, 0.0, 1.0}}, {"intensity", {1.0, 1.0, 1.0}}}},
+      {"sample",
+       {{"kind", "mesh"},
+        {"file", "mesh.ply"},
+        {"scan_inputs",
+         {{{"file", "sphere.ply"},
+           {"world_from_scan", {{"rotation", {1.0, 0.0, 0.0, 0.0}}, {"translation", {0.0, 0.0, 0.5}}}}}}}}},
+      {"photos", {{{"file", "photo.png"}, {"exposure_s", 1.0}}}}};
+  WriteText(dir / "session.json", manifest.dump(2));
+  const RunResult run = RunIbrdf("scan --session " + dir / "session.json" + " --out " + dir / "out.ply", true);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream in(dir / "out.ply.json");
+  const nlohmann::json sidecar = nlohmann::json::parse(in);
+  ASSERT_EQ(sidecar.at("inputs").size(), 1u);
+  EXPECT_EQ(sidecar.at("inputs")[0].at("path"), fs::absolute(dir / "sphere.ply").lexically_normal().string());
+  const ScanMesh out = ReadPly(dir / "out.ply");
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : out.points) centroid += p / double(out.points.size());
+  EXPECT_NEAR(centroid.z(), 0.5, 1e-3);  // the sphere around the origin, moved by world_from_scan
+
+  const RunResult both = RunIbrdf("scan " + dir / "sphere.ply --session " + dir.str() + " --out " + dir / "x.ply");
+  EXPECT_EQ(both.exit_code, 1) << both.output;
+  manifest["sample"] = {{"kind", "sphere"}, {"center", {0.0, 0.0, 0.0}}, {"radius", 0.05}};
+  WriteText(dir / "session.json", manifest.dump(2));
+  const RunResult sphere = RunIbrdf("scan --session " + dir.str() + " --out " + dir / "x.ply");
+  EXPECT_EQ(sphere.exit_code, 1);
+  EXPECT_NE(sphere.output.find("/sample/kind: the sample is a sphere, not a scanned mesh"), std::string::npos)
+      << sphere.output;
+  EXPECT_FALSE(fs::exists(dir / "x.ply"));
+}
+
 TEST(ScanCommand, BunnyWithConf) {
   IBRDF_REQUIRE_BUNNY();
   ScratchDir dir;

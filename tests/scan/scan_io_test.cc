@@ -99,11 +99,11 @@ TEST(ScanIo, BadConfIsAnErrorNamingTheLine) {
 // points whose nearest bun000 point is within 2 mm (the overlap).
 TEST(ScanIo, BunnyScansMergedWithConfAgreeInTheOverlap) {
   IBRDF_REQUIRE_BUNNY();
-  const std::vector<ScanInput> inputs = InputsFromConf(
+  const std::vector<ScanInputSpec> inputs = InputsFromConf(
       testing::BunnyDir() + "/bun.conf", {testing::BunnyDir() + "/bun000.ply", testing::BunnyDir() + "/bun045.ply"});
   ScanMesh scans[2];
   for (int k = 0; k < 2; ++k) {
-    scans[k] = ReadScanFile(inputs[k].path);
+    scans[k] = ReadScanFile(inputs[k].file);
     TessellateRangeGrid(RangeGridOptions(), &scans[k]);
     TransformMesh(*inputs[k].world_from_scan, &scans[k]);
   }

@@ -1,0 +1,191 @@
+#include "align/sphere_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <ceres/ceres.h>
+
+#include "align/cost_functions/sphere_tangent_error.h"
+#include "core/error.h"
+
+namespace ibrdf {
+
+bool SphereFitOptions::Check(std::string* why) const {
+  IBRDF_CHECK_OPTION_GE(silhouette_lines, 8);
+  IBRDF_CHECK_OPTION_GT(first_band_fraction, 0.0);
+  IBRDF_CHECK_OPTION_GT(second_band_px, 0.0);
+  IBRDF_CHECK_OPTION_GT(final_band_px, 0.0);
+  IBRDF_CHECK_OPTION_GT(cauchy_m, 0.0);
+  IBRDF_CHECK_OPTION_GT(outlier_rms_factor, 0.0);
+  IBRDF_CHECK_OPTION_GE(min_points, 4);
+  IBRDF_CHECK_OPTION_GT(tolerance, 0.0);
+  return true;
+}
+
+std::string SphereFit::BriefReport() const {
+  if (!fitted) return "sphere as given: " + reason;
+  char buffer[320];
+  std::snprintf(
+      buffer, sizeof(buffer),
+      "sphere centre (%.5f, %.5f, %.5f) m, radius %.5f m from %d silhouette points (RMS %.3f mm, %d rejected)",
+      center.x(), center.y(), center.z(), radius, silhouette_points, 1e3 * rms_m, rejected_points);
+  return buffer;
+}
+
+std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& camera,
+                                              const Rigid3d& camera_from_world, const Eigen::Vector3d& center,
+                                              double radius, int lines, double band_px) {
+  std::vector<Eigen::Vector2d> points;
+  const Eigen::Vector3d c = camera_from_world * center;
+  if (!(c.z() > radius)) return points;
+  const Eigen::Vector2d center_px = camera.ImageFromCamera(c);
+  const double radius_px = camera.FocalX() * radius / std::sqrt(c.squaredNorm() - radius * radius);
+  const double step = 0.25;
+  for (int k = 0; k < lines; ++k) {
+    const double angle = 2.0 * M_PI * k / lines;
+    const Eigen::Vector2d direction(std::cos(angle), std::sin(angle));
+    // Search the band around the predicted silhouette, with room for the inside and outside levels.
+    const double s0 = radius_px - band_px - 3.0, s1 = radius_px + band_px + 3.0;
+    std::vector<double> profile;
+    for (double s = s0; s <= s1; s += step)
+      profile.push_back(BilinearLuminance(image, center_px.x() + s * direction.x(), center_px.y() + s * direction.y()));
+    if (std::any_of(profile.begin(), profile.end(), [](double v) { return !std::isfinite(v); })) continue;
+    // The sharpest drop over one pixel.
+    const int span = static_cast<int>(1.0 / step);
+    int best = -1;
+    double best_drop = 0.0;
+    for (size_t i = 0; i + span < profile.size(); ++i) {
+      const double drop = profile[i] - profile[i + span];
+      if (drop > best_drop) {
+        best_drop = drop;
+        best = static_cast<int>(i);
+      }
+    }
+    const int guard = static_cast<int>(2.0 / step);
+    if (best < guard || best + span + guard >= static_cast<int>(profile.size())) continue;
+    const double inside = profile[best - guard + span / 2];
+    const double outside = profile[best + span + guard];
+    if (!(inside > 0.03) || !(outside < 0.1 * inside)) continue;
+    // A rise before the edge means something brighter than the limb lies just beyond it (a white card
+    // behind the sphere): the drop found is that thing's edge, not the limb. Skip the line.
+    bool rises = false;
+    for (int i = 0; i + span <= best && !rises; ++i) rises = profile[i + span] - profile[i] > 0.25 * inside;
+    if (rises) continue;
+    // Sub-pixel: the crossing of the mid level between the two ends of the steepest drop (the limb
+    // pixel and the first background pixel); the level further inside may differ from the limb's.
+    const double mid = 0.5 * (profile[best] + profile[best + span]);
+    double edge = -1.0;
+    for (int i = best - guard; i < best + span + guard; ++i) {
+      if (profile[i] >= mid && profile[i + 1] < mid) {
+        edge = s0 + step * (i + (profile[i] - mid) / (profile[i] - profile[i + 1]));
+        break;
+      }
+    }
+    if (edge < 0.0) continue;
+    points.push_back(center_px + edge * direction);
+  }
+  return points;
+}
+
+TangentRay RayThroughPixel(const Camera& camera, const Rigid3d& camera_from_world, const Eigen::Vector2d& p) {
+  const Rigid3d world_from_camera = camera_from_world.Inverse();
+  const Eigen::Vector2d xy = camera.CamPlaneFromImage(p);
+  return {world_from_camera.translation,
+          world_from_camera.rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0).normalized()};
+}
+
+SphereFit FitSphereToTangentRays(const std::vector<TangentRay>& rays, const Eigen::Vector3d& start_center,
+                                 double start_radius, bool reject_outliers, const SphereFitOptions& options) {
+  SphereFit fit;
+  fit.center = start_center;
+  fit.radius = start_radius;
+  if (static_cast<int>(rays.size()) < options.min_points) {
+    fit.reason =
+        "only " + std::to_string(rays.size()) + " silhouette points (need " + std::to_string(options.min_points) + ")";
+    return fit;
+  }
+  double center[3] = {start_center.x(), start_center.y(), start_center.z()};
+  double radius = start_radius;
+  std::vector<bool> keep(rays.size(), true);
+  for (int pass = 0; pass < (reject_outliers ? 2 : 1); ++pass) {
+    ceres::Problem problem;
+    for (size_t k = 0; k < rays.size(); ++k) {
+      if (!keep[k]) continue;
+      problem.AddResidualBlock(SphereTangentError::Create(rays[k].origin, rays[k].direction),
+                               new ceres::CauchyLoss(options.cauchy_m), center, &radius);
+    }
+    problem.SetParameterLowerBound(&radius, 0, 1e-6);
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = ceres::DENSE_QR;
+    solver_options.max_num_iterations = 100;
+    solver_options.function_tolerance = options.tolerance;
+    solver_options.parameter_tolerance = options.tolerance;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem, &summary);
+    std::vector<double> residuals(rays.size());
+    double squared = 0.0;
+    int count = 0;
+    for (size_t k = 0; k < rays.size(); ++k) {
+      SphereTangentError(rays[k].origin, rays[k].direction)(center, &radius, &residuals[k]);
+      if (keep[k]) {
+        squared += residuals[k] * residuals[k];
+        ++count;
+      }
+    }
+    fit.rms_m = std::sqrt(squared / std::max(count, 1));
+    fit.silhouette_points = count;
+    fit.rejected_points = static_cast<int>(rays.size()) - count;
+    if (pass == 0 && reject_outliers) {
+      for (size_t k = 0; k < rays.size(); ++k) {
+        keep[k] = std::abs(residuals[k]) <= options.outlier_rms_factor * fit.rms_m;
+      }
+    }
+  }
+  fit.center = Eigen::Vector3d(center[0], center[1], center[2]);
+  fit.radius = radius;
+  fit.fitted = fit.silhouette_points >= options.min_points;
+  if (!fit.fitted) {
+    fit.reason = "only " + std::to_string(fit.silhouette_points) + " silhouette points left after rejecting " +
+                 std::to_string(fit.rejected_points) + " outliers (need " + std::to_string(options.min_points) + ")";
+  }
+  return fit;
+}
+
+SphereFit FitSphereToSilhouettes(const Camera& camera, const std::vector<SilhouettePhoto>& photos,
+                                 const Eigen::Vector3d& center, double radius, const SphereFitOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("sphere fit options", why);
+  SphereFit fit;
+  fit.center = center;
+  fit.radius = radius;
+  fit.reason = "no round ran";
+  const double bands_px[] = {options.first_band_fraction, options.second_band_px, options.final_band_px};
+  for (int round = 0; round < 3; ++round) {
+    std::vector<TangentRay> rays;
+    for (const SilhouettePhoto& photo : photos) {
+      IBRDF_CHECK(photo.image != nullptr);
+      const Rigid3d& pose = photo.camera_from_world;
+      const Eigen::Vector3d c = pose * fit.center;
+      const double radius_px =
+          camera.FocalX() * fit.radius / std::sqrt(std::max(c.squaredNorm() - fit.radius * fit.radius, 1e-12));
+      const double band = round == 0 ? bands_px[0] * radius_px : bands_px[round];
+      for (const Eigen::Vector2d& p :
+           SilhouettePoints(*photo.image, camera, pose, fit.center, fit.radius, options.silhouette_lines, band)) {
+        rays.push_back(RayThroughPixel(camera, pose, p));
+      }
+    }
+    if (static_cast<int>(rays.size()) < options.min_points) {
+      // The estimate of the rounds before stands (none: not fitted).
+      if (round == 0) {
+        fit.reason = "only " + std::to_string(rays.size()) + " silhouette points found in " +
+                     std::to_string(photos.size()) + " photos (need " + std::to_string(options.min_points) + ")";
+      }
+      break;
+    }
+    fit = FitSphereToTangentRays(rays, fit.center, fit.radius, round == 2, options);
+  }
+  return fit;
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,80 @@
+// A sphere sample's centre and radius from its silhouettes (the paper's section 3.2: the sample's pose
+// from the photos). Rays through sub-pixel limb points are tangent to the sphere. Three rounds, each
+// extracting limb points in a band around the current estimate's silhouette (wide, then narrow) and
+// fitting with a Cauchy loss, so edges of other things (a card behind the limb) do not pull the fit;
+// the last round drops points beyond a multiple of the RMS and refits.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/camera.h"
+#include "core/image_io.h"
+#include "core/rigid3.h"
+
+namespace ibrdf {
+
+// Options of FitSphereToSilhouettes and FitSphereToTangentRays (the defaults are the align stage's).
+struct SphereFitOptions {
+  int silhouette_lines = 360;         // radial search lines per photo
+  double first_band_fraction = 0.15;  // round 1: limb points searched within this fraction of the radius
+  double second_band_px = 3.0;        // round 2: within this many pixels of the silhouette
+  double final_band_px = 1.5;         // round 3 (with outlier rejection): within this many pixels
+  double cauchy_m = 2e-4;             // robust loss scale on ray-to-sphere distances, metres
+  double outlier_rms_factor = 3.0;    // the last round drops rays farther than this x RMS and refits
+  int min_points = 8;                 // fewer tangent rays: no fit (the sphere stays as given)
+  double tolerance = 1e-15;           // Ceres function and parameter tolerance
+  bool Check(std::string* why) const;
+};
+
+// A ray tangent to the sphere: through a camera centre and a silhouette point. World frame.
+struct TangentRay {
+  Eigen::Vector3d origin;     // the camera centre
+  Eigen::Vector3d direction;  // unit
+};
+
+// One photo of the sphere: a linear image (core/linear_image.h) and its pose. The image is not owned.
+struct SilhouettePhoto {
+  const Image* image = nullptr;
+  Rigid3d camera_from_world;
+};
+
+// What the sphere fit found; reads as not fitted until it ran.
+struct SphereFit {
+  bool fitted = false;
+  std::string reason;  // why not fitted
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+  int silhouette_points = 0;  // tangent rays used
+  int rejected_points = 0;    // outliers removed after the first solve
+  double rms_m = 0.0;         // RMS of ray-to-sphere distances, metres
+  // "sphere centre (0.00001, 0.00002, 0.05000) m, radius 0.05000 m from 1234 silhouette points (RMS ...)"
+  std::string BriefReport() const;
+};
+
+// Silhouette edge points of a sphere (centre `center`, radius `radius`, world frame) in one photo:
+// along `lines` radial lines from the sphere's projected centre, within `band_px` of its predicted
+// silhouette, the sharpest drop from a lit limb to the dark background, located at sub-pixel precision
+// where the profile crosses the mid level. Edges against anything bright (the platform) or on the unlit
+// side (no contrast) are skipped. Pixels, COLMAP convention.
+std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& camera,
+                                              const Rigid3d& camera_from_world, const Eigen::Vector3d& center,
+                                              double radius, int lines, double band_px);
+
+// The ray through pixel `p` of a camera at `camera_from_world`.
+TangentRay RayThroughPixel(const Camera& camera, const Rigid3d& camera_from_world, const Eigen::Vector2d& p);
+
+// One round of the fit: the sphere tangent to `rays` (Cauchy loss), from the start `center`, `radius`.
+// With `reject_outliers`, rays beyond options.outlier_rms_factor x RMS are then dropped and the fit
+// repeated. Fewer than options.min_points rays: not fitted (the start is returned, with the reason).
+SphereFit FitSphereToTangentRays(const std::vector<TangentRay>& rays, const Eigen::Vector3d& center, double radius,
+                                 bool reject_outliers, const SphereFitOptions& options);
+
+// The whole fit: three rounds of SilhouettePoints in `photos` and FitSphereToTangentRays, from the
+// start `center`, `radius` (the session's). Throws Error for bad options.
+SphereFit FitSphereToSilhouettes(const Camera& camera, const std::vector<SilhouettePhoto>& photos,
+                                 const Eigen::Vector3d& center, double radius, const SphereFitOptions& options);
+
+}  // namespace ibrdf

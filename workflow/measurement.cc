@@ -1,0 +1,266 @@
+#include "workflow/measurement.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/file_util.h"
+#include "core/session.h"
+#include "workflow/stamp.h"
+
+namespace fs = std::filesystem;
+
+namespace ibrdf {
+namespace {
+
+std::string Absolute(const std::string& path) { return fs::absolute(path).lexically_normal().string(); }
+
+// A stage that applies, without an action yet (Planner::Execute gives it the launcher's).
+Stage MakeStage(std::string name, std::vector<std::string> arguments, std::vector<std::string> inputs,
+                std::vector<std::string> outputs) {
+  Stage stage;
+  stage.name = std::move(name);
+  stage.arguments = std::move(arguments);
+  stage.inputs = std::move(inputs);
+  stage.outputs = std::move(outputs);
+  return stage;
+}
+
+// The plan's state as the stages run: each reads the session the previous one wrote.
+class Planner {
+ public:
+  Planner(const MeasurementOptions& options, const StageLauncher& launch, WorkflowRun* run)
+      : options_(options), launch_(launch), run_(run) {}
+
+  std::string At(const std::string& name) const { return run_->Path(name); }
+
+  // Executes `stage`; one without an action runs its arguments through the launcher.
+  void Execute(Stage stage) {
+    if (!stage.action) {
+      stage.action = [launch = launch_, name = stage.name, arguments = stage.arguments] {
+        return launch(name, arguments);
+      };
+    }
+    run_->Execute(std::move(stage));
+  }
+
+  // The session at `path`; absent only when the stage that writes it was left out by --stop-after.
+  std::optional<Session> SessionAt(const std::string& path) const {
+    if (run_->stopped() && !fs::exists(path)) return std::nullopt;
+    return Session::Load(path);
+  }
+
+  void Synth(const Recipe& recipe);
+  void Scan();
+  void Align();
+  void Derender();
+  void SampleStages();  // check, compare, reconstruct, report
+
+  std::string manifest_path;  // the input session (synth's for a recipe)
+  std::string current;        // the manifest the next stage reads
+  std::string truth_path;     // truth.json beside the input session, if any
+
+ private:
+  const MeasurementOptions& options_;
+  StageLauncher launch_;
+  WorkflowRun* run_;
+};
+
+void Planner::Synth(const Recipe& recipe) {
+  Stage synth = MakeStage("synth", {"synth", "--material", recipe.material}, {recipe.path, recipe.material},
+                          {At("synth/session.json"), At("synth/truth.json")});
+  synth.arguments.insert(synth.arguments.end(), recipe.synth_args.begin(), recipe.synth_args.end());
+  synth.arguments.insert(synth.arguments.end(), {"--out", At("synth"), "--overwrite"});
+  Execute(synth);
+  manifest_path = At("synth/session.json");
+}
+
+// A mesh sample with raw scans: `ibrdf scan --session` merges them into DIR/scan/mesh.ply, and
+// DIR/scan/session.json is the session with that mesh (every path absolute, no scan_inputs).
+void Planner::Scan() {
+  const std::optional<Session> session = SessionAt(manifest_path);
+  Stage scan =
+      MakeStage("scan", {}, {manifest_path}, {At("scan/mesh.ply"), At("scan/mesh.ply.json"), At("scan/session.json")});
+  if (!session || session->sample.kind != SampleSpec::Kind::kMesh) {
+    scan.not_applicable = "the sample is analytic, not a scanned mesh";
+  } else if (session->sample.scan_inputs.empty()) {
+    scan.not_applicable = "the session's mesh sample has no scan_inputs";
+  } else {
+    for (const ScanInputSpec& input : session->sample.scan_inputs) {
+      scan.inputs.push_back(session->AbsolutePath(input.file));
+    }
+    fs::create_directories(At("scan"));
+    scan.arguments = {"scan", "--session", manifest_path, "--out", At("scan/mesh.ply"), "--overwrite"};
+    Session merged = *session;
+    merged.sample.mesh_file = At("scan/mesh.ply");
+    merged.sample.scan_inputs.clear();
+    scan.action = [launch = launch_, arguments = scan.arguments, merged, folder = At("scan")] {
+      const int code = launch("scan", arguments);
+      if (code == 0) merged.SaveRebased(folder, Session::PathStyle::kAbsolute);
+      return code;
+    };
+  }
+  const bool applies = scan.not_applicable.empty();
+  Execute(scan);
+  if (applies) current = At("scan/session.json");
+}
+
+// Sessions with coded targets; otherwise every photo needs its pose.
+void Planner::Align() {
+  const std::optional<Session> session = SessionAt(current);
+  Stage align = MakeStage("align", {"align", current, "--out", At("align"), "--overwrite"}, {current},
+                          {At("align/session.json"), At("align/alignment.json")});
+  if (session) {
+    for (const std::string& file : session->InputFiles()) align.inputs.push_back(file);
+  }
+  if (!session || !session->targets) {
+    align.not_applicable = "the session has no targets; its photos' poses are used as given";
+    for (size_t i = 0; session && i < session->photos.size(); ++i) {
+      if (!session->photos[i].camera_from_world) {
+        ThrowError(current + ": /photos/" + std::to_string(i) + "/camera_from_world",
+                   "missing, and the session has no targets block from which `ibrdf align` could find it");
+      }
+    }
+  }
+  const bool applies = align.not_applicable.empty();
+  Execute(align);
+  if (applies) current = At("align/session.json");
+}
+
+void Planner::Derender() {
+  const std::optional<Session> session = SessionAt(current);
+  Stage derender = MakeStage("derender", {"derender", current, "--out", At("samples.npy"), "--overwrite"}, {current},
+                             {At("samples.npy"), At("samples.npy.json")});
+  if (options_.pixel_stride != 1) {
+    derender.arguments.push_back("--stride");
+    derender.arguments.push_back(std::to_string(options_.pixel_stride));
+  }
+  if (session) {
+    for (const std::string& file : session->InputFiles()) derender.inputs.push_back(file);
+  }
+  Execute(derender);
+}
+
+void Planner::SampleStages() {
+  const std::vector<std::string> samples_in = {At("samples.npy"), At("samples.npy.json")};
+  Stage check = MakeStage("check", {"check", At("samples.npy"), "--out", At("consistency.json"), "--overwrite"},
+                          samples_in, {At("consistency.json")});
+  if (options_.check_regression) check.arguments.push_back("--regression");
+  Execute(check);
+
+  Stage compare = MakeStage("compare", {}, samples_in, {At("truth-comparison.json")});
+  if (truth_path.empty()) {
+    compare.not_applicable = "no truth.json beside the session (not synthetic)";
+  } else {
+    compare.arguments = {"compare", At("samples.npy"),           "--truth",    truth_path,
+                         "--out",   At("truth-comparison.json"), "--overwrite"};
+    compare.inputs.push_back(truth_path);
+  }
+  Execute(compare);
+
+  Stage reconstruct =
+      MakeStage("reconstruct", {"reconstruct", At("samples.npy"), "--out", At("reconstruction"), "--overwrite"},
+                samples_in, {At("reconstruction/summary.json"), At("reconstruction/brdf.binary")});
+  if (!truth_path.empty()) {
+    reconstruct.arguments.insert(reconstruct.arguments.end(), {"--truth", truth_path});
+    reconstruct.inputs.push_back(truth_path);
+  }
+  auto pass = [&](const char* flag, double value, double unset) {
+    if (value == unset) return;
+    std::ostringstream text;
+    text << value;
+    reconstruct.arguments.insert(reconstruct.arguments.end(), {flag, text.str()});
+  };
+  pass("--degree", options_.degree, -1);
+  pass("--radius-h-deg", options_.radius_h_deg, -1.0);
+  pass("--radius-d-deg", options_.radius_d_deg, -1.0);
+  if (!options_.fits) reconstruct.arguments.push_back("--no-fits");
+  Execute(reconstruct);
+
+  Stage report = MakeStage("report", {"report", run_->run_dir(), "--out", At("report"), "--overwrite"}, {},
+                           {At("report/index.html")});
+  if (!options_.report) {
+    report.not_applicable = "--no-report";
+  } else {
+    report.inputs = {At("samples.npy"), At("samples.npy.json"), At("consistency.json"),
+                     At("reconstruction/summary.json"), At("reconstruction/brdf.binary")};
+    if (!truth_path.empty()) report.inputs.push_back(At("truth-comparison.json"));
+    for (const Stage& stage : run_->stages()) {
+      if (run_->outcome(stage.name).status != StageStatus::kNotApplicable) {
+        report.inputs.push_back(StampPath(run_->run_dir(), stage.name));
+      }
+    }
+  }
+  Execute(report);
+}
+
+}  // namespace
+
+const std::vector<std::string>& MeasurementStageNames() {
+  static const std::vector<std::string> kStages = {"synth", "scan",    "align",       "derender",
+                                                   "check", "compare", "reconstruct", "report"};
+  return kStages;
+}
+
+bool MeasurementOptions::Check(std::string* why) const {
+  if (pixel_stride < 1) {
+    *why = "--stride must be at least 1";
+    return false;
+  }
+  if (degree != -1 && (degree < 0 || degree > 2)) {
+    *why = "--degree must be 0, 1 or 2";
+    return false;
+  }
+  if ((radius_h_deg != -1.0 && !(radius_h_deg > 0.0)) || (radius_d_deg != -1.0 && !(radius_d_deg > 0.0))) {
+    *why = "kernel radii must be positive";
+    return false;
+  }
+  const std::vector<std::string>& stages = MeasurementStageNames();
+  if (!stop_after.empty() && std::find(stages.begin(), stages.end(), stop_after) == stages.end()) {
+    *why = "--stop-after: unknown stage \"" + stop_after +
+           "\" (synth, scan, align, derender, check, compare, reconstruct, report)";
+    return false;
+  }
+  return true;
+}
+
+MeasurementInput OpenMeasurementInput(const std::string& input, const std::string& out) {
+  if (!fs::exists(input)) {
+    ThrowError(input, "does not exist (expected a session folder, session.json or a recipe folder)");
+  }
+  MeasurementInput result;
+  if (fs::is_directory(input) && fs::exists(fs::path(input) / "recipe.json")) {
+    result.recipe = ReadRecipe((fs::path(input) / "recipe.json").string());
+  } else if (fs::path(input).filename() == "recipe.json") {
+    result.recipe = ReadRecipe(input);
+  } else {
+    const std::string manifest = fs::is_directory(input) ? (fs::path(input) / "session.json").string() : input;
+    if (!fs::exists(manifest)) ThrowError(input, "holds neither session.json nor recipe.json");
+    result.manifest_path = Absolute(manifest);
+    Session::Load(result.manifest_path);
+  }
+  const std::string run_dir = Absolute(out);
+  if (!result.manifest_path.empty() && SameFile(run_dir, fs::path(result.manifest_path).parent_path().string())) {
+    ThrowError(out, "is the session's folder; the run writes into a folder of its own");
+  }
+  if (fs::exists(run_dir) && !fs::is_directory(run_dir)) ThrowError(out, "exists and is not a folder");
+  return result;
+}
+
+std::string RunMeasurement(const MeasurementInput& input, const MeasurementOptions& options,
+                           const StageLauncher& launch, WorkflowRun* run) {
+  Planner plan(options, launch, run);
+  plan.manifest_path = input.manifest_path;
+  if (input.recipe) plan.Synth(*input.recipe);
+  const fs::path session_dir = fs::path(plan.manifest_path).parent_path();
+  if (fs::exists(session_dir / "truth.json")) plan.truth_path = (session_dir / "truth.json").string();
+  plan.current = plan.manifest_path;
+  plan.Scan();
+  plan.Align();
+  plan.Derender();
+  plan.SampleStages();
+  return plan.truth_path;
+}
+
+}  // namespace ibrdf

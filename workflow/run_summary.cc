@@ -1,0 +1,146 @@
+#include "workflow/run_summary.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "workflow/stage_json.h"
+
+namespace fs = std::filesystem;
+
+namespace ibrdf {
+namespace {
+
+// samples.npy.json: derender's counts.
+void AddSamples(const fs::path& dir, nlohmann::json* summary) {
+  const std::optional<StageJson> side = StageJson::ReadIfExists((dir / "samples.npy.json").string());
+  if (!side) return;
+  side->Object("/counts");
+  (*summary)["session"] = side->String("/session", "");
+  (*summary)["session_name"] = side->String("/session_name", "");
+  (*summary)["samples"] = {{"file", (dir / "samples.npy").string()},
+                           {"photos", side->Count("/counts/photos", 0)},
+                           {"pixels_examined", side->Count("/counts/pixels_examined", 0)},
+                           {"accepted", side->Count("/counts/accepted", 0)},
+                           {"rejected", side->ObjectOr("/counts/rejected", nlohmann::json::object())}};
+}
+
+// consistency.json: `ibrdf check`'s figures (null where a figure is not valid).
+void AddConsistency(const fs::path& dir, nlohmann::json* summary) {
+  const std::optional<StageJson> c = StageJson::ReadIfExists((dir / "consistency.json").string());
+  if (!c) return;
+  nlohmann::json out;
+  for (const std::string figure : {"reciprocity", "isotropy"}) {
+    const std::string at = "/" + figure;
+    if (!c->Has(at)) continue;
+    out[figure] = c->Boolean(at + "/valid", false) ? c->Figure(at + "/overall_rel_error") : nlohmann::json();
+    out[figure + "_per_channel"] = c->FigureOr(at + "/per_channel_rel_error", nlohmann::json());
+    out[figure + "_bins_compared"] = c->Count(at + "/bins_compared", 0);
+  }
+  if (c->Has("/regression")) out["regression"] = c->Value("/regression");
+  (*summary)["consistency"] = out;
+}
+
+// reconstruction/summary.json: the table's and the fits' figures as reconstruct wrote them.
+void AddReconstruction(const fs::path& dir, nlohmann::json* summary) {
+  const std::optional<StageJson> r = StageJson::ReadIfExists((dir / "reconstruction" / "summary.json").string());
+  if (!r) return;
+  (*summary)["reconstruction"] = {{"folder", (dir / "reconstruction").string()},
+                                  {"merl", (dir / "reconstruction" / "brdf.binary").string()},
+                                  {"table", r->ValueOr("/table", nlohmann::json())},
+                                  {"fits", r->ValueOr("/fits", nlohmann::json())}};
+}
+
+// truth-comparison.json and the reconstruction's error against the truth (synthetic sessions).
+void AddTruth(const fs::path& dir, const std::string& truth_path, nlohmann::json* summary) {
+  if (truth_path.empty()) return;
+  nlohmann::json truth = {{"file", truth_path}};
+  if (const std::optional<StageJson> t = StageJson::ReadIfExists((dir / "truth-comparison.json").string())) {
+    truth["samples_median_rel_error"] = t->Figure("/overall/median_rel_error");
+    truth["samples_p95_rel_error"] = t->Figure("/overall/p95_rel_error");
+    truth["samples_mean_signed_rel_error"] = t->Figure("/overall/mean_signed_rel_error");
+    truth["samples_compared"] = t->Count("/overall/count");
+  }
+  const std::optional<StageJson> r = StageJson::ReadIfExists((dir / "reconstruction" / "summary.json").string());
+  if (r && r->Has("/error_against_truth")) {
+    truth["brdf_rel_rmse"] = r->Figure("/error_against_truth/rel_rms_error");
+    truth["brdf_rel_rmse_all"] = r->Figure("/error_against_truth/rel_rms_error_all");
+    truth["brdf_cells_scored"] = r->Count("/error_against_truth/cells_scored");
+    truth["brdf_coverage"] = r->Figure("/error_against_truth/coverage");
+  }
+  (*summary)["truth"] = truth;
+}
+
+// "1.23 %", or "n/a" for a null (NaN) or absent figure.
+std::string Percent(const nlohmann::json& value) {
+  if (!value.is_number()) return "n/a";
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.2f %%", 100.0 * value.get<double>());
+  return buffer;
+}
+
+// "1.00 %, 2.00 %, 3.00 %" per channel, or "n/a" when not an array.
+std::string PercentPerChannel(const nlohmann::json& value) {
+  if (!value.is_array()) return "n/a";
+  std::string text;
+  for (const nlohmann::json& x : value) text += (text.empty() ? "" : ", ") + Percent(x);
+  return text;
+}
+
+}  // namespace
+
+nlohmann::json BuildRunSummary(const WorkflowRun& run, const std::string& input, const std::string& truth_path,
+                               double wall_s) {
+  const fs::path dir(run.run_dir());
+  nlohmann::json summary = {{"format", "ibrdf-run"}, {"version", 1}, {"input", input}, {"run_dir", run.run_dir()}};
+  nlohmann::json stages = nlohmann::json::object(), timings = nlohmann::json::object();
+  double stage_sum = 0.0;
+  for (const Stage& stage : run.stages()) {
+    const StageOutcome& outcome = run.outcome(stage.name);
+    stages[stage.name] = {{"status", StageStatusName(outcome.status)}, {"reason", outcome.reason}};
+    if (outcome.status != StageStatus::kNotApplicable) {
+      timings[stage.name] = outcome.seconds;
+      stage_sum += outcome.seconds;
+    }
+  }
+  timings["stages_total"] = stage_sum;
+  timings["this_invocation"] = wall_s;
+  summary["stages"] = stages;
+  summary["timings_s"] = timings;
+  AddSamples(dir, &summary);
+  AddConsistency(dir, &summary);
+  AddReconstruction(dir, &summary);
+  AddTruth(dir, truth_path, &summary);
+  const std::string report = (dir / "report" / "index.html").string();
+  if (fs::exists(report)) summary["report"] = report;
+  return summary;
+}
+
+std::vector<std::string> RunHeadline(const nlohmann::json& summary_json) {
+  const StageJson summary(summary_json, "summary.json");
+  std::vector<std::string> lines;
+  if (summary.Has("/samples")) {
+    std::string rejected;
+    for (const auto& [reason, count] : summary.Object("/samples/rejected").items()) {
+      const uint64_t n = summary.Count("/samples/rejected/" + reason);
+      if (n > 0) rejected += (rejected.empty() ? "" : ", ") + reason + " " + std::to_string(n);
+    }
+    lines.push_back("samples: " + std::to_string(summary.Count("/samples/accepted")) +
+                    " accepted; rejected: " + (rejected.empty() ? "none" : rejected));
+  }
+  if (summary.Has("/consistency")) {
+    lines.push_back("consistency: reciprocity " + Percent(summary.ValueOr("/consistency/reciprocity", nullptr)) +
+                    ", bilateral symmetry " + Percent(summary.ValueOr("/consistency/isotropy", nullptr)));
+  }
+  if (summary.Has("/truth")) {
+    lines.push_back("against the truth: samples' median relative error (R, G, B) " +
+                    PercentPerChannel(summary.ValueOr("/truth/samples_median_rel_error", nullptr)) +
+                    "; reconstruction relative RMS " +
+                    PercentPerChannel(summary.ValueOr("/truth/brdf_rel_rmse", nullptr)));
+  }
+  return lines;
+}
+
+}  // namespace ibrdf

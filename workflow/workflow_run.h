@@ -1,0 +1,58 @@
+// The engine of `ibrdf run`: stages executed one by one into a run folder, each skipped when its stamp
+// says it is up to date (stamp.h), re-run otherwise with the reason printed, and stamped once its
+// action succeeds. Stages are planned one at a time because a later stage's plan depends on the files
+// earlier ones wrote (measurement.h). Decisions: docs/workflow.md.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "workflow/stage.h"
+
+namespace ibrdf {
+
+struct WorkflowOptions {
+  std::string run_dir;     // the run folder (created, with stamps/); made absolute
+  std::string build_id;    // the binary whose stages run (ExecutableBuildId()); a different one re-runs them
+  std::string version;     // recorded in stamps for the reader, e.g. "ibrdf 0.1.0"
+  bool force = false;      // re-run every stage that applies, up to date or not
+  std::string stop_after;  // the last stage to run ("": all); later ones are not applicable
+
+  bool Check(std::string* why) const;
+};
+
+class WorkflowRun {
+ public:
+  // Creates the run folder and DIR/stamps, and removes the temporaries an interrupted stage left
+  // (temporaries.h). Throws Error for invalid options.
+  explicit WorkflowRun(WorkflowOptions options);
+
+  // Runs `stage` unless it does not apply, comes after stop_after, or is up to date; logs a line per
+  // stage ("== run 4: derender (an input changed)") and records the outcome. The old stamp is removed
+  // before the action runs and the new one written only after it succeeds, so an interrupted stage
+  // runs again. Throws Error when the action fails ("stage NAME failed (exit N) ...").
+  const StageOutcome& Execute(Stage stage);
+
+  // True once the stop_after stage has been executed: the stages after it do not run.
+  bool stopped() const { return !stopped_.empty(); }
+  // The stages executed so far, in order.
+  const std::vector<Stage>& stages() const { return stages_; }
+  // The outcome of an executed stage (an InternalError for an unknown one).
+  const StageOutcome& outcome(const std::string& stage) const;
+  const WorkflowOptions& options() const { return options_; }
+  // The absolute run folder, and `name` inside it.
+  const std::string& run_dir() const { return options_.run_dir; }
+  std::string Path(const std::string& name) const;
+
+ private:
+  WorkflowOptions options_;
+  std::string stopped_;  // why later stages do not run ("--stop-after NAME"), once they do not
+  std::vector<Stage> stages_;
+  std::map<std::string, StageOutcome> outcomes_;
+};
+
+// "1.52 s".
+std::string FormatSeconds(double seconds);
+
+}  // namespace ibrdf
