@@ -76,10 +76,10 @@ Similarity3d Similarity3d::Estimate(const Eigen::Matrix3Xd& source, const Eigen:
 }
 
 bool ColmapAlignmentOptions::Check(std::string* why) const {
-  if (min_images < 3 || !(max_center_error_m > 0.0) || !(max_rotation_error_deg > 0.0) || max_triples < 1) {
-    *why = "min_images >= 3, max_center_error_m > 0, max_rotation_error_deg > 0, max_triples >= 1";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(min_images, 3);
+  IBRDF_CHECK_OPTION_GT(max_center_error_m, 0.0);
+  IBRDF_CHECK_OPTION_GT(max_rotation_error_deg, 0.0);
+  IBRDF_CHECK_OPTION_GE(max_triples, 1);
   return true;
 }
 

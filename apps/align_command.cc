@@ -66,12 +66,12 @@ void AddAlignCommand(CLI::App& app) {
   command->callback([args] {
     StageLog stage("align");
     const Session session = Session::Load(args->session);
-    AlignStageOptions& o = args->o;
-    o.align.fit_sphere = !args->no_sphere;
-    o.align.fit_light = !args->no_light;
-    o.align.fit_cylinder = !args->no_cylinder;
-    o.colmap_runner.fix_intrinsics = !args->colmap_refine_intrinsics;
-    AlignSessionToFolder(session, o, args->out);
+    AlignStageOptions& options = args->o;
+    options.align.fit_sphere = !args->no_sphere;
+    options.align.fit_light = !args->no_light;
+    options.align.fit_cylinder = !args->no_cylinder;
+    options.colmap_runner.fix_intrinsics = !args->colmap_refine_intrinsics;
+    AlignSessionToFolder(session, options, args->out);
     Log(1, "aligned session written to " + args->out + "/session.json");
   });
 }

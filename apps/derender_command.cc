@@ -33,7 +33,7 @@ void AddDerenderCommand(CLI::App& app) {
                    "Mesh samples: shadow rays auto (where the scan's convexity report asks for them), on or "
                    "off; overrides the session's sample.visibility")
       ->check(CLI::IsMember({"auto", "on", "off"}))
-      ->each([args](const std::string& name) { VisibilityFromName(name, &o.visibility.emplace()); });
+      ->each([args](const std::string& name) { VisibilityFromName(name, &args->options.visibility.emplace()); });
   command->add_flag("!--no-mixed-pixel-mask", o.mask_mixed_pixels,
                     "Mesh samples: keep pixels that straddle the silhouette (corner rays miss or jump in depth)");
   command

@@ -69,23 +69,23 @@ void AddReconstructCommand(CLI::App& app) {
   command->add_flag("--overwrite", o.overwrite, "Replace an existing output folder");
   command->callback([args] {
     StageLog stage("reconstruct");
-    ReconstructOptions& o = args->o;
-    RequireWritableOutput(args->out, o.overwrite, {args->samples});
-    if (args->no_fold) o.regression.fold_reciprocity = o.regression.fold_bilateral = false;
-    if (args->linear_values) o.regression.log_space = false;
-    o.fits = !args->no_fits;
+    ReconstructOptions& options = args->o;
+    RequireWritableOutput(args->out, options.overwrite, {args->samples});
+    if (args->no_fold) options.regression.fold_reciprocity = options.regression.fold_bilateral = false;
+    if (args->linear_values) options.regression.log_space = false;
+    options.fits = !args->no_fits;
     // The option groups checked here too, so that a message names the flags.
     std::string why;
-    if (!o.regression.Check(&why)) ThrowError("--degree/--radius", why);
-    o.select_bandwidth = args->bandwidth != "given";
-    if (o.select_bandwidth && !ParseBandwidthCriterion(args->bandwidth, &o.selection.criterion)) {
+    if (!options.regression.Check(&why)) ThrowError("--degree/--radius", why);
+    options.select_bandwidth = args->bandwidth != "given";
+    if (options.select_bandwidth && !ParseBandwidthCriterion(args->bandwidth, &options.selection.criterion)) {
       ThrowError("--bandwidth", "expected 'given', 'loo' or 'gcv', got '" + args->bandwidth + "'");
     }
-    if (!o.selection.Check(&why)) ThrowError("--bandwidth-scales/--bandwidth-samples", why);
-    if (!o.tabulate.Check(&why)) ThrowError("--max-theta-deg", why);
-    if (!o.fit.Check(&why)) ThrowError("--lobes/--fit-samples", why);
-    if (o.eval_only && o.eval_file.empty()) ThrowError("--eval-only", "needs --eval POINTS.npy");
-    ReconstructFile(args->samples, o, args->out);
+    if (!options.selection.Check(&why)) ThrowError("--bandwidth-scales/--bandwidth-samples", why);
+    if (!options.tabulate.Check(&why)) ThrowError("--max-theta-deg", why);
+    if (!options.fit.Check(&why)) ThrowError("--lobes/--fit-samples", why);
+    if (options.eval_only && options.eval_file.empty()) ThrowError("--eval-only", "needs --eval POINTS.npy");
+    ReconstructFile(args->samples, options, args->out);
   });
 }
 

@@ -20,7 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 using testing::ScratchDir;
 
-std::string Run(const std::string& command, int* exit_code) {
+std::string RunCommand(const std::string& command, int* exit_code) {
   std::string output;
   FILE* pipe = popen((command + " 2>&1").c_str(), "r");
   if (!pipe) return output;
@@ -36,7 +36,7 @@ TEST(ReportInstall, TheInstalledBinaryRunsTheInstalledScript) {
   ScratchDir dir;
   const std::string prefix = dir / "prefix";
   int code = -1;
-  std::string output = Run(
+  std::string output = RunCommand(
       std::string("\"") + IBRDF_CMAKE_COMMAND + "\" --install \"" + IBRDF_BUILD_DIR + "\" --prefix \"" + prefix + "\"",
       &code);
   ASSERT_EQ(code, 0) << output;
@@ -55,7 +55,7 @@ TEST(ReportInstall, TheInstalledBinaryRunsTheInstalledScript) {
   sample.wi[2] = sample.wo[2] = 1.0f;
   WriteSamples(run + "/samples.npy", {sample, sample});
   ::unsetenv("IBRDF_REPORT_SCRIPT");
-  output = Run("\"" + prefix + "/bin/ibrdf\" -q report \"" + run + "\"", &code);
+  output = RunCommand("\"" + prefix + "/bin/ibrdf\" -q report \"" + run + "\"", &code);
   ASSERT_EQ(code, 0) << output;
   EXPECT_NE(output.find("stub report.py of share/ibrdf ran"), std::string::npos) << output;
   EXPECT_TRUE(fs::exists(run + "/report/index.html"));

@@ -18,7 +18,7 @@ TEST(SphereRender, LambertianShowsCosineOverPi) {
   const Image image = RenderSphere(size, phase, [](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) {
     EXPECT_NEAR(wi.norm(), 1.0, 1e-12);
     EXPECT_GT(wo.z(), 0.0);
-    return Eigen::Vector3d(0.5, 0.5, 0.5) / kPi;
+    return Eigen::Vector3d(Eigen::Vector3d::Constant(0.5 / kPi));
   });
   const Eigen::Vector3d light(-std::sin(phase), 0.0, std::cos(phase));
   int lit = 0;
