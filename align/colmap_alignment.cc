@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
+#include "core/logging.h"
 
 namespace fs = std::filesystem;
 
@@ -75,10 +76,10 @@ Similarity3d Similarity3d::Estimate(const Eigen::Matrix3Xd& source, const Eigen:
 }
 
 bool ColmapAlignmentOptions::Check(std::string* why) const {
-  if (min_images < 3 || !(max_center_error_m > 0.0) || !(max_rotation_error_deg > 0.0) || max_triples < 1) {
-    *why = "min_images >= 3, max_center_error_m > 0, max_rotation_error_deg > 0, max_triples >= 1";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(min_images, 3);
+  IBRDF_CHECK_OPTION_GT(max_center_error_m, 0.0);
+  IBRDF_CHECK_OPTION_GT(max_rotation_error_deg, 0.0);
+  IBRDF_CHECK_OPTION_GE(max_triples, 1);
   return true;
 }
 
@@ -295,6 +296,39 @@ nlohmann::json ToJson(const ColmapAlignment& alignment) {
           {"max_center_error_m", alignment.max_center_error_m},
           {"rms_rotation_error_deg", alignment.rms_rotation_error_deg},
           {"photos", photos}};
+}
+
+Session MergeColmapPoses(const Session& input, const Session& target_aligned, const ColmapModel& model,
+                         const ColmapAlignment& alignment, bool keep_camera) {
+  IBRDF_CHECK(alignment.photos.size() == input.photos.size())
+      << alignment.photos.size() << " matches for " << input.photos.size() << " photos";
+  Session merged = target_aligned;
+  merged.photos.clear();
+  for (size_t i = 0; i < input.photos.size(); ++i) {
+    const ColmapPhotoMatch& match = alignment.photos[i];
+    PhotoSpec photo = input.photos[i];
+    if (match.metric_pose && (match.inlier || !match.target_pose)) {
+      photo.camera_from_world = *match.metric_pose;
+    } else if (match.target_pose) {
+      if (match.metric_pose)
+        Log(1, "photo " + photo.file + ": COLMAP's pose disagrees with the targets'; the targets' kept");
+      photo.camera_from_world = *match.target_pose;
+    } else {
+      continue;
+    }
+    merged.photos.push_back(photo);
+  }
+  const Camera* camera = SharedColmapCamera(model, alignment);
+  if (keep_camera) {
+    Log(1, "the calibrated intrinsics are kept (COLMAP's are in its model)");
+  } else if (camera && camera->width == input.camera.width && camera->height == input.camera.height) {
+    merged.camera = *camera;
+  } else {
+    Log(1,
+        "the session's intrinsics are kept: the registered photos do not share one COLMAP camera of the session's "
+        "size");
+  }
+  return merged;
 }
 
 }  // namespace ibrdf

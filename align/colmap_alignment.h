@@ -17,6 +17,7 @@
 
 #include "align/colmap_model.h"
 #include "core/rigid3.h"
+#include "core/session.h"
 
 namespace ibrdf {
 
@@ -83,5 +84,14 @@ ColmapAlignment AlignColmapModel(const ColmapModel& model, const std::vector<std
 const Camera* SharedColmapCamera(const ColmapModel& model, const ColmapAlignment& alignment);
 
 nlohmann::json ToJson(const ColmapAlignment& alignment);
+
+// The target-aligned session `target_aligned` with COLMAP's poses merged in, photo by photo of `input`
+// (the session that was aligned; `alignment` was made from its photos): a photo COLMAP registered gets
+// its metric pose, except one whose COLMAP pose disagrees with its target-based pose (not an inlier),
+// which keeps the target-based one; a photo COLMAP lacks keeps its target-based pose; a photo neither
+// posed is left out. The camera becomes COLMAP's shared camera (SharedColmapCamera) when it has the
+// session's size, unless `keep_camera` (calibrated intrinsics). Logs each pose or camera kept.
+Session MergeColmapPoses(const Session& input, const Session& target_aligned, const ColmapModel& model,
+                         const ColmapAlignment& alignment, bool keep_camera);
 
 }  // namespace ibrdf

@@ -1,8 +1,4 @@
-// ibrdf check: consistency of measured samples (reciprocity, bilateral symmetry).
-#include <cstdio>
-
-#include <nlohmann/json.hpp>
-
+// ibrdf check: consistency of measured samples (reconstruct/consistency.h) behind flags.
 #include "apps/commands.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
@@ -11,8 +7,8 @@
 #include "reconstruct/prediction_check.h"
 
 namespace ibrdf {
-
 namespace {
+
 void AddCheckCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "check",
@@ -22,8 +18,7 @@ void AddCheckCommand(CLI::App& app) {
     std::string samples, out;
     ConsistencyOptions options;
     PredictionCheckOptions prediction;
-    bool regression = false;
-    bool overwrite = false;
+    bool regression = false, overwrite = false;
   };
   auto args = std::make_shared<Args>();
   command->add_option("samples", args->samples, "Sample file (.npy) from `ibrdf derender`")->required();
@@ -46,17 +41,7 @@ void AddCheckCommand(CLI::App& app) {
     StageLog stage("check");
     RequireWritableOutput(args->out, args->overwrite, {args->samples});
     const std::vector<BrdfSample> samples = ReadSamples(args->samples);
-    const ConsistencyReport report = CheckConsistency(samples, args->options);
-    nlohmann::json json = ToJson(report, args->options);
-    if (args->regression) {
-      const PredictionReport prediction = CheckWithRegression(samples, args->prediction);
-      json["regression"] = ToJson(prediction, args->prediction);
-      Log(1, prediction.BriefReport());
-    }
-    WriteJsonFile(args->out, json);
-    Log(1, report.BriefReport());
-    if (!report.reciprocity.valid()) Log(1, "warning: no bin pair had enough samples for a reciprocity figure");
-    if (!report.isotropy.valid()) Log(1, "warning: no bin pair had enough samples for an isotropy figure");
+    WriteJsonFile(args->out, CheckSamples(samples, args->options, args->regression ? &args->prediction : nullptr));
     Log(1, "report written to " + args->out);
   });
 }

@@ -1,15 +1,13 @@
-// ibrdf derender: a session's photos to a BRDF sample file.
+// ibrdf derender: a session's photos to a BRDF sample file (derender/derenderer.h) behind flags.
 #include "apps/commands.h"
-#include "core/error.h"
 #include "core/file_util.h"
-#include "core/json_reader.h"
 #include "core/logging.h"
 #include "core/session.h"
 #include "derender/derenderer.h"
 
 namespace ibrdf {
-
 namespace {
+
 void AddDerenderCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "derender",
@@ -23,40 +21,39 @@ void AddDerenderCommand(CLI::App& app) {
     std::string visibility;
   };
   auto args = std::make_shared<Args>();
+  DerenderOptions& o = args->options;
   command->add_option("session", args->session, "Session folder or session.json")->required();
   command->add_option("--out", args->out, "Sample file to write (.npy); the sidecar goes to <out>.json")->required();
-  command->add_option("--max-theta-i-deg", args->options.max_theta_i_deg, "Grazing limit for incidence")
-      ->capture_default_str();
-  command->add_option("--max-theta-e-deg", args->options.max_theta_e_deg, "Grazing limit for exitance")
-      ->capture_default_str();
-  command->add_option("--min-signal", args->options.min_signal, "Signal floor (linear, normalized units)")
-      ->capture_default_str();
-  command->add_option("--stride", args->options.pixel_stride, "Use every n-th pixel in x and y")->capture_default_str();
+  command->add_option("--max-theta-i-deg", o.max_theta_i_deg, "Grazing limit for incidence")->capture_default_str();
+  command->add_option("--max-theta-e-deg", o.max_theta_e_deg, "Grazing limit for exitance")->capture_default_str();
+  command->add_option("--min-signal", o.min_signal, "Signal floor (linear, normalized units)")->capture_default_str();
+  command->add_option("--stride", o.pixel_stride, "Use every n-th pixel in x and y")->capture_default_str();
   command
       ->add_option("--visibility", args->visibility,
                    "Mesh samples: shadow rays auto (where the scan's convexity report asks for them), on or "
                    "off; overrides the session's sample.visibility")
-      ->check(CLI::IsMember({"auto", "on", "off"}));
-  command->add_flag("!--no-mixed-pixel-mask", args->options.mask_mixed_pixels,
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->each([args](const std::string& name) { VisibilityFromName(name, &args->options.visibility.emplace()); });
+  command->add_flag("!--no-mixed-pixel-mask", o.mask_mixed_pixels,
                     "Mesh samples: keep pixels that straddle the silhouette (corner rays miss or jump in depth)");
   command
-      ->add_option("--mixed-pixel-depth-factor", args->options.mixed_pixel_depth_factor,
+      ->add_option("--mixed-pixel-depth-factor", o.mixed_pixel_depth_factor,
                    "Mesh samples: depth jump across a pixel, in pixel footprints, that marks it mixed")
       ->capture_default_str();
   command
-      ->add_option("--max-normal-fit-rms-m", args->options.max_normal_fit_rms_m,
+      ->add_option("--max-normal-fit-rms-m", o.max_normal_fit_rms_m,
                    "Mesh samples: reject hits whose local-plane fit RMS exceeds this (metres; 0: no limit)")
       ->capture_default_str();
   command
-      ->add_option("--min-fit-neighbours", args->options.min_fit_neighbours,
+      ->add_option("--min-fit-neighbours", o.min_fit_neighbours,
                    "Mesh samples: reject hits on faces with a corner fitted from fewer points")
       ->capture_default_str();
   command
-      ->add_option("--shadow-edge-deg", args->options.shadow_edge_deg,
+      ->add_option("--shadow-edge-deg", o.shadow_edge_deg,
                    "Mesh samples, shadow rays on: reject lit pixels within this angle of a shadow edge")
       ->capture_default_str();
   command
-      ->add_option("--shadow-edge-rays", args->options.shadow_edge_rays,
+      ->add_option("--shadow-edge-rays", o.shadow_edge_rays,
                    "Mesh samples, shadow rays on: rays to the disc around the light (0: no shadow-edge test)")
       ->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace existing output files");
@@ -68,19 +65,9 @@ void AddDerenderCommand(CLI::App& app) {
     if (session.sample.kind == SampleSpec::Kind::kMesh) {
       inputs.push_back(ResolvePath(session.directory, session.sample.mesh_file));
     }
-    if (!args->visibility.empty()) {
-      Visibility visibility;
-      VisibilityFromName(args->visibility, &visibility);
-      args->options.visibility = visibility;
-    }
     RequireWritableOutput(args->out, args->overwrite, inputs);
     RequireWritableOutput(SidecarPath(args->out), args->overwrite, inputs);
-    Log(1, "session " + session.name + ": " + std::to_string(session.photos.size()) + " photos, " +
-               SampleKindName(session.sample.kind) + " sample, response " + session.radiometry.response.Describe());
-    const DerenderResult result = Derender(session, args->options);
-    WriteSamples(args->out, result.samples);
-    WriteJsonFile(SidecarPath(args->out), DerenderSidecar(session, args->options, result.summary));
-    Log(1, result.summary.BriefReport());
+    DerenderToFile(session, args->options, args->out);
     Log(1, "samples written to " + args->out);
   });
 }

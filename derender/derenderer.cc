@@ -17,6 +17,8 @@
 #include "core/file_util.h"
 #include "core/json_reader.h"
 #include "core/light.h"
+#include "core/logging.h"
+#include "core/sample_file.h"
 #include "derender/analytic_sample.h"
 #include "derender/light_calibration.h"
 #include "derender/mesh_sample.h"
@@ -681,6 +683,16 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
     o["visibility"] = VisibilityName(options.visibility.value_or(session.sample.visibility));
   }
   return sidecar;
+}
+
+DerenderResult DerenderToFile(const Session& session, const DerenderOptions& options, const std::string& samples_path) {
+  Log(1, "session " + session.name + ": " + std::to_string(session.photos.size()) + " photos, " +
+             SampleKindName(session.sample.kind) + " sample, response " + session.radiometry.response.Describe());
+  DerenderResult result = Derender(session, options);
+  WriteSamples(samples_path, result.samples);
+  WriteJsonFile(SidecarPath(samples_path), DerenderSidecar(session, options, result.summary));
+  Log(1, result.summary.BriefReport());
+  return result;
 }
 
 }  // namespace ibrdf

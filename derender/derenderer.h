@@ -116,4 +116,8 @@ std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera);
 // The sample file's sidecar: units, colour space, counts, options and the session it came from.
 nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options, const DerenderSummary& summary);
 
+// The derender stage as `ibrdf derender` runs it: logs the session, derenders it (Derender) and writes
+// the samples to `samples_path` (.npy) and the sidecar to SidecarPath(samples_path); logs the summary.
+DerenderResult DerenderToFile(const Session& session, const DerenderOptions& options, const std::string& samples_path);
+
 }  // namespace ibrdf

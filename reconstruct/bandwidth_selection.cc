@@ -28,20 +28,12 @@ const char* BandwidthCriterionName(BandwidthCriterion criterion) {
 }
 
 bool BandwidthSelectionOptions::Check(std::string* why) const {
-  if (scales.empty()) {
-    *why = "at least one bandwidth scale is needed";
-    return false;
+  IBRDF_CHECK_OPTION(!scales.empty());
+  for (const double scale : scales) {
+    IBRDF_CHECK_OPTION_GT(scale, 0.0);
+    IBRDF_CHECK_OPTION_LE(scale, 100.0);
   }
-  for (double s : scales) {
-    if (!(s > 0.0 && s <= 100.0)) {
-      *why = "bandwidth scales must be in (0, 100]";
-      return false;
-    }
-  }
-  if (samples < 10) {
-    *why = "at least 10 samples are needed to score a bandwidth";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(samples, size_t(10));
   return true;
 }
 

@@ -8,7 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/logging.h"
 #include "core/statistics.h"
+#include "reconstruct/prediction_check.h"
 
 namespace ibrdf {
 namespace {
@@ -201,6 +203,22 @@ nlohmann::json ToJson(const ConsistencyReport& report, const ConsistencyOptions&
             {"max_theta_deg", options.max_theta_deg}}},
           {"reciprocity", FigureJson(report.reciprocity)},
           {"isotropy", FigureJson(report.isotropy)}};
+}
+
+nlohmann::json CheckSamples(const std::vector<BrdfSample>& samples, const ConsistencyOptions& options,
+                            const PredictionCheckOptions* prediction, ConsistencyReport* report_out) {
+  const ConsistencyReport report = CheckConsistency(samples, options);
+  nlohmann::json json = ToJson(report, options);
+  if (prediction) {
+    const PredictionReport predicted = CheckWithRegression(samples, *prediction);
+    json["regression"] = ToJson(predicted, *prediction);
+    Log(1, predicted.BriefReport());
+  }
+  Log(1, report.BriefReport());
+  if (!report.reciprocity.valid()) Log(1, "warning: no bin pair had enough samples for a reciprocity figure");
+  if (!report.isotropy.valid()) Log(1, "warning: no bin pair had enough samples for an isotropy figure");
+  if (report_out) *report_out = report;
+  return json;
 }
 
 }  // namespace ibrdf

@@ -59,4 +59,12 @@ ConsistencyReport CheckConsistency(const std::vector<BrdfSample>& samples, const
 
 nlohmann::json ToJson(const ConsistencyReport& report, const ConsistencyOptions& options);
 
+struct PredictionCheckOptions;
+
+// `ibrdf check`'s report: the binned figures (CheckConsistency, ToJson) and, with `prediction`, the
+// local-regression checks (reconstruct/prediction_check.h) under "regression". Logs both summaries and
+// a warning for each figure no bin pair had enough samples for. `report` (optional) gets the figures.
+nlohmann::json CheckSamples(const std::vector<BrdfSample>& samples, const ConsistencyOptions& options,
+                            const PredictionCheckOptions* prediction, ConsistencyReport* report = nullptr);
+
 }  // namespace ibrdf

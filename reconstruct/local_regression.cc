@@ -186,34 +186,20 @@ struct LocalRegression::Impl {
 };
 
 bool LocalRegressionOptions::Check(std::string* why) const {
-  if (degree < 0 || degree > 2) {
-    *why = "degree must be 0, 1 or 2";
-    return false;
-  }
-  if (!(radius_h_deg > 0.0 && radius_h_deg <= 90.0) || !(radius_d_deg > 0.0 && radius_d_deg <= 90.0)) {
-    *why = "kernel radii must be in (0, 90] degrees";
-    return false;
-  }
-  if (!(min_rcond >= 0.0 && min_rcond < 1.0) || !(min_samples_per_coefficient >= 1.0)) {
-    *why = "min_rcond must be in [0, 1) and min_samples_per_coefficient at least 1";
-    return false;
-  }
-  if (!(range_margin >= 0.0)) {
-    *why = "range_margin must be non-negative";
-    return false;
-  }
-  if (min_neighbors < 1 || !(max_growth >= 1.0)) {
-    *why = "min_neighbors must be at least 1 and max_growth at least 1";
-    return false;
-  }
-  if (!(bin_fraction_h >= 0.0 && bin_fraction_h <= 1.0) || !(bin_fraction_d >= 0.0 && bin_fraction_d <= 1.0)) {
-    *why = "bin fractions must be in [0, 1]";
-    return false;
-  }
-  if (log_space && !(log_floor > 0.0)) {
-    *why = "log_floor must be positive";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_RANGE(degree, 0, 2);
+  IBRDF_CHECK_OPTION_GT(radius_h_deg, 0.0);
+  IBRDF_CHECK_OPTION_LE(radius_h_deg, 90.0);
+  IBRDF_CHECK_OPTION_GT(radius_d_deg, 0.0);
+  IBRDF_CHECK_OPTION_LE(radius_d_deg, 90.0);
+  IBRDF_CHECK_OPTION_GE(min_rcond, 0.0);
+  IBRDF_CHECK_OPTION_LT(min_rcond, 1.0);
+  IBRDF_CHECK_OPTION_GE(min_samples_per_coefficient, 1.0);
+  IBRDF_CHECK_OPTION_GE(range_margin, 0.0);
+  IBRDF_CHECK_OPTION_GE(min_neighbors, 1);
+  IBRDF_CHECK_OPTION_GE(max_growth, 1.0);
+  IBRDF_CHECK_OPTION_RANGE(bin_fraction_h, 0.0, 1.0);
+  IBRDF_CHECK_OPTION_RANGE(bin_fraction_d, 0.0, 1.0);
+  if (log_space) IBRDF_CHECK_OPTION_GT(log_floor, 0.0);
   return true;
 }
 

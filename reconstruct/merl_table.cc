@@ -107,14 +107,9 @@ MerlTable ReadMerl(const std::string& path) {
 }
 
 bool TabulateOptions::Check(std::string* why) const {
-  if (!(max_theta_deg > 0.0 && max_theta_deg <= 90.0)) {
-    *why = "max_theta_deg must be in (0, 90]";
-    return false;
-  }
-  if (!(min_effective_samples >= 0.0f)) {
-    *why = "min_effective_samples must be non-negative";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GT(max_theta_deg, 0.0);
+  IBRDF_CHECK_OPTION_LE(max_theta_deg, 90.0);
+  IBRDF_CHECK_OPTION_GE(min_effective_samples, 0.0f);
   return true;
 }
 

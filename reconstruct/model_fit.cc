@@ -149,15 +149,14 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
 }  // namespace
 
 bool ModelFitOptions::Check(std::string* why) const {
-  if (lafortune_lobes < 1 || lafortune_lobes > 3) {
-    *why = "lafortune_lobes must be 1, 2 or 3";
-    return false;
-  }
-  if (max_samples < 10 || !(relative_floor >= 0.0) || !(absolute_floor > 0.0) || !(huber_scale > 0.0) ||
-      max_iterations < 1 || !(max_theta_deg > 0.0 && max_theta_deg <= 90.0)) {
-    *why = "max_samples >= 10, floors and huber_scale positive, max_iterations >= 1, max_theta_deg in (0, 90]";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_RANGE(lafortune_lobes, 1, 3);
+  IBRDF_CHECK_OPTION_GE(max_samples, size_t(10));
+  IBRDF_CHECK_OPTION_GE(relative_floor, 0.0);
+  IBRDF_CHECK_OPTION_GT(absolute_floor, 0.0);
+  IBRDF_CHECK_OPTION_GT(huber_scale, 0.0);
+  IBRDF_CHECK_OPTION_GE(max_iterations, 1);
+  IBRDF_CHECK_OPTION_GT(max_theta_deg, 0.0);
+  IBRDF_CHECK_OPTION_LE(max_theta_deg, 90.0);
   return true;
 }
 

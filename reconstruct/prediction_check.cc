@@ -67,15 +67,13 @@ nlohmann::json FigureJson(const PairFigure& figure) {
 
 bool PredictionCheckOptions::Check(std::string* why) const {
   if (!regression.Check(why)) return false;
-  if (held_out_photos < 0 || max_predicted_samples < 1) {
-    *why = "held_out_photos must be non-negative and max_predicted_samples positive";
-    return false;
-  }
-  if (!(max_theta_deg > 0.0 && max_theta_deg <= 90.0) || !(near_plane_deg >= 0.0 && near_plane_deg < 90.0) ||
-      !(step_deg > 0.0)) {
-    *why = "max_theta_deg in (0, 90], near_plane_deg in [0, 90), step_deg positive";
-    return false;
-  }
+  IBRDF_CHECK_OPTION_GE(held_out_photos, 0);
+  IBRDF_CHECK_OPTION_GE(max_predicted_samples, size_t(1));
+  IBRDF_CHECK_OPTION_GT(max_theta_deg, 0.0);
+  IBRDF_CHECK_OPTION_LE(max_theta_deg, 90.0);
+  IBRDF_CHECK_OPTION_GE(near_plane_deg, 0.0);
+  IBRDF_CHECK_OPTION_LT(near_plane_deg, 90.0);
+  IBRDF_CHECK_OPTION_GT(step_deg, 0.0);
   return true;
 }
 

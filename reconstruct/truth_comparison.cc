@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "core/json_reader.h"
+#include "core/sample_file.h"
 #include "core/statistics.h"
 
 namespace ibrdf {
@@ -117,6 +120,41 @@ std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path) {
   std::unique_ptr<BrdfModel> material = MaterialFromJson(root.Raw("material"), truth_path, "/material");
   root.Finish();
   return material;
+}
+
+std::string TruthPathFromSidecar(const std::string& samples_path) {
+  namespace fs = std::filesystem;
+  const std::string sidecar = SidecarPath(samples_path);
+  if (!fs::exists(sidecar)) ThrowError(samples_path, "has no sidecar " + sidecar + "; pass --truth");
+  const nlohmann::json json = ReadJsonFile(sidecar);
+  if (!json.contains("session") || !json["session"].is_string()) {
+    ThrowError(sidecar + ": /session", "missing; pass --truth");
+  }
+  const std::string truth = (fs::path(json["session"].get<std::string>()).parent_path() / "truth.json").string();
+  if (!fs::exists(truth)) {
+    ThrowError(truth, "does not exist: the samples' session is not synthetic (pass --truth for a known BRDF)");
+  }
+  return truth;
+}
+
+std::string ComparisonTable(const TruthComparison& comparison) {
+  std::string table;
+  char line[4096];  // room for six %f of any double
+  std::snprintf(line, sizeof(line), "%-12s %9s  %-26s  %-26s\n", "theta band", "samples", "median |rel error| R G B %",
+                "p95 |rel error| R G B %");
+  table += line;
+  const auto row = [&](const std::string& name, const ErrorStats& s) {
+    std::snprintf(line, sizeof(line), "%-12s %9zu  %7.3f %7.3f %7.3f    %7.2f %7.2f %7.2f\n", name.c_str(), s.count,
+                  100 * s.median[0], 100 * s.median[1], 100 * s.median[2], 100 * s.p95[0], 100 * s.p95[1],
+                  100 * s.p95[2]);
+    table += line;
+  };
+  for (const ThetaBand& band : comparison.bands) {
+    if (band.stats.count == 0) continue;
+    row(std::to_string(int(band.low_deg)) + "-" + std::to_string(int(band.high_deg)) + " deg", band.stats);
+  }
+  row("all", comparison.overall);
+  return table;
 }
 
 }  // namespace ibrdf

@@ -43,4 +43,12 @@ nlohmann::json ToJson(const TruthComparison& comparison);
 // Reads the material of a synthetic session's truth.json.
 std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path);
 
+// truth.json beside the session the samples came from, as the samples' sidecar records it. Throws Error
+// (suggesting --truth) when there is no sidecar, it names no session, or the session has no truth.json.
+std::string TruthPathFromSidecar(const std::string& samples_path);
+
+// The comparison as the table `ibrdf compare` prints: median and 95th-percentile relative error per
+// channel (percent) for each non-empty band and overall, one line each.
+std::string ComparisonTable(const TruthComparison& comparison);
+
 }  // namespace ibrdf

@@ -1,6 +1,7 @@
 // COLMAP into the metric target frame: a model written from a synthetic session's true poses after a
 // known similarity is brought back within 1e-6 (relative), an outlier image does not pull it, the real
-// test model is aligned to a transformed copy of itself, and what cannot be aligned is a clear error.
+// test model is aligned to a transformed copy of itself, what cannot be aligned is a clear error, the
+// merge of COLMAP's and the targets' poses photo by photo, and the align stage with a COLMAP model.
 #include "align/colmap_alignment.h"
 
 #include <cmath>
@@ -12,9 +13,10 @@
 
 #include <gtest/gtest.h>
 
+#include "align/align_stage.h"
 #include "core/error.h"
 #include "core/json_reader.h"
-#include "tests/run_ibrdf.h"
+#include "core/logging.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -23,7 +25,6 @@ namespace {
 namespace fs = std::filesystem;
 using testing::MakeSession;
 using testing::MaterialPath;
-using testing::RunIbrdf;
 using testing::ScratchDir;
 
 const std::string kModel = std::string(IBRDF_SHARED_DATA_DIR) + "/colmap-test-model/sparse/0";
@@ -234,10 +235,56 @@ TEST(ColmapAlignment, TooFewPhotosPosedBothWaysIsAnError) {
   EXPECT_NE(message.find("m: no similarity brings 3 of the 4 photos"), std::string::npos) << message;
 }
 
-// End to end: `ibrdf align --colmap` on a target session, with a model written from the true poses
-// after a similarity: the aligned session holds the true poses (within the target-based similarity's
-// error) and COLMAP's camera; alignment.json reports the similarity.
-TEST(ColmapAlignment, AlignCommandWithAColmapModel) {
+// Photo by photo: an inlier takes COLMAP's pose, an outlier keeps the targets', a photo only COLMAP
+// registered takes COLMAP's, one only the targets posed keeps theirs, one neither posed is left out; the
+// camera becomes COLMAP's shared camera of the session's size unless the camera is kept.
+TEST(ColmapAlignment, MergeColmapPosesPhotoByPhoto) {
+  Session input;
+  input.camera = Camera::Create(CameraModelId::kPinhole, 100, 80, {100, 100, 50, 40});
+  for (int i = 0; i < 5; ++i) {
+    PhotoSpec photo;
+    photo.file = "photos/" + std::to_string(i) + ".png";
+    input.photos.push_back(photo);
+  }
+  Session aligned = input;
+  aligned.name = "aligned";
+  const auto pose = [](double x) { return Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(x, 0, 0)); };
+  ColmapAlignment colmap;
+  colmap.photos.resize(5);
+  colmap.photos[0].metric_pose = pose(1.0);  // inlier
+  colmap.photos[0].target_pose = pose(1.1);
+  colmap.photos[0].inlier = true;
+  colmap.photos[1].metric_pose = pose(2.0);  // outlier
+  colmap.photos[1].target_pose = pose(2.1);
+  colmap.photos[2].metric_pose = pose(3.0);  // COLMAP only
+  colmap.photos[3].target_pose = pose(4.1);  // targets only
+  ColmapModel model;
+  model.cameras[1] = Camera::Create(CameraModelId::kPinhole, 100, 80, {101, 101, 50, 40});
+  for (uint32_t id : {1u, 2u, 3u}) {
+    ColmapImage image;
+    image.id = id;
+    image.camera_id = 1;
+    model.images[id] = image;
+    colmap.photos[id - 1].image_id = id;
+  }
+  const Session merged = MergeColmapPoses(input, aligned, model, colmap, /*keep_camera=*/false);
+  EXPECT_EQ(merged.name, "aligned");
+  ASSERT_EQ(merged.photos.size(), 4u);
+  const double expected[] = {1.0, 2.1, 3.0, 4.1};
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(merged.photos[i].file, input.photos[i].file);
+    EXPECT_EQ(merged.photos[i].camera_from_world->translation.x(), expected[i]) << "photo " << i;
+  }
+  EXPECT_EQ(merged.camera.params, model.cameras[1].params);
+  EXPECT_EQ(MergeColmapPoses(input, aligned, model, colmap, /*keep_camera=*/true).camera.params, input.camera.params);
+  model.cameras[1].width = 200;  // not the session's size: the session's camera stays
+  EXPECT_EQ(MergeColmapPoses(input, aligned, model, colmap, false).camera.params, input.camera.params);
+}
+
+// End to end through the align stage with a COLMAP model: a target session with a model written from
+// the true poses after a similarity: the aligned session holds the true poses (within the target-based
+// similarity's error) and COLMAP's camera; alignment.json reports the similarity.
+TEST(ColmapAlignment, AlignStageWithAColmapModel) {
   ScratchDir dir;
   SynthOptions options;
   options.targets = true;
@@ -250,9 +297,16 @@ TEST(ColmapAlignment, AlignCommandWithAColmapModel) {
   model.cameras[1].params[0] *= 1.001;  // COLMAP's own estimate of the focal length
   fs::create_directories(dir / "model");
   model.WriteBinary(dir / "model");
-  const auto run = RunIbrdf("align " + dir / "s --colmap " + dir / "model --out " + dir / "aligned", /*quiet=*/true);
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("colmap: 6 photos registered"), std::string::npos) << run.output;
+  AlignStageOptions stage;
+  stage.colmap_model = dir / "model";
+  SetVerbosity(1);
+  ::testing::internal::CaptureStderr();
+  const AlignStageResult result = AlignSessionToFolder(Session::Load(dir / "s"), stage, dir / "aligned");
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  SetVerbosity(0);
+  ASSERT_TRUE(result.success);
+  ASSERT_TRUE(result.colmap);
+  EXPECT_NE(log.find("colmap: 6 photos registered"), std::string::npos) << log;
   const Session aligned = Session::Load(dir / "aligned");
   ASSERT_EQ(aligned.photos.size(), session.photos.size());
   EXPECT_EQ(aligned.camera.params, model.cameras[1].params);
@@ -269,9 +323,8 @@ TEST(ColmapAlignment, AlignCommandWithAColmapModel) {
   for (auto& [id, image] : model.images) image.name = "other-" + image.name;
   model.WriteText(dir / "model");
   fs::remove(dir / "model/cameras.bin");
-  const auto bad = RunIbrdf("align " + dir / "s --colmap " + dir / "model --out " + dir / "bad");
-  EXPECT_NE(bad.exit_code, 0);
-  EXPECT_NE(bad.output.find("0 of the session's"), std::string::npos) << bad.output;
+  const std::string message = ErrorOf([&] { AlignSessionToFolder(Session::Load(dir / "s"), stage, dir / "bad"); });
+  EXPECT_NE(message.find("0 of the session's"), std::string::npos) << message;
   EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 

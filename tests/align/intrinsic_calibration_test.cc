@@ -1,6 +1,6 @@
 // Intrinsic calibration from synthetic ChArUco board photos: the camera that took them (distortion
 // included) recovered within the issue's bounds, the board's layout as OpenCV defines it, too few
-// usable photos refused with the reasons, and `ibrdf align --calibrate` end to end.
+// usable photos refused with the reasons, and the align stage with calibration (align/align_stage.h) end to end.
 #include "align/intrinsic_calibration.h"
 
 #include <cmath>
@@ -13,18 +13,18 @@
 
 #include <gtest/gtest.h>
 
+#include "align/align_stage.h"
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/json_reader.h"
+#include "core/logging.h"
 #include "derender/synthetic_charuco.h"
-#include "tests/run_ibrdf.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::RunIbrdf;
 using testing::ScratchDir;
 
 std::string ErrorOf(const std::function<void()>& f) {
@@ -148,17 +148,31 @@ TEST(IntrinsicCalibration, TooFewUsablePhotosAreRefusedWithTheReasons) {
 // End to end: synth writes board photos with the session's camera, `ibrdf align --calibrate`
 // calibrates from them, aligns with the calibrated camera and writes it into the aligned session; the
 // poses stay within the align stage's bounds (0.5 mm, 0.05 degrees).
-TEST(IntrinsicCalibration, AlignCommandCalibratesThenAligns) {
+TEST(IntrinsicCalibration, AlignStageCalibratesThenAligns) {
   ScratchDir dir;
-  const std::string material = testing::MaterialPath("bluepaint");
-  auto run = RunIbrdf("synth --out " + dir / "s" + " --material " + material +
-                      " --targets --photos 4 --light-photos 0 --charuco-photos 24");
-  ASSERT_EQ(run.exit_code, 0) << run.output;
+  // As `ibrdf synth --targets --photos 4 --light-photos 0 --charuco-photos 24` makes it.
+  SynthOptions synth;
+  synth.targets = true;
+  synth.camera_elevation_deg = 45.0;
+  synth.num_photos = 4;
+  synth.light_target_photos = 0;
+  testing::MakeSession(dir / "s", synth, *LoadMaterial(testing::MaterialPath("bluepaint")));
+  CharucoPhotoOptions board;
+  board.num_photos = 24;
+  board.seed = synth.seed + 1000;
+  ASSERT_TRUE(WriteCharucoPhotos(Session::Load(dir / "s").camera, board, dir / "s/calibration", false).success);
   ASSERT_TRUE(fs::exists(dir / "s/calibration/board.json"));
-  run = RunIbrdf("align " + dir / "s" + " --calibrate " + dir / "s/calibration --no-sphere --out " + dir / "aligned",
-                 true);
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("calibration: "), std::string::npos) << run.output;
+  AlignStageOptions options;
+  options.calibration_dir = dir / "s/calibration";
+  options.align.fit_sphere = false;
+  SetVerbosity(1);
+  ::testing::internal::CaptureStderr();
+  const AlignStageResult result = AlignSessionToFolder(Session::Load(dir / "s"), options, dir / "aligned");
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  SetVerbosity(0);
+  ASSERT_TRUE(result.success);
+  ASSERT_TRUE(result.calibration);
+  EXPECT_NE(log.find("calibration: "), std::string::npos) << log;
   const Session truth = Session::Load(dir / "s");
   const Session aligned = Session::Load(dir / "aligned");
   ExpectWithinIssueBounds(truth.camera, aligned.camera);

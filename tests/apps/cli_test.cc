@@ -215,5 +215,29 @@ TEST_F(CliTest, CompareWithoutTruthSaysSo) {
   EXPECT_NE(result.output.find("truth.json"), std::string::npos) << result.output;
 }
 
+// `ibrdf reconstruct`: a bad --bandwidth is a clear message naming the flag and the value, a non-zero
+// exit and nothing written; bad --bandwidth-scales too.
+TEST_F(CliTest, ReconstructUnknownBandwidthCriterionIsAClearError) {
+  const std::string samples = dir_ / "samples.npy", out = dir_ / "rec";
+  ASSERT_EQ(RunIbrdf("derender " + session_ + " --out " + samples).exit_code, 0);
+  const RunResult run = RunIbrdf("reconstruct " + samples + " --out " + out + " --bandwidth aic");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.output.find("--bandwidth"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("aic"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_NE(RunIbrdf("reconstruct " + samples + " --out " + out + " --bandwidth loo --bandwidth-scales 0,1").exit_code,
+            0);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// `ibrdf report` on a folder that is not a run folder: one line naming the missing samples.npy, exit 1.
+TEST(Cli, ReportOnAFolderWithoutSamplesIsOneClearLine) {
+  ScratchDir dir;
+  const RunResult result = RunIbrdf("report " + dir.str());
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("ibrdf: error: " + dir / "samples.npy"), std::string::npos) << result.output;
+  EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << result.output;
+}
+
 }  // namespace
 }  // namespace ibrdf

@@ -11,11 +11,11 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/logging.h"
 #include "derender/derenderer.h"
 #include "derender/light_calibration.h"
 #include "derender/radiance_image.h"
 #include "reconstruct/truth_comparison.h"
-#include "tests/run_ibrdf.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -226,31 +226,47 @@ TEST(Radiometry, FlatFieldOfTheWrongSizeIsAnError) {
   }
 }
 
-// Through the command line: synth with an unknown light, sRGB, black level and vignetting; derender
-// calibrates the light and the samples match the truth; a saturated white reference stops it with a clear
-// message, a non-zero exit and no output.
-TEST(Radiometry, CommandLineCalibratesAndRefusesSaturatedReference) {
+// The derender stage as `ibrdf derender` runs it (DerenderToFile), on a session made as `ibrdf synth
+// --photos 2 --width 200 --height 150 --srgb --black-level 0.03 --vignetting 0.4 --light-unknown
+// --light-intensity 0.7 0.9 1.2` makes it: the light is calibrated and the samples match the truth; a
+// saturated white reference stops it with a clear message and no output.
+TEST(Radiometry, DerenderStageCalibratesAndRefusesSaturatedReference) {
   ScratchDir dir;
   const std::string session = dir / "s";
-  const testing::RunResult synth = testing::RunIbrdf(
-      "synth --out " + session + " --material " + MaterialPath("bluepaint") +
-      " --photos 2 --width 200 --height 150 --srgb --black-level 0.03 --vignetting 0.4 --light-unknown"
-      " --light-intensity 0.7 0.9 1.2");
-  ASSERT_EQ(synth.exit_code, 0) << synth.output;
-  const testing::RunResult derender = testing::RunIbrdf("derender " + session + " --out " + (dir / "a.npy"), true);
-  ASSERT_EQ(derender.exit_code, 0) << derender.output;
-  EXPECT_NE(derender.output.find("light calibration: white reference"), std::string::npos) << derender.output;
+  SynthOptions options;
+  options.num_photos = 2;
+  options.width = 200;
+  options.height = 150;
+  options.effects.srgb = true;
+  options.effects.black_level = 0.03;
+  options.effects.vignetting = 0.4;
+  options.radiometry.light_unknown = true;
+  options.light_intensity = Eigen::Vector3d(0.7, 0.9, 1.2);
+  const std::string material = MaterialPath("bluepaint");
+  ASSERT_TRUE(WriteSyntheticSession(options, *LoadMaterial(material), material, session, false).success);
+  SetVerbosity(1);
+  ::testing::internal::CaptureStderr();
+  const DerenderResult result = DerenderToFile(Session::Load(session), DerenderOptions(), dir / "a.npy");
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  SetVerbosity(0);
+  EXPECT_TRUE(result.summary.success);
+  EXPECT_NE(log.find("light calibration: white reference"), std::string::npos) << log;
   const auto samples = ReadSamples(dir / "a.npy");
+  EXPECT_EQ(samples.size(), result.samples.size());
   const TruthComparison comparison = CompareWithTruth(samples, *LoadMaterial(MaterialPath("bluepaint")));
   for (int c = 0; c < 3; ++c) EXPECT_LT(std::abs(comparison.overall.bias[c]), 0.01) << "channel " << c;
 
   Image white = ReadImage(session + "/calibration/white-000.png");
   for (float& v : white.pixels) v = std::min(1.0f, 4.0f * v);
   WriteImage(session + "/calibration/white-000.png", white, PixelFormat::kUint16);
-  const testing::RunResult refused = testing::RunIbrdf("derender " + session + " --out " + (dir / "b.npy"));
-  EXPECT_NE(refused.exit_code, 0);
-  EXPECT_NE(refused.output.find("white-000.png"), std::string::npos) << refused.output;
-  EXPECT_NE(refused.output.find("saturated"), std::string::npos) << refused.output;
+  std::string message;
+  try {
+    DerenderToFile(Session::Load(session), DerenderOptions(), dir / "b.npy");
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("white-000.png"), std::string::npos) << message;
+  EXPECT_NE(message.find("saturated"), std::string::npos) << message;
   EXPECT_FALSE(std::filesystem::exists(dir / "b.npy"));
 }
 

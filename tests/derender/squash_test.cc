@@ -1,4 +1,4 @@
-// End to end through the ibrdf tool on irregular synthetic samples (issue 5): synth a squash with a
+// End to end through the stage libraries on irregular synthetic samples (issue 5): synth a squash with a
 // simulated range scan 10 km out -> scan -> align (camera poses, light, and the mesh's registration by
 // the markers the scanner saw) -> derender on the scanned mesh -> samples against the true BRDF; the
 // same on the true geometry; and a dented sphere's self-shadows with visibility off and on.
@@ -12,44 +12,64 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "align/align_stage.h"
 #include "core/brdf_model.h"
 #include "core/file_util.h"
 #include "core/json_reader.h"
+#include "core/logging.h"
 #include "core/sample_file.h"
 #include "core/session.h"
+#include "derender/derenderer.h"
 #include "derender/synthetic.h"
 #include "reconstruct/truth_comparison.h"
-#include "tests/run_ibrdf.h"
+#include "scan/scan_pipeline.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::RunIbrdf;
 using testing::ScratchDir;
 
 // A small session: 640x480 (markers of 28 mm need about 30 pixels to pose a photo), 4 measurement
 // photos, no light-marker photos (the light stays as given), noise-free camera,
-// a coarse scan (1.5 mm spacing).
-std::string SynthArgs(const std::string& shape, const std::string& out, double scan_offset_m) {
-  return "synth --out " + out + " --material " + testing::MaterialPath("bluepaint") + " --shape " + shape +
-         " --effects none --width 640 --height 480 --photos 4 --light-photos 0 --scan-spacing-m 0.0015" +
-         " --truth-mesh-spacing-m 0.0015" + " --scan-offset-m " + std::to_string(scan_offset_m);
+// a coarse scan (1.5 mm spacing); as `ibrdf synth --shape SHAPE --effects none --width 640 --height 480
+// --photos 4 --light-photos 0 --scan-spacing-m 0.0015 --truth-mesh-spacing-m 0.0015 --scan-offset-m X
+// [--fill-light F]` makes it.
+void Synth(const std::string& shape, const std::string& out, double scan_offset_m, double fill_light = 0.0) {
+  SynthOptions options;
+  options.shape = SynthShapeFromName(shape);
+  options.targets = true;
+  options.camera_elevation_deg = 45.0;
+  options.light_target_photos = 0;
+  options.effects = CameraEffects::None();
+  options.width = 640;
+  options.height = 480;
+  options.num_photos = 4;
+  options.scanner.spacing_m = 0.0015;
+  options.truth_mesh_spacing_m = 0.0015;
+  options.scan_offset_m = scan_offset_m;
+  options.fill_light = fill_light;
+  const std::string material = testing::MaterialPath("bluepaint");
+  ASSERT_TRUE(WriteSyntheticSession(options, *LoadMaterial(material), material, out, false).success);
 }
 
-void RunOk(const std::string& arguments) {
-  const testing::RunResult result = RunIbrdf(arguments);
-  ASSERT_EQ(result.exit_code, 0) << arguments << "\n" << result.output;
-}
-
-// ibrdf scan of the session's range grids into its sample's mesh file.
+// The scan stage on the session's range grids into its sample's mesh file (as `ibrdf scan` does).
 void ScanSession(const std::string& dir) {
   const Session session = Session::Load(dir);
-  std::string inputs;
+  std::vector<ScanInput> inputs;
   for (const ScanInputSpec& input : session.sample.scan_inputs)
-    inputs += " " + ResolvePath(session.directory, input.file);
-  RunOk("scan" + inputs + " --out " + ResolvePath(session.directory, session.sample.mesh_file));
+    inputs.push_back({ResolvePath(session.directory, input.file), std::nullopt});
+  const ScanOptions options;
+  WriteScanOutputs(ResolvePath(session.directory, session.sample.mesh_file), RunScan(inputs, options), options);
+}
+
+void Align(const std::string& session, const std::string& out) {
+  AlignSessionToFolder(Session::Load(session), AlignStageOptions(), out);
+}
+
+void DerenderSession(const std::string& session, const std::string& out) {
+  DerenderToFile(Session::Load(session), DerenderOptions(), out);
 }
 
 // A copy of a session's manifest in its own folder whose sample is the true geometry (world frame).
@@ -66,18 +86,19 @@ TruthComparison Compare(const std::string& samples, const std::string& truth_jso
 }
 
 TEST(Squash, ScanAlignDerenderMatchesTheTruth) {
+  SetVerbosity(0);
   ScratchDir dir;
   const std::string s = dir / "s";
-  RunOk(SynthArgs("squash", s, 1e4));
+  ASSERT_NO_FATAL_FAILURE(Synth("squash", s, 1e4));
   ScanSession(s);
-  RunOk("align " + s + " --out " + dir / "aligned");
+  Align(s, dir / "aligned");
   const nlohmann::json alignment = ReadJsonFile(dir / "aligned/alignment.json");
   ASSERT_TRUE(alignment.contains("mesh_registration")) << alignment.dump();
   EXPECT_EQ(alignment["mesh_registration"]["used_markers"], 12);
   EXPECT_LT(alignment["mesh_registration"]["rms_m"].get<double>(), 2e-4);
-  RunOk("derender " + dir / "aligned" + " --out " + dir / "scanned.npy");
+  DerenderSession(dir / "aligned", dir / "scanned.npy");
   const TruthComparison scanned = Compare(dir / "scanned.npy", s + "/truth.json");
-  RunOk("derender " + TruthMeshSession(s, "auto") + " --out " + dir / "true.npy");
+  DerenderSession(TruthMeshSession(s, "auto"), dir / "true.npy");
   const TruthComparison truth = Compare(dir / "true.npy", s + "/truth.json");
   std::cout << "scanned mesh: " << scanned.BriefReport() << "\ntrue mesh:    " << truth.BriefReport() << "\n";
   EXPECT_GT(scanned.overall.count, 8000u);
@@ -86,10 +107,10 @@ TEST(Squash, ScanAlignDerenderMatchesTheTruth) {
 
   // The same measurement with the scanner's frame at the world's origin: the same samples.
   const std::string near = dir / "near";
-  RunOk(SynthArgs("squash", near, 0.0));
+  ASSERT_NO_FATAL_FAILURE(Synth("squash", near, 0.0));
   ScanSession(near);
-  RunOk("align " + near + " --out " + dir / "near-aligned");
-  RunOk("derender " + dir / "near-aligned" + " --out " + dir / "near.npy");
+  Align(near, dir / "near-aligned");
+  DerenderSession(dir / "near-aligned", dir / "near.npy");
   const std::vector<BrdfSample> far_samples = ReadSamples(dir / "scanned.npy");
   const std::vector<BrdfSample> near_samples = ReadSamples(dir / "near.npy");
   ASSERT_EQ(far_samples.size(), near_samples.size());
@@ -111,9 +132,10 @@ TEST(Squash, ScanAlignDerenderMatchesTheTruth) {
 // of the point light: with visibility off they pass the signal floor and give samples far below the
 // truth; with it on they are rejected as shadowed.
 TEST(Squash, DentShadowsAreRejectedWithVisibility) {
+  SetVerbosity(0);
   ScratchDir dir;
   const std::string s = dir / "dent";
-  RunOk(SynthArgs("dent", s, 1.0) + " --fill-light 0.05");
+  ASSERT_NO_FATAL_FAILURE(Synth("dent", s, 1.0, 0.05));
   const std::unique_ptr<BrdfModel> material = LoadTruthMaterial(s + "/truth.json");
   const Session session = Session::Load(s);
   const nlohmann::json truth = ReadJsonFile(s + "/truth.json");
@@ -140,7 +162,7 @@ TEST(Squash, DentShadowsAreRejectedWithVisibility) {
   std::vector<double> shadow_errors;  // visibility off: |relative error| of the green channel in true shadow
   for (const std::string visibility : {"off", "on"}) {
     const std::string samples = dir / ("dent-" + visibility + ".npy");
-    RunOk("derender " + TruthMeshSession(s, visibility) + " --out " + samples);
+    DerenderSession(TruthMeshSession(s, visibility), samples);
     size_t shadowed = 0;
     const std::vector<BrdfSample> all = ReadSamples(samples);
     for (const BrdfSample& sample : all) {

@@ -1,4 +1,8 @@
-// `ibrdf report`: the HTML report of a run folder opens in headless Chromium with every image shown.
+// The report stage (report/report_stage.h) through its library call: the HTML report of a run folder
+// made stage by stage opens in headless Chromium with every image shown; the report data holds the
+// photo, the renders and the incidence-plane curves; what is not a run folder is a clear error.
+#include "report/report_stage.h"
+
 #include <unistd.h>
 
 #include <cstdio>
@@ -9,17 +13,25 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
-#include "tests/run_ibrdf.h"
+#include "core/error.h"
+#include "core/json_reader.h"
+#include "core/logging.h"
+#include "core/sample_file.h"
+#include "core/session.h"
+#include "derender/derenderer.h"
+#include "reconstruct/consistency.h"
+#include "reconstruct/reconstruction_stage.h"
+#include "reconstruct/truth_comparison.h"
 #include "tests/scratch_dir.h"
+#include "tests/test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace ibrdf {
 namespace {
 
-using testing::RunIbrdf;
-using testing::RunResult;
 using testing::ScratchDir;
 
 std::string Slurp(const std::string& path) {
@@ -53,32 +65,50 @@ std::string Capture(const std::string& command) {
   return output;
 }
 
-// A run folder made stage by stage (so this test does not depend on `ibrdf run`), then the report.
+// A run folder made stage by stage through the libraries, as `ibrdf run` lays it out: samples.npy (with
+// its sidecar), consistency.json, truth-comparison.json, reconstruction/.
 class ReportTest : public ::testing::Test {
  protected:
+  void SetUp() override { SetVerbosity(0); }
   void MakeRunFolder() {
     const std::string s = dir_ / "s", run = dir_ / "run";
-    ASSERT_EQ(RunIbrdf(std::string("synth --material ") + IBRDF_SAMPLES_DIR +
-                       "/materials/bluepaint.json --width 160 --height 120 --photos 6 --out " + s)
-                  .exit_code,
-              0);
+    SynthOptions synth;
+    synth.width = 160;
+    synth.height = 120;
+    synth.num_photos = 6;
+    const std::unique_ptr<BrdfModel> material =
+        LoadMaterial(std::string(IBRDF_SAMPLES_DIR) + "/materials/bluepaint.json");
+    testing::MakeSession(s, synth, *material);
     fs::create_directories(run);
-    ASSERT_EQ(RunIbrdf("derender " + s + " --out " + run + "/samples.npy").exit_code, 0);
-    ASSERT_EQ(RunIbrdf("check " + run + "/samples.npy --out " + run + "/consistency.json").exit_code, 0);
-    ASSERT_EQ(RunIbrdf("compare " + run + "/samples.npy --out " + run + "/truth-comparison.json").exit_code, 0);
-    ASSERT_EQ(RunIbrdf("reconstruct " + run + "/samples.npy --no-fits --out " + run + "/reconstruction --truth " + s +
-                       "/truth.json")
-                  .exit_code,
-              0);
+    const std::string samples_path = run + "/samples.npy";
+    const std::vector<BrdfSample> samples = DerenderToFile(Session::Load(s), DerenderOptions(), samples_path).samples;
+    WriteJsonFile(run + "/consistency.json", CheckSamples(samples, ConsistencyOptions(), nullptr));
+    const std::string truth_path = TruthPathFromSidecar(samples_path);
+    nlohmann::json comparison = ToJson(CompareWithTruth(samples, *LoadTruthMaterial(truth_path)));
+    comparison["samples"] = samples_path;
+    comparison["truth"] = truth_path;
+    WriteJsonFile(run + "/truth-comparison.json", comparison);
+    ReconstructOptions reconstruct;
+    reconstruct.fits = false;
+    reconstruct.truth_file = s + "/truth.json";
+    ASSERT_TRUE(ReconstructFile(samples_path, reconstruct, run + "/reconstruction").success);
   }
   ScratchDir dir_;
 };
 
 TEST_F(ReportTest, WritesEveryFigureAndTheHtmlShowsThemInHeadlessChromium) {
-  MakeRunFolder();
-  const RunResult report = RunIbrdf("report " + dir_ / "run", true);
-  ASSERT_EQ(report.exit_code, 0) << report.output;
+  ASSERT_NO_FATAL_FAILURE(MakeRunFolder());
+  const ReportResult report = WriteReport(dir_ / "run", ReportOptions());
+  ASSERT_TRUE(report.success);
   const std::string folder = dir_ / "run/report";
+  EXPECT_EQ(report.index_html, folder + "/index.html");
+  EXPECT_TRUE(report.photo_shown) << report.photo_note;
+  EXPECT_TRUE(report.reconstruction);
+  EXPECT_TRUE(report.truth);
+  const nlohmann::json data = ReadJsonFile(folder + "/report-data.json");
+  EXPECT_EQ(data.at("photo").at("index"), report.photo);
+  EXPECT_EQ(data.at("incidence_plane").size(), 4u);
+  EXPECT_EQ(data.at("incidence_plane")[0].at("angle_deg").size(), data.at("incidence_plane")[0].at("truth").size());
   for (const char* figure : {"coverage.png", "incidence-plane.png", "reciprocity.png", "isotropy.png", "timings.png",
                              "truth-bands.png", "photo.png", "render.png", "render-truth.png"}) {
     EXPECT_TRUE(fs::exists(folder + "/" + figure)) << figure;
@@ -118,12 +148,25 @@ TEST_F(ReportTest, WritesEveryFigureAndTheHtmlShowsThemInHeadlessChromium) {
   EXPECT_EQ(match[3], "failed");
 }
 
-TEST(ReportCommand, AFolderWithoutSamplesIsOneClearLine) {
+TEST(ReportStage, AFolderWithoutSamplesIsAnErrorNamingThem) {
   ScratchDir dir;
-  const RunResult result = RunIbrdf("report " + dir.str());
-  EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.output.find("ibrdf: error: " + dir / "samples.npy"), std::string::npos) << result.output;
-  EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << result.output;
+  std::string message;
+  try {
+    WriteReport(dir.str(), ReportOptions());
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find(dir / "samples.npy"), std::string::npos) << message;
+  EXPECT_FALSE(fs::exists(dir / "report"));
+}
+
+TEST(ReportStage, OptionsCheckNamesTheRenderSize) {
+  std::string why;
+  EXPECT_TRUE(ReportOptions().Check(&why)) << why;
+  ReportOptions options;
+  options.render_size = 8;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("render_size"), std::string::npos) << why;
 }
 
 }  // namespace

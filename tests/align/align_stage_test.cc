@@ -1,0 +1,66 @@
+// The align stage's own parts (align/align_stage.h): default options are valid, a COLMAP model given
+// and COLMAP run at once are refused naming the constraint, and the aligned session's paths rebased
+// from the input session's folder onto the output folder (photos; a mesh and its scans).
+#include "align/align_stage.h"
+
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "core/session.h"
+#include "tests/scratch_dir.h"
+
+namespace ibrdf {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(AlignStage, DefaultOptionsAreValidAndColmapSourcesExcludeEachOther) {
+  std::string why;
+  AlignStageOptions options;
+  EXPECT_TRUE(options.Check(&why)) << why;
+  options.colmap_model = "model";
+  options.run_colmap = true;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("run_colmap"), std::string::npos) << why;
+  std::string message;
+  try {
+    AlignSessionToFolder(Session(), options, "out");
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("align options: "), std::string::npos) << message;
+}
+
+TEST(AlignStage, RebasesPathsOntoTheOutputFolder) {
+  testing::ScratchDir dir;
+  Session input;
+  input.directory = dir / "sessions/in";
+  Session aligned;
+  PhotoSpec photo;
+  photo.file = "photos/a.png";
+  aligned.photos = {photo};
+  photo.file = dir / "elsewhere/b.png";  // absolute paths stay where they point
+  aligned.photos.push_back(photo);
+  aligned.sample.kind = SampleSpec::Kind::kMesh;
+  aligned.sample.mesh_file = "scan/mesh.ply";
+  ScanInputSpec scan;
+  scan.file = "scan/view-0.ply";
+  aligned.sample.scan_inputs = {scan};
+  RebaseSessionPaths(input, dir / "out/aligned", &aligned);
+  EXPECT_EQ(aligned.photos[0].file, "../../sessions/in/photos/a.png");
+  EXPECT_EQ(aligned.photos[1].file, "../../elsewhere/b.png");
+  EXPECT_EQ(aligned.sample.mesh_file, "../../sessions/in/scan/mesh.ply");
+  EXPECT_EQ(aligned.sample.scan_inputs[0].file, "../../sessions/in/scan/view-0.ply");
+  // A sphere sample has no mesh: its (unused) mesh path stays as it is.
+  Session sphere;
+  sphere.photos = {photo};
+  sphere.sample.mesh_file = "x.ply";
+  RebaseSessionPaths(input, dir / "out", &sphere);
+  EXPECT_EQ(sphere.sample.mesh_file, "x.ply");
+  EXPECT_EQ(sphere.photos[0].file, "../elsewhere/b.png");
+}
+
+}  // namespace
+}  // namespace ibrdf
