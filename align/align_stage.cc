@@ -93,18 +93,6 @@ std::string AlignStageResult::BriefReport() const {
   return out.str();
 }
 
-void RebaseSessionPaths(const Session& input, const std::string& out_dir, Session* aligned) {
-  const fs::path final_dir = fs::absolute(out_dir).lexically_normal();
-  const auto rebase = [&](std::string* file) {
-    *file = fs::absolute(ResolvePath(input.directory, *file)).lexically_normal().lexically_relative(final_dir).string();
-  };
-  if (aligned->sample.kind == SampleSpec::Kind::kMesh) {
-    rebase(&aligned->sample.mesh_file);
-    for (ScanInputSpec& scan : aligned->sample.scan_inputs) rebase(&scan.file);
-  }
-  for (PhotoSpec& photo : aligned->photos) rebase(&photo.file);
-}
-
 AlignStageResult AlignSessionToFolder(const Session& input, const AlignStageOptions& options,
                                       const std::string& out_dir) {
   std::string why;
@@ -128,7 +116,9 @@ AlignStageResult AlignSessionToFolder(const Session& input, const AlignStageOpti
     stage.colmap = MergeColmap(session, options, directory.temporary_path(), &result, &extra);
   }
   RegisterScannedMesh(session, &result.session.sample, &extra);
-  RebaseSessionPaths(session, out_dir, &result.session);
+  // The aligned session's path fields still name files from the input session's folder.
+  result.session.directory = session.directory;
+  result.session = result.session.Rebased(out_dir);
   result.session.name = session.name + "-aligned";
   result.session.Save((fs::path(directory.temporary_path()) / "session.json").string());
   nlohmann::json alignment = ToJson(result);

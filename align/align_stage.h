@@ -51,9 +51,5 @@ struct AlignStageResult {
 AlignStageResult AlignSessionToFolder(const Session& session, const AlignStageOptions& options,
                                       const std::string& out_dir);
 
-// Makes the file paths of `aligned` (photos; for a mesh sample the mesh and its scan inputs), which
-// are relative to `input`'s folder, relative to `out_dir` (where `aligned` will be saved), so that the
-// aligned manifest points at the input session's files. (To be replaced by Session::SaveRebased.)
-void RebaseSessionPaths(const Session& input, const std::string& out_dir, Session* aligned);
 
 }  // namespace ibrdf

@@ -1,6 +1,5 @@
 // ibrdf derender: a session's photos to a BRDF sample file (derender/derenderer.h) behind flags.
 #include "apps/commands.h"
-#include "core/file_util.h"
 #include "core/logging.h"
 #include "core/session.h"
 #include "derender/derenderer.h"
@@ -60,11 +59,8 @@ void AddDerenderCommand(CLI::App& app) {
   command->callback([args] {
     StageLog stage("derender");
     const Session session = Session::Load(args->session);
-    std::vector<std::string> inputs = {session.manifest_path};
-    for (size_t i = 0; i < session.photos.size(); ++i) inputs.push_back(session.PhotoPath(i));
-    if (session.sample.kind == SampleSpec::Kind::kMesh) {
-      inputs.push_back(ResolvePath(session.directory, session.sample.mesh_file));
-    }
+    std::vector<std::string> inputs = session.InputFiles();
+    inputs.push_back(session.manifest_path);
     RequireWritableOutput(args->out, args->overwrite, inputs);
     RequireWritableOutput(SidecarPath(args->out), args->overwrite, inputs);
     DerenderToFile(session, args->options, args->out);

@@ -35,9 +35,8 @@ TEST(AlignStage, DefaultOptionsAreValidAndColmapSourcesExcludeEachOther) {
 
 TEST(AlignStage, RebasesPathsOntoTheOutputFolder) {
   testing::ScratchDir dir;
-  Session input;
-  input.directory = dir / "sessions/in";
   Session aligned;
+  aligned.directory = dir / "sessions/in";
   PhotoSpec photo;
   photo.file = "photos/a.png";
   aligned.photos = {photo};
@@ -48,18 +47,19 @@ TEST(AlignStage, RebasesPathsOntoTheOutputFolder) {
   ScanInputSpec scan;
   scan.file = "scan/view-0.ply";
   aligned.sample.scan_inputs = {scan};
-  RebaseSessionPaths(input, dir / "out/aligned", &aligned);
-  EXPECT_EQ(aligned.photos[0].file, "../../sessions/in/photos/a.png");
-  EXPECT_EQ(aligned.photos[1].file, "../../elsewhere/b.png");
-  EXPECT_EQ(aligned.sample.mesh_file, "../../sessions/in/scan/mesh.ply");
-  EXPECT_EQ(aligned.sample.scan_inputs[0].file, "../../sessions/in/scan/view-0.ply");
+  const Session rebased = aligned.Rebased(dir / "out/aligned");
+  EXPECT_EQ(rebased.photos[0].file, "../../sessions/in/photos/a.png");
+  EXPECT_EQ(rebased.photos[1].file, "../../elsewhere/b.png");
+  EXPECT_EQ(rebased.sample.mesh_file, "../../sessions/in/scan/mesh.ply");
+  EXPECT_EQ(rebased.sample.scan_inputs[0].file, "../../sessions/in/scan/view-0.ply");
   // A sphere sample has no mesh: its (unused) mesh path stays as it is.
   Session sphere;
+  sphere.directory = dir / "sessions/in";
   sphere.photos = {photo};
   sphere.sample.mesh_file = "x.ply";
-  RebaseSessionPaths(input, dir / "out", &sphere);
-  EXPECT_EQ(sphere.sample.mesh_file, "x.ply");
-  EXPECT_EQ(sphere.photos[0].file, "../elsewhere/b.png");
+  const Session sphere_rebased = sphere.Rebased(dir / "out");
+  EXPECT_EQ(sphere_rebased.sample.mesh_file, "x.ply");
+  EXPECT_EQ(sphere_rebased.photos[0].file, "../elsewhere/b.png");
 }
 
 }  // namespace
