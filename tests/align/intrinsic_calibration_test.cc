@@ -16,7 +16,7 @@
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/json_reader.h"
-#include "derender/synthetic_charuco.h"
+#include "synth/synthetic_charuco.h"
 #include "tests/run_ibrdf.h"
 #include "tests/test_util.h"
 

@@ -17,8 +17,8 @@
 #include "core/json_reader.h"
 #include "core/sample_file.h"
 #include "core/session.h"
-#include "derender/synthetic.h"
 #include "reconstruct/truth_comparison.h"
+#include "synth/synthetic.h"
 #include "tests/run_ibrdf.h"
 #include "tests/test_util.h"
 
