@@ -26,9 +26,9 @@
 #include "derender/derenderer.h"
 #include "derender/mesh_sample.h"
 #include "derender/radiance_image.h"
-#include "derender/synthetic.h"
 #include "scan/ply_io.h"
 #include "scan/synthetic_scan.h"
+#include "synth/synthetic.h"
 
 namespace ibrdf {
 namespace {

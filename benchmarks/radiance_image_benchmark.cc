@@ -21,7 +21,7 @@
 #include "core/session.h"
 #include "derender/light_calibration.h"
 #include "derender/radiance_image.h"
-#include "derender/synthetic.h"
+#include "synth/synthetic.h"
 
 namespace ibrdf {
 namespace {
@@ -39,7 +39,7 @@ const Session& BenchSession(int kind) {
     fs::create_directories(root);
     const auto material = LoadMaterial(std::string(IBRDF_SAMPLES_DIR) + "/materials/bluepaint.json");
     SynthOptions options;
-    options.num_photos = 4;
+    options.rig.num_photos = 4;
     if (kind == kSrgbFlat) {
       options.effects.srgb = true;
       options.effects.black_level = 0.03;

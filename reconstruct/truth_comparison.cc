@@ -111,10 +111,15 @@ nlohmann::json ToJson(const TruthComparison& comparison) {
 }
 
 std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path) {
+  constexpr int kTruthVersion = 1;  // the one version synth writes
   const nlohmann::json json = ReadJsonFile(truth_path);
   JsonObject root(json, truth_path);
   if (root.String("format") != "ibrdf-truth") ThrowError(root.Where("format"), "expected \"ibrdf-truth\"");
-  root.Integer("version");
+  const int version = root.Integer("version");
+  if (version != kTruthVersion) {
+    ThrowError(root.Where("version"), "unknown version " + std::to_string(version) + " (this build reads version " +
+                                          std::to_string(kTruthVersion) + ")");
+  }
   root.String("material_name", "");
   root.Raw("generator");
   std::unique_ptr<BrdfModel> material = MaterialFromJson(root.Raw("material"), truth_path, "/material");

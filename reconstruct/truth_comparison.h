@@ -40,7 +40,9 @@ TruthComparison CompareWithTruth(const std::vector<BrdfSample>& samples, const B
 
 nlohmann::json ToJson(const TruthComparison& comparison);
 
-// Reads the material of a synthetic session's truth.json.
+// Reads the material of a synthetic session's truth.json ({"format": "ibrdf-truth", "version": 1, ...},
+// written by synth/synthetic.cc). Throws Error naming the file and field for another format or an
+// unknown version.
 std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path);
 
 // truth.json beside the session the samples came from, as the samples' sidecar records it. Throws Error

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "core/brdf_model.h"
-#include "derender/synthetic.h"
+#include "synth/synthetic.h"
 #include "tests/scratch_dir.h"
 
 namespace ibrdf::testing {

@@ -26,10 +26,10 @@ using testing::ScratchDir;
 
 SynthOptions TargetOptions(int photos) {
   SynthOptions options;
-  options.targets = true;
-  options.camera_elevation_deg = 45.0;
-  options.num_photos = photos;
-  options.light_target_photos = 3;  // and 3 photos of the light's markers (role "targets")
+  options.targets.enabled = true;
+  options.rig.camera_elevation_deg = 45.0;
+  options.rig.num_photos = photos;
+  options.targets.light_photos = 3;  // and 3 photos of the light's markers (role "targets")
   return options;
 }
 
@@ -103,8 +103,8 @@ TEST(Align, MarkerIdListedTwiceIsAnError) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options = TargetOptions(1);
-  options.width = 160;
-  options.height = 120;
+  options.rig.width = 160;
+  options.rig.height = 120;
   Session session = Session::Load(MakeSession(dir / "s", options, material));
   session.targets->reference[1].id = session.targets->reference[0].id;
   session.Save(dir / "s/session.json");
@@ -177,9 +177,9 @@ TEST(Align, LightTargetsAndPhotoRolesInTheSessionFile) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options = TargetOptions(1);
-  options.width = 160;
-  options.height = 120;
-  options.light_target_photos = 1;
+  options.rig.width = 160;
+  options.rig.height = 120;
+  options.targets.light_photos = 1;
   const Session session = Session::Load(MakeSession(dir / "s", options, material));
   ASSERT_TRUE(session.targets->light);
   EXPECT_EQ(session.targets->light->markers.size(), 2u);
@@ -220,9 +220,9 @@ TEST(Align, SessionWithoutTargetsIsAnError) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options;
-  options.num_photos = 1;
-  options.width = 64;
-  options.height = 48;
+  options.rig.num_photos = 1;
+  options.rig.width = 64;
+  options.rig.height = 48;
   const Session session = Session::Load(MakeSession(dir / "s", options, material));
   try {
     AlignSession(session, AlignOptions());

@@ -27,9 +27,9 @@ constexpr double kDegree = M_PI / 180.0;
 
 SynthOptions FreeLayoutOptions(int photos) {
   SynthOptions options;
-  options.targets = true;
-  options.camera_elevation_deg = 45.0;
-  options.num_photos = photos;
+  options.targets.enabled = true;
+  options.rig.camera_elevation_deg = 45.0;
+  options.rig.num_photos = photos;
   return options;
 }
 
@@ -172,8 +172,8 @@ TEST(BundleAdjustment, UnknownLayoutInTheSessionFile) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options = FreeLayoutOptions(1);
-  options.width = 160;
-  options.height = 120;
+  options.rig.width = 160;
+  options.rig.height = 120;
   const Session session = Session::Load(MakeSession(dir / "s", options, material));
   nlohmann::json json = session.ToJson();
   json["targets"].erase("reference");
@@ -214,7 +214,7 @@ TEST(BundleAdjustment, MixedKnownAndUnknownLayout) {
   const Session truth = Session::Load(MakeSession(dir / "s", options, material));
   Session session = truth;
   UnknownLayoutSpec layout;
-  layout.size = options.target_size;
+  layout.size = options.targets.marker_size;
   session.targets->reference.clear();
   for (const TargetSpec& target : truth.targets->reference) {
     if (target.id % 2 == 0) {

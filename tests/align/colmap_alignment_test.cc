@@ -120,10 +120,10 @@ TEST(ColmapAlignment, DefaultOptionsAreValid) {
 TEST(ColmapAlignment, RecoversTheSimilarityOfASyntheticSession) {
   ScratchDir dir;
   SynthOptions options;
-  options.width = 200;
-  options.height = 150;
-  options.num_photos = 8;
-  options.camera_elevation_deg = 20.0;
+  options.rig.width = 200;
+  options.rig.height = 150;
+  options.rig.num_photos = 8;
+  options.rig.camera_elevation_deg = 20.0;
   const auto material = LoadMaterial(MaterialPath("bluepaint"));
   const Session session = Session::Load(MakeSession(dir / "s", options, *material));
   const Similarity3d truth = RandomSimilarity(11);
@@ -287,9 +287,9 @@ TEST(ColmapAlignment, MergeColmapPosesPhotoByPhoto) {
 TEST(ColmapAlignment, AlignStageWithAColmapModel) {
   ScratchDir dir;
   SynthOptions options;
-  options.targets = true;
-  options.camera_elevation_deg = 45.0;
-  options.num_photos = 6;
+  options.targets.enabled = true;
+  options.rig.camera_elevation_deg = 45.0;
+  options.rig.num_photos = 6;
   const auto material = LoadMaterial(MaterialPath("bluepaint"));
   const Session session = Session::Load(MakeSession(dir / "s", options, *material));
   const Similarity3d truth = RandomSimilarity(21);

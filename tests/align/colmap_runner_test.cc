@@ -42,9 +42,9 @@ std::string Script(const std::string& path, const std::string& body) {
 
 Session SmallSession(const ScratchDir& dir) {
   SynthOptions options;
-  options.width = 200;
-  options.height = 150;
-  options.num_photos = 3;
+  options.rig.width = 200;
+  options.rig.height = 150;
+  options.rig.num_photos = 3;
   const auto material = LoadMaterial(MaterialPath("bluepaint"));
   return Session::Load(MakeSession(dir / "s", options, *material));
 }

@@ -11,8 +11,8 @@
 
 #include "align/aligner.h"
 #include "derender/derenderer.h"
-#include "derender/synthetic_targets.h"
 #include "reconstruct/truth_comparison.h"
+#include "synth/synthetic_targets.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -33,9 +33,9 @@ TEST(CylinderFit, DefaultOptionsAreValid) {
 // out; a single marker is too little (a clear reason, the sample stays as given).
 TEST(CylinderFit, RigidFitOfExactCornersAndOutliers) {
   SynthOptions options;
-  options.targets = true;
-  options.sample = SampleSpec::Kind::kCylinder;
-  options.sample_marker_count = 4;
+  options.targets.enabled = true;
+  options.scene.sample = SampleSpec::Kind::kCylinder;
+  options.targets.sample_marker_count = 4;
   const SampleTargetsSpec spec = SampleTargetLayout(options, nullptr);
   ASSERT_EQ(spec.markers.size(), 4u);
   const Rigid3d world_from_sample(Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d(1, 2, 0).normalized())),
@@ -72,10 +72,10 @@ TEST(CylinderFit, CylinderSessionFromItsOwnPhotos) {
   ScratchDir dir;
   const auto material = LoadMaterial(MaterialPath("bluepaint"));
   SynthOptions options;
-  options.sample = SampleSpec::Kind::kCylinder;
-  options.targets = true;
-  options.camera_elevation_deg = 45.0;
-  options.num_photos = 6;
+  options.scene.sample = SampleSpec::Kind::kCylinder;
+  options.targets.enabled = true;
+  options.rig.camera_elevation_deg = 45.0;
+  options.rig.num_photos = 6;
   const Session truth = Session::Load(MakeSession(dir / "s", options, *material));
   ASSERT_TRUE(truth.targets->sample);
   Session guess = truth;

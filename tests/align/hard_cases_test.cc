@@ -24,9 +24,9 @@ constexpr double kDegree = M_PI / 180.0;
 
 SynthOptions HardCaseOptions(int photos) {
   SynthOptions options;
-  options.targets = true;
-  options.camera_elevation_deg = 45.0;
-  options.num_photos = photos;
+  options.targets.enabled = true;
+  options.rig.camera_elevation_deg = 45.0;
+  options.rig.num_photos = photos;
   return options;
 }
 
@@ -219,9 +219,9 @@ TEST(HardCasesBesideTheLight, CameraBesideTheLight) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options = HardCaseOptions(2);
-  options.camera_elevation_deg = 30.0;
-  options.arc_start_deg = 1.0;
-  options.arc_end_deg = 4.0;
+  options.rig.camera_elevation_deg = 30.0;
+  options.rig.arc_start_deg = 1.0;
+  options.rig.arc_end_deg = 4.0;
   const Session truth = Session::Load(MakeSession(dir / "s", options, material));
   bool aligned = false;
   const AlignResult result = AlignOrNothing(truth, AlignOptions(), &aligned);
@@ -237,7 +237,7 @@ TEST(HardCasesHidden, MarkersPartlyHiddenBySample) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options = HardCaseOptions(3);
-  options.camera_elevation_deg = 30.0;
+  options.rig.camera_elevation_deg = 30.0;
   const Session truth = Session::Load(MakeSession(dir / "s", options, material));
   bool aligned = false;
   const AlignResult result = AlignOrNothing(truth, PosesOnly(), &aligned);

@@ -18,7 +18,7 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
-#include "derender/synthetic_charuco.h"
+#include "synth/synthetic_charuco.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -152,10 +152,10 @@ TEST(IntrinsicCalibration, AlignStageCalibratesThenAligns) {
   ScratchDir dir;
   // As `ibrdf synth --targets --photos 4 --light-photos 0 --charuco-photos 24` makes it.
   SynthOptions synth;
-  synth.targets = true;
-  synth.camera_elevation_deg = 45.0;
-  synth.num_photos = 4;
-  synth.light_target_photos = 0;
+  synth.targets.enabled = true;
+  synth.rig.camera_elevation_deg = 45.0;
+  synth.rig.num_photos = 4;
+  synth.targets.light_photos = 0;
   testing::MakeSession(dir / "s", synth, *LoadMaterial(testing::MaterialPath("bluepaint")));
   CharucoPhotoOptions board;
   board.num_photos = 24;

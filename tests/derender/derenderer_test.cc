@@ -25,7 +25,7 @@ using testing::ScratchDir;
 
 SynthOptions NoiseFree(SampleSpec::Kind kind = SampleSpec::Kind::kSphere) {
   SynthOptions options;
-  options.sample = kind;
+  options.scene.sample = kind;
   options.effects = CameraEffects::None();
   return options;
 }
@@ -33,7 +33,7 @@ SynthOptions NoiseFree(SampleSpec::Kind kind = SampleSpec::Kind::kSphere) {
 // A noise-free session of a Lambertian sphere of albedo 0.5 with `photos` photos.
 Session LambertianSession(const ScratchDir& dir, int photos, SynthOptions options = NoiseFree()) {
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
-  options.num_photos = photos;
+  options.rig.num_photos = photos;
   return Session::Load(MakeSession(dir / "s", options, material));
 }
 
@@ -82,7 +82,7 @@ TEST(Derender, BluepaintSphereWithCameraNoise) {
   ScratchDir dir;
   const auto material = LoadMaterial(MaterialPath("bluepaint"));
   SynthOptions options;
-  options.num_photos = 10;
+  options.rig.num_photos = 10;
   const Session session = Session::Load(MakeSession(dir / "s", options, *material));
   ASSERT_TRUE(session.radiometry.noise.has_value());
   const DerenderResult result = DerenderAnalytic(session, DerenderOptions());
@@ -117,9 +117,9 @@ TEST(Derender, PrimerCylinderSamplesLieInIncidencePlane) {
   const DerenderResult result = DerenderAnalytic(session, DerenderOptions());
   ASSERT_GT(result.samples.size(), 200000u);
   // Bound from the geometry: the strip's half-height seen from the camera and from the light.
-  const double half = 0.5 * options.cylinder_length;
-  const double bound = std::atan(half / (options.camera_distance - options.sample_radius)) +
-                       std::atan(half / (options.light_distance - options.sample_radius));
+  const double half = 0.5 * options.scene.cylinder_length;
+  const double bound = std::atan(half / (options.rig.camera_distance - options.scene.sample_radius)) +
+                       std::atan(half / (options.scene.light_distance - options.scene.sample_radius));
   // n . (wi x wo) vanishes for coplanar directions; with n horizontal it is bounded by the sum of the
   // sines of wi's and wo's tilts out of the horizontal plane.
   double worst = 0.0;
@@ -138,8 +138,8 @@ TEST(Derender, FarFromOriginGivesSameSamples) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options = NoiseFree();
-  options.num_photos = 4;
-  options.origin = Eigen::Vector3d(1e4, -1e4, 2e3);
+  options.rig.num_photos = 4;
+  options.scene.origin = Eigen::Vector3d(1e4, -1e4, 2e3);
   const Session session = Session::Load(MakeSession(dir / "s", options, material));
   const DerenderResult result = DerenderAnalytic(session, DerenderOptions());
   ASSERT_GT(result.samples.size(), 100000u);
@@ -153,7 +153,7 @@ TEST(Derender, SrgbEightBitWithBlackLevelIsLinearized) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options = NoiseFree();
-  options.num_photos = 4;
+  options.rig.num_photos = 4;
   options.effects.srgb = true;
   options.effects.bits = 8;
   options.effects.black_level = 0.02;
@@ -177,8 +177,8 @@ TEST(Derender, SaturatedPixelsAreRejectedAndCounted) {
   ScratchDir dir;
   const auto material = LoadMaterial(MaterialPath("glossy-ggx"));
   SynthOptions options = NoiseFree();
-  options.num_photos = 4;
-  options.exposure_target = 1.0;  // the highlight clips
+  options.rig.num_photos = 4;
+  options.rig.exposure_target = 1.0;  // the highlight clips
   const Session session = Session::Load(MakeSession(dir / "s", options, *material));
   const DerenderResult result = DerenderAnalytic(session, DerenderOptions());
   EXPECT_GT(result.summary.rejected.at("saturated"), 0u);

@@ -32,9 +32,9 @@ constexpr double kAlbedo = 0.5;
 // Small, noise-free sphere sessions: 200 x 150 pixels, 4 photos.
 SynthOptions SmallSphere() {
   SynthOptions options;
-  options.width = 200;
-  options.height = 150;
-  options.num_photos = 4;
+  options.rig.width = 200;
+  options.rig.height = 150;
+  options.rig.num_photos = 4;
   options.effects = CameraEffects::None();
   return options;
 }
@@ -120,13 +120,13 @@ TEST(MeshDerender, FarFromOriginGivesSameSamples) {
   WritePly(dir / "near/sphere.ply", sphere);
   const DerenderResult near_result = Derender(WithMesh(near_analytic, "sphere.ply"), DerenderOptions());
   SynthOptions far_options = SmallSphere();
-  far_options.origin = Eigen::Vector3d(1e4, -1e4, 2e3);
+  far_options.scene.origin = Eigen::Vector3d(1e4, -1e4, 2e3);
   const Session far_analytic = LambertianSession(dir / "far", far_options);
   ScanMesh far_sphere = sphere;
-  for (Eigen::Vector3d& p : far_sphere.points) p += far_options.origin;
+  for (Eigen::Vector3d& p : far_sphere.points) p += far_options.scene.origin;
   WritePly(dir / "far/sphere.ply", sphere);
   WritePly(dir / "far/far-sphere.ply", far_sphere);
-  const Sim3d moved(Eigen::Quaterniond::Identity(), far_options.origin, 1.0);
+  const Sim3d moved(Eigen::Quaterniond::Identity(), far_options.scene.origin, 1.0);
   for (const Session& far : {WithMesh(far_analytic, "sphere.ply", moved), WithMesh(far_analytic, "far-sphere.ply")}) {
     const DerenderResult far_result = Derender(far, DerenderOptions());
     ASSERT_GT(near_result.samples.size(), 10000u);

@@ -20,9 +20,9 @@
 #include "core/sample_file.h"
 #include "core/session.h"
 #include "derender/derenderer.h"
-#include "derender/synthetic.h"
 #include "reconstruct/truth_comparison.h"
 #include "scan/scan_pipeline.h"
+#include "synth/synthetic.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -38,18 +38,18 @@ using testing::ScratchDir;
 // [--fill-light F]` makes it.
 void Synth(const std::string& shape, const std::string& out, double scan_offset_m, double fill_light = 0.0) {
   SynthOptions options;
-  options.shape = SynthShapeFromName(shape);
-  options.targets = true;
-  options.camera_elevation_deg = 45.0;
-  options.light_target_photos = 0;
+  options.scene.shape = SynthShapeFromName(shape);
+  options.targets.enabled = true;
+  options.rig.camera_elevation_deg = 45.0;
+  options.targets.light_photos = 0;
   options.effects = CameraEffects::None();
-  options.width = 640;
-  options.height = 480;
-  options.num_photos = 4;
-  options.scanner.spacing_m = 0.0015;
-  options.truth_mesh_spacing_m = 0.0015;
-  options.scan_offset_m = scan_offset_m;
-  options.fill_light = fill_light;
+  options.rig.width = 640;
+  options.rig.height = 480;
+  options.rig.num_photos = 4;
+  options.scan.scanner.spacing_m = 0.0015;
+  options.scan.truth_mesh_spacing_m = 0.0015;
+  options.scan.offset_m = scan_offset_m;
+  options.scene.fill_light = fill_light;
   const std::string material = testing::MaterialPath("bluepaint");
   ASSERT_TRUE(WriteSyntheticSession(options, *LoadMaterial(material), material, out, false).success);
 }
@@ -57,11 +57,9 @@ void Synth(const std::string& shape, const std::string& out, double scan_offset_
 // The scan stage on the session's range grids into its sample's mesh file (as `ibrdf scan` does).
 void ScanSession(const std::string& dir) {
   const Session session = Session::Load(dir);
-  std::vector<ScanInput> inputs;
-  for (const ScanInputSpec& input : session.sample.scan_inputs)
-    inputs.push_back({ResolvePath(session.directory, input.file), std::nullopt});
   const ScanOptions options;
-  WriteScanOutputs(ResolvePath(session.directory, session.sample.mesh_file), RunScan(inputs, options), options);
+  WriteScanOutputs(ResolvePath(session.directory, session.sample.mesh_file), RunScan(InputsFromSession(session), options),
+                   options);
 }
 
 void Align(const std::string& session, const std::string& out) {

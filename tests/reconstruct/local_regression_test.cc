@@ -169,9 +169,9 @@ TEST(LocalRegression, CylinderIsScoredOverTheDomainItCovers) {
   ScratchDir dir;
   SynthOptions options;
   options.effects = CameraEffects::None();
-  options.sample = SampleSpec::Kind::kCylinder;
-  options.width = 400;
-  options.height = 300;
+  options.scene.sample = SampleSpec::Kind::kCylinder;
+  options.rig.width = 400;
+  options.rig.height = 300;
   const Session session = Session::Load(MakeSession(dir / "s", options, *material));
   const auto samples = DerenderAnalytic(session, DerenderOptions()).samples;
   ASSERT_GT(samples.size(), 1000u);

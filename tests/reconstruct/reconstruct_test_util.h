@@ -15,9 +15,9 @@ inline std::vector<BrdfSample> SessionSamples(const BrdfModel& material, const C
   ScratchDir dir;
   SynthOptions options;
   options.effects = effects;
-  options.num_photos = photos;
-  options.width = width;
-  options.height = height;
+  options.rig.num_photos = photos;
+  options.rig.width = width;
+  options.rig.height = height;
   const Session session = Session::Load(MakeSession(dir / "s", options, material));
   return DerenderAnalytic(session, DerenderOptions()).samples;
 }

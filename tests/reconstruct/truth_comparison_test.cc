@@ -2,11 +2,13 @@
 #include "reconstruct/truth_comparison.h"
 
 #include <cmath>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
 #include "core/brdf_coords.h"
 #include "core/error.h"
+#include "tests/scratch_dir.h"
 
 namespace ibrdf {
 namespace {
@@ -65,6 +67,29 @@ TEST(TruthComparison, ZeroTruthIsSkippedNotDividedBy) {
   EXPECT_EQ(comparison.skipped_zero_truth, 1u);
   EXPECT_EQ(comparison.overall.count, 0u);
   EXPECT_TRUE(comparison.overall.median.allFinite());
+}
+
+// truth.json's format and version are checked: an unknown version is an Error naming the file and field.
+TEST(TruthComparison, LoadTruthMaterialRejectsUnknownVersions) {
+  testing::ScratchDir dir;
+  auto write = [&](const std::string& name, const std::string& format, int version) {
+    std::ofstream(dir / name) << "{\"format\": \"" << format << "\", \"version\": " << version
+                              << ", \"material_name\": \"grey\", \"generator\": {}, "
+                                 "\"material\": {\"model\": \"lambertian\", \"albedo\": [0.5, 0.5, 0.5]}}";
+    return dir / name;
+  };
+  EXPECT_NO_THROW(LoadTruthMaterial(write("v1.json", "ibrdf-truth", 1)));
+  const std::string v2 = write("v2.json", "ibrdf-truth", 2);
+  try {
+    LoadTruthMaterial(v2);
+    ADD_FAILURE() << "version 2 was accepted";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(v2), std::string::npos) << message;
+    EXPECT_NE(message.find("version"), std::string::npos) << message;
+  }
+  EXPECT_THROW(LoadTruthMaterial(write("v0.json", "ibrdf-truth", 0)), Error);
+  EXPECT_THROW(LoadTruthMaterial(write("other.json", "ibrdf-alignment", 1)), Error);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-#include "derender/synthetic_radiometry.h"
+#include "synth/synthetic_radiometry.h"
 
 #include <algorithm>
 #include <atomic>
@@ -12,31 +12,10 @@
 #include "core/light.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
-#include "derender/synthetic.h"
 
 namespace fs = std::filesystem;
 
 namespace ibrdf {
-
-bool SynthRadiometryOptions::Check(std::string* why) const {
-  if (brackets < 1 || brackets > 16) {
-    *why = "brackets must be 1 to 16";
-    return false;
-  }
-  if (!(bracket_step_ev > 0.0 && bracket_step_ev <= 8.0)) {
-    *why = "bracket_step_ev must be in (0, 8]";
-    return false;
-  }
-  if (!(white_reflectance > 0.0 && white_reflectance <= 1.0) || !(white_size > 0.0)) {
-    *why = "the white reference needs a reflectance in (0, 1] and a positive size";
-    return false;
-  }
-  if (!(white_exposure_scale > 0.0)) {
-    *why = "white_exposure_scale must be positive";
-    return false;
-  }
-  return true;
-}
 
 double VignettingAt(const Camera& camera, double strength, double x, double y) {
   if (strength <= 0.0) return 1.0;
@@ -210,7 +189,7 @@ void WriteSynthCalibration(const SynthOptions& options, const std::string& direc
     PhotoSpec photo;
     photo.file = std::string("calibration/white-000.") + (effects.bits == 0 ? "exr" : "png");
     photo.camera_from_world = first->camera_from_world;
-    photo.exposure_s = radiometry.white_exposure_scale * options.exposure_target / level;
+    photo.exposure_s = radiometry.white_exposure_scale * options.rig.exposure_target / level;
     photo.gain = 1.0;
     for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
     ApplyVignetting(session->camera, effects.vignetting, &image);

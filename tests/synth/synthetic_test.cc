@@ -1,5 +1,5 @@
 // The synthetic session generator: reproducible, loadable, and physically placed as in the paper.
-#include "derender/synthetic.h"
+#include "synth/synthetic.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,8 +16,8 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "core/session.h"
-#include "derender/synthetic_shapes.h"
 #include "scan/ply_io.h"
+#include "synth/synthetic_shapes.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -39,7 +39,7 @@ TEST(Synth, DefaultOptionsAreValid) {
   EXPECT_TRUE(CameraEffects().Check(&why)) << why;
   EXPECT_TRUE(CameraEffects::None().Check(&why)) << why;
   SynthOptions bad;
-  bad.camera_distance = 0.01;
+  bad.rig.camera_distance = 0.01;
   EXPECT_FALSE(bad.Check(&why));
 }
 
@@ -47,9 +47,9 @@ TEST(Synth, FixedSeedIsReproducibleAndSeedsDiffer) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options;
-  options.num_photos = 2;
-  options.width = 160;
-  options.height = 120;
+  options.rig.num_photos = 2;
+  options.rig.width = 160;
+  options.rig.height = 120;
   MakeSession(dir / "a", options, material);
   MakeSession(dir / "b", options, material);
   options.seed = 2;
@@ -64,9 +64,9 @@ TEST(Synth, SessionLoadsWithPosesOnTheArc) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options;
-  options.num_photos = 5;
-  options.width = 160;
-  options.height = 120;
+  options.rig.num_photos = 5;
+  options.rig.width = 160;
+  options.rig.height = 120;
   const Session session = Session::Load(MakeSession(dir / "s", options, material));
   ASSERT_EQ(session.photos.size(), 5u);
   const Eigen::Vector3d to_light = (session.light.position - session.sample.center).normalized();
@@ -75,9 +75,10 @@ TEST(Synth, SessionLoadsWithPosesOnTheArc) {
     ASSERT_TRUE(photo.camera_from_world.has_value());
     EXPECT_GT(photo.exposure_s, 0.0);
     const Eigen::Vector3d center = photo.camera_from_world->Inverse().translation;
-    EXPECT_NEAR((center - session.sample.center).norm(), options.camera_distance, 1e-9);
+    EXPECT_NEAR((center - session.sample.center).norm(), options.rig.camera_distance, 1e-9);
     const double azimuth = std::acos(to_light.dot((center - session.sample.center).normalized())) * 180.0 / M_PI;
-    EXPECT_NEAR(azimuth, options.arc_start_deg + i * (options.arc_end_deg - options.arc_start_deg) / 4, 1e-6);
+    EXPECT_NEAR(azimuth, options.rig.arc_start_deg + i * (options.rig.arc_end_deg - options.rig.arc_start_deg) / 4,
+                1e-6);
     // The sample centre projects to the principal point.
     const Eigen::Vector2d pixel = session.camera.ImageFromCamera(*photo.camera_from_world * session.sample.center);
     EXPECT_NEAR(pixel.x(), 80.0, 1e-6);
@@ -91,9 +92,9 @@ TEST(Synth, AutoExposurePutsThe99thPercentileAtTheTarget) {
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options;
   options.effects = CameraEffects::None();
-  options.num_photos = 1;
-  options.width = 200;
-  options.height = 150;
+  options.rig.num_photos = 1;
+  options.rig.width = 200;
+  options.rig.height = 150;
   const Session session = Session::Load(MakeSession(dir / "s", options, material));
   const Image image = ReadImage(session.PhotoPath(0));
   std::vector<float> lit;
@@ -102,7 +103,7 @@ TEST(Synth, AutoExposurePutsThe99thPercentileAtTheTarget) {
   }
   std::sort(lit.begin(), lit.end());
   ASSERT_FALSE(lit.empty());
-  EXPECT_NEAR(lit[size_t(0.99 * (lit.size() - 1))], options.exposure_target, 0.02);
+  EXPECT_NEAR(lit[size_t(0.99 * (lit.size() - 1))], options.rig.exposure_target, 0.02);
 }
 
 // Supersampling averages n x n rays over the pixel: inside the disc it matches the centre ray of a
@@ -112,9 +113,9 @@ TEST(Synth, SupersamplingAveragesOverThePixel) {
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options;
   options.effects = CameraEffects::None();
-  options.num_photos = 1;
-  options.width = 200;
-  options.height = 150;
+  options.rig.num_photos = 1;
+  options.rig.width = 200;
+  options.rig.height = 150;
   const Session session = Session::Load(MakeSession(dir / "s", options, material));
   std::vector<uint8_t> mask;
   const Image centre = RenderRadiance(session, 0, material, 1, &mask);
@@ -148,9 +149,9 @@ TEST(Synth, ExistingOutputIsNotReplacedWithoutOverwrite) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options;
-  options.num_photos = 1;
-  options.width = 64;
-  options.height = 48;
+  options.rig.num_photos = 1;
+  options.rig.width = 64;
+  options.rig.height = 48;
   MakeSession(dir / "s", options, material);
   EXPECT_THROW(WriteSyntheticSession(options, material, "test", dir / "s", /*overwrite=*/false), Error);
   EXPECT_TRUE(std::filesystem::exists(dir / "s/session.json"));
@@ -182,9 +183,9 @@ TEST(SynthShapes, DefaultParametersAreValid) {
   EXPECT_FALSE(bad.Check(&why));
   EXPECT_THROW(DentedSphereSample(Eigen::Vector3d::Zero(), bad), Error);
   SynthOptions options;
-  options.shape = SynthOptions::Shape::kSquash;
+  options.scene.shape = SynthShape::kSquash;
   EXPECT_FALSE(options.Check(&why));  // needs targets
-  options.targets = true;
+  options.targets.enabled = true;
   EXPECT_TRUE(options.Check(&why)) << why;
 }
 
@@ -281,19 +282,19 @@ TEST(SynthShapes, SizesAndRestingPoint) {
   EXPECT_LT((normal - Eigen::Vector3d::UnitX()).norm(), 1e-12);
 }
 
-SynthOptions SmallShapeSession(SynthOptions::Shape shape) {
+SynthOptions SmallShapeSession(SynthShape shape) {
   SynthOptions options;
-  options.shape = shape;
-  options.targets = true;
-  options.camera_elevation_deg = 45.0;
-  options.num_photos = 3;
-  options.width = 200;
-  options.height = 150;
+  options.scene.shape = shape;
+  options.targets.enabled = true;
+  options.rig.camera_elevation_deg = 45.0;
+  options.rig.num_photos = 3;
+  options.rig.width = 200;
+  options.rig.height = 150;
   options.effects = CameraEffects::None();
-  options.scanner.spacing_m = 0.003;
-  options.scanner.views_around = 4;
-  options.scan_offset_m = 1e4;
-  options.truth_mesh_spacing_m = 0.004;
+  options.scan.scanner.spacing_m = 0.003;
+  options.scan.scanner.views_around = 4;
+  options.scan.offset_m = 1e4;
+  options.scan.truth_mesh_spacing_m = 0.004;
   return options;
 }
 
@@ -303,10 +304,10 @@ TEST(SynthShapes, DentCastsAShadowOnItself) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   const SynthSummary dent =
-      WriteSyntheticSession(SmallShapeSession(SynthOptions::Shape::kDent), material, "test", dir / "dent", false);
+      WriteSyntheticSession(SmallShapeSession(SynthShape::kDent), material, "test", dir / "dent", false);
   EXPECT_GT(dent.shadowed_pixels, 30u);
   const SynthSummary pot =
-      WriteSyntheticSession(SmallShapeSession(SynthOptions::Shape::kPot), material, "test", dir / "pot", false);
+      WriteSyntheticSession(SmallShapeSession(SynthShape::kPot), material, "test", dir / "pot", false);
   EXPECT_EQ(pot.shadowed_pixels, 0u);
 }
 
@@ -315,7 +316,7 @@ TEST(SynthShapes, DentCastsAShadowOnItself) {
 TEST(SynthShapes, ShapeSessionHasScansTargetsAndTruth) {
   ScratchDir dir;
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
-  const SynthOptions options = SmallShapeSession(SynthOptions::Shape::kSquash);
+  const SynthOptions options = SmallShapeSession(SynthShape::kSquash);
   const SynthSummary summary = WriteSyntheticSession(options, material, "test", dir / "s", false);
   EXPECT_EQ(summary.scan_views, 5);
   const Session session = Session::Load(dir / "s");
@@ -324,14 +325,14 @@ TEST(SynthShapes, ShapeSessionHasScansTargetsAndTruth) {
   ASSERT_EQ(session.sample.scan_inputs.size(), 5u);
   ASSERT_TRUE(session.targets.has_value());
   ASSERT_EQ(session.sample.scan_targets.size(), session.targets->reference.size());
-  const Rigid3d scan_from_world = ScanFromWorld(options);
+  const Rigid3d scan_from_world = ScanFromWorld(options.scan);
   for (size_t i = 0; i < session.sample.scan_targets.size(); ++i) {
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector3d world = scan_from_world.Inverse() * session.sample.scan_targets[i].corners[k];
-      EXPECT_LT((world - session.targets->reference[i].corners[k]).norm(), 6 * options.scan_target_noise_m);
+      EXPECT_LT((world - session.targets->reference[i].corners[k]).norm(), 6 * options.scan.target_noise_m);
     }
   }
-  const std::unique_ptr<ImplicitSample> truth = MakeTrueShape(options);
+  const std::unique_ptr<ImplicitSample> truth = MakeTrueShape(options.scene);
   const Rigid3d world_from_scan = scan_from_world.Inverse();
   size_t points = 0;
   for (const ScanInputSpec& input : session.sample.scan_inputs) {
@@ -340,7 +341,7 @@ TEST(SynthShapes, ShapeSessionHasScansTargetsAndTruth) {
     EXPECT_GT(view.points.front().norm(), 9e3);  // scanner coordinates
     for (const Eigen::Vector3d& p : view.points) {
       // Range noise of 0.1 mm along the ray: within 6 sigma of the surface.
-      ASSERT_LT(std::abs(truth->Evaluate(world_from_scan * p - options.origin, nullptr)), 6e-4);
+      ASSERT_LT(std::abs(truth->Evaluate(world_from_scan * p - options.scene.origin, nullptr)), 6e-4);
     }
     points += view.points.size();
   }
@@ -349,7 +350,7 @@ TEST(SynthShapes, ShapeSessionHasScansTargetsAndTruth) {
   ASSERT_EQ(mesh.normals.size(), mesh.points.size());
   for (size_t i = 0; i < mesh.points.size(); i += 7) {
     Eigen::Vector3d gradient;
-    EXPECT_LT(std::abs(truth->Evaluate(mesh.points[i] - options.origin, &gradient)), 1e-12);
+    EXPECT_LT(std::abs(truth->Evaluate(mesh.points[i] - options.scene.origin, &gradient)), 1e-12);
     EXPECT_LT((mesh.normals[i] - gradient.normalized()).norm(), 1e-6);
   }
   const nlohmann::json truth_json = ReadJsonFile(dir / "s/truth.json");

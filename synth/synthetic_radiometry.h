@@ -1,7 +1,8 @@
 // The radiometric side of synthetic sessions (docs/radiometry.md): the sensor (shot and read noise,
 // black level, clipping, response, quantization), vignetting and its flat-field image, exposure
 // brackets, and the white-reference photo that calibrates an unknown light. Called from
-// WriteSyntheticSession (synthetic.cc) at a few marked hooks.
+// WriteSyntheticSession (synth/synthetic.cc) at a few marked hooks; the options are
+// SynthRadiometryOptions and CameraEffects (synth/synth_options.h).
 #pragma once
 
 #include <cstdint>
@@ -12,31 +13,9 @@
 #include "core/camera.h"
 #include "core/image_io.h"
 #include "core/session.h"
+#include "synth/synth_options.h"
 
 namespace ibrdf {
-
-struct CameraEffects;
-struct SynthOptions;
-
-// Exposure brackets and the light's calibration in a synthetic session.
-struct SynthRadiometryOptions {
-  // Exposures per camera pose: the auto-exposure and brackets - 1 shorter ones, each bracket_step_ev
-  // stops below the one before (the highlights a single exposure clips), all with the pose's
-  // `bracket` id. 1: no brackets.
-  int brackets = 1;
-  double bracket_step_ev = 2.0;
-  // The session states a unit light intensity (1, 1, 1) instead of the true one and carries a white
-  // reference (calibration.white_reference) that recovers it: one photo of a flat target of albedo
-  // white_reflectance and side white_size at the sample's centre (the sample taken away), facing
-  // between the light and the first camera, from the first camera's pose.
-  bool light_unknown = false;
-  double white_reflectance = 0.99;
-  double white_size = 0.05;  // metres
-  // The white-reference photo's exposure relative to its auto-exposure (> 1.25 clips the target).
-  double white_exposure_scale = 1.0;
-
-  bool Check(std::string* why) const;
-};
 
 // Relative sensitivity of a pixel (col + 0.5, row + 0.5 at its centre) under natural vignetting of
 // the given strength: cos^4 of an effective field angle that grows with the distance r from the

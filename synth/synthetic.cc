@@ -1,4 +1,4 @@
-#include "derender/synthetic.h"
+#include "synth/synthetic.h"
 
 #include <algorithm>
 #include <atomic>
@@ -21,9 +21,9 @@
 #include "core/radiometry.h"
 #include "core/statistics.h"
 #include "derender/analytic_sample.h"
-#include "derender/synthetic_radiometry.h"
-#include "derender/synthetic_targets.h"
 #include "scan/ply_io.h"
+#include "synth/synthetic_radiometry.h"
+#include "synth/synthetic_targets.h"
 
 namespace fs = std::filesystem;
 
@@ -37,8 +37,60 @@ constexpr char kTruthMesh[] = "truth-mesh.ply";
 
 // The true shape a session renders: the irregular shape, or the session's own sphere or cylinder.
 std::unique_ptr<AnalyticSample> TrueSample(const SynthOptions& options, const Session& session) {
-  if (options.shape != SynthOptions::Shape::kNone) return MakeTrueShape(options);
+  if (options.scene.shape != SynthShape::kNone) return MakeTrueShape(options.scene);
   return AnalyticSample::Create(session.sample);
+}
+
+// The measurement photos: cameras on the arc, evenly spaced in azimuth from the light direction.
+std::vector<PhotoSpec> ArcPhotos(const SynthOptions& options) {
+  std::vector<PhotoSpec> photos;
+  const CameraEffects& effects = options.effects;
+  const double elevation = options.rig.camera_elevation_deg * kDegree;
+  for (int i = 0; i < options.rig.num_photos; ++i) {
+    const double t = options.rig.num_photos == 1 ? 0.0 : double(i) / (options.rig.num_photos - 1);
+    const double azimuth =
+        (options.rig.arc_start_deg + t * (options.rig.arc_end_deg - options.rig.arc_start_deg)) * kDegree;
+    const Eigen::Vector3d direction(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                                    std::sin(elevation));
+    PhotoSpec photo;
+    char name[32];
+    std::snprintf(name, sizeof(name), "photos/%03d.%s", i, effects.bits == 0 ? "exr" : "png");
+    photo.file = name;
+    photo.camera_from_world = LookAtCameraFromWorld(options.scene.origin + options.rig.camera_distance * direction,
+                                                    options.scene.origin, Eigen::Vector3d::UnitZ());
+    photos.push_back(photo);
+  }
+  return photos;
+}
+
+// The light-target photos (role "targets"): from behind and above the sample, opposite the light, looking past the
+// sample at the light's card, turned so the long side of the frame runs from the platform to the card; spread sideways
+// (0.25 m apart) so the card's markers are seen from several directions. None without targets.
+std::vector<PhotoSpec> LightTargetPhotos(const SynthOptions& options) {
+  std::vector<PhotoSpec> photos;
+  const CameraEffects& effects = options.effects;
+  if (options.targets.enabled && options.targets.light_photos > 0) {
+    const int n = options.targets.light_photos;
+    for (int k = 0; k < n; ++k) {
+      const double lateral = 0.25 * (k - 0.5 * (n - 1));
+      PhotoSpec photo;
+      char name[40];
+      std::snprintf(name, sizeof(name), "photos/target-%03d.%s", k, effects.bits == 0 ? "exr" : "png");
+      photo.file = name;
+      photo.role = PhotoRole::kTargets;
+      // A roll of 10 to 18 degrees keeps the markers' sides off the pixel grid: an edge along a pixel
+      // row is anti-aliased by CompositeTargets' 4 x 4 rays in quarter-pixel steps (a corner bias of up
+      // to 0.12 px, which the light's 2 m lever turns into millimetres).
+      const Rigid3d roll(Eigen::Quaterniond(Eigen::AngleAxisd((10.0 + 4.0 * k) * kDegree, Eigen::Vector3d::UnitZ())),
+                         Eigen::Vector3d::Zero());
+      photo.camera_from_world =
+          roll * LookAtCameraFromWorld(options.scene.origin + Eigen::Vector3d(-0.7, lateral, 0.55),
+                                       options.scene.origin + Eigen::Vector3d(0.35, -0.2 * lateral, -0.1),
+                                       -Eigen::Vector3d::UnitY());
+      photos.push_back(photo);
+    }
+  }
+  return photos;
 }
 
 // The session (camera, light, sample, poses) an options object describes, without photos on disk.
@@ -46,32 +98,34 @@ Session BuildSession(const SynthOptions& options) {
   Session session;
   SampleSpec& sample = session.sample;
   double bounding_radius = 0.0;
-  if (options.shape != SynthOptions::Shape::kNone) {
+  if (options.scene.shape != SynthShape::kNone) {
     sample.kind = SampleSpec::Kind::kMesh;
     sample.mesh_file = kScanMesh;
-    bounding_radius = MakeTrueShape(options)->BoundingRadius();
+    bounding_radius = MakeTrueShape(options.scene)->BoundingRadius();
   } else {
-    sample.kind = options.sample;
-    sample.center = options.origin;
-    sample.radius = options.sample_radius;
+    sample.kind = options.scene.sample;
+    sample.center = options.scene.origin;
+    sample.radius = options.scene.sample_radius;
     if (sample.kind == SampleSpec::Kind::kCylinder) {
       sample.axis = Eigen::Vector3d::UnitZ();
-      sample.length = options.cylinder_length;
+      sample.length = options.scene.cylinder_length;
     }
     bounding_radius = AnalyticSample::Create(sample)->BoundingRadius();
   }
 
   session.light.kind = Light::Kind::kPoint;
-  session.light.position = options.origin + options.light_distance * Eigen::Vector3d::UnitX();
-  session.light.intensity = options.light_intensity;
+  session.light.position = options.scene.origin + options.scene.light_distance * Eigen::Vector3d::UnitX();
+  session.light.intensity = options.scene.light_intensity;
 
-  const double framed_radius = options.targets ? std::max(bounding_radius, options.platform_radius) : bounding_radius;
-  const double half_angle = std::asin(std::min(1.0, framed_radius / options.camera_distance));
-  const double focal = options.frame_fraction * 0.5 * std::min(options.width, options.height) / std::tan(half_angle);
-  session.camera = Camera::Create(
-      CameraModelId::kOpenCV, options.width, options.height,
-      {focal, focal, 0.5 * options.width, 0.5 * options.height, options.k1, options.k2, options.p1, options.p2},
-      "synth camera");
+  const double framed_radius =
+      options.targets.enabled ? std::max(bounding_radius, options.targets.platform_radius) : bounding_radius;
+  const double half_angle = std::asin(std::min(1.0, framed_radius / options.rig.camera_distance));
+  const double focal =
+      options.rig.frame_fraction * 0.5 * std::min(options.rig.width, options.rig.height) / std::tan(half_angle);
+  session.camera = Camera::Create(CameraModelId::kOpenCV, options.rig.width, options.rig.height,
+                                  {focal, focal, 0.5 * options.rig.width, 0.5 * options.rig.height, options.rig.k1,
+                                   options.rig.k2, options.rig.p1, options.rig.p2},
+                                  "synth camera");
 
   const CameraEffects& effects = options.effects;
   session.radiometry.response.kind = effects.srgb ? Response::Kind::kSrgb : Response::Kind::kLinear;
@@ -87,9 +141,9 @@ Session BuildSession(const SynthOptions& options) {
     session.radiometry.noise = noise;
   }
 
-  if (options.targets) {
+  if (options.targets.enabled) {
     TargetsSpec targets;
-    targets.dictionary = options.target_dictionary;
+    targets.dictionary = options.targets.dictionary;
     targets.reference = TargetLayout(options);
     const SampleTargetsSpec sample_targets = SampleTargetLayout(options, nullptr);
     if (!sample_targets.markers.empty()) targets.sample = sample_targets;
@@ -98,54 +152,11 @@ Session BuildSession(const SynthOptions& options) {
     session.targets = targets;
   }
 
-  const double elevation = options.camera_elevation_deg * kDegree;
-  for (int i = 0; i < options.num_photos; ++i) {
-    const double t = options.num_photos == 1 ? 0.0 : double(i) / (options.num_photos - 1);
-    const double azimuth = (options.arc_start_deg + t * (options.arc_end_deg - options.arc_start_deg)) * kDegree;
-    const Eigen::Vector3d direction(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
-                                    std::sin(elevation));
-    PhotoSpec photo;
-    char name[32];
-    std::snprintf(name, sizeof(name), "photos/%03d.%s", i, effects.bits == 0 ? "exr" : "png");
-    photo.file = name;
-    photo.camera_from_world = LookAtCameraFromWorld(options.origin + options.camera_distance * direction,
-                                                    options.origin, Eigen::Vector3d::UnitZ());
-    session.photos.push_back(photo);
-  }
-  // Target photos: from behind and above the sample, opposite the light, looking past the sample at
-  // the light's card, turned so the long side of the frame runs from the platform to the card; spread
-  // sideways (0.25 m apart) so the card's markers are seen from several directions.
-  if (options.targets && options.light_target_photos > 0) {
-    const int n = options.light_target_photos;
-    for (int k = 0; k < n; ++k) {
-      const double lateral = 0.25 * (k - 0.5 * (n - 1));
-      PhotoSpec photo;
-      char name[40];
-      std::snprintf(name, sizeof(name), "photos/target-%03d.%s", k, effects.bits == 0 ? "exr" : "png");
-      photo.file = name;
-      photo.role = PhotoRole::kTargets;
-      // A roll of 10 to 18 degrees keeps the markers' sides off the pixel grid: an edge along a pixel
-      // row is anti-aliased by CompositeTargets' 4 x 4 rays in quarter-pixel steps (a corner bias of up
-      // to 0.12 px, which the light's 2 m lever turns into millimetres).
-      const Rigid3d roll(Eigen::Quaterniond(Eigen::AngleAxisd((10.0 + 4.0 * k) * kDegree, Eigen::Vector3d::UnitZ())),
-                         Eigen::Vector3d::Zero());
-      photo.camera_from_world =
-          roll * LookAtCameraFromWorld(options.origin + Eigen::Vector3d(-0.7, lateral, 0.55),
-                                       options.origin + Eigen::Vector3d(0.35, -0.2 * lateral, -0.1),
-                                       -Eigen::Vector3d::UnitY());
-      session.photos.push_back(photo);
-    }
-  }
+  session.photos = ArcPhotos(options);
+  const std::vector<PhotoSpec> target_photos = LightTargetPhotos(options);
+  session.photos.insert(session.photos.end(), target_photos.begin(), target_photos.end());
   ExpandBrackets(options, &session);  // radiometry hook: exposure brackets
   return session;
-}
-
-// The platform plane's height: the sample rests on it.
-double PlatformHeight(const SynthOptions& options) {
-  if (options.shape != SynthOptions::Shape::kNone) return options.origin.z() + MakeTrueShape(options)->LowestZ();
-  const double below =
-      options.sample == SampleSpec::Kind::kCylinder ? 0.5 * options.cylinder_length : options.sample_radius;
-  return options.origin.z() - below;
 }
 
 // A flat board carrying markers on white cards: the platform (a dark disk) or the light's card (a
@@ -165,11 +176,12 @@ struct Board {
 class TargetScene {
  public:
   explicit TargetScene(const SynthOptions& options)
-      : options_(options), dictionary_(options.target_dictionary, "synth --target-dictionary") {
+      : options_(options), dictionary_(options.targets.dictionary, "synth --target-dictionary") {
     Board platform;
-    platform.center = Eigen::Vector3d(options.origin.x(), options.origin.y(), PlatformHeight(options));
-    platform.radius = options.platform_radius;
-    platform.background = options.target_black;
+    platform.center =
+        Eigen::Vector3d(options.scene.origin.x(), options.scene.origin.y(), PlatformHeight(options.scene));
+    platform.radius = options.targets.platform_radius;
+    platform.background = options.targets.black;
     platform.markers = TargetLayout(options);
     boards_.push_back(platform);
     std::vector<TargetSpec> light_markers;
@@ -177,15 +189,15 @@ class TargetScene {
     if (!light_markers.empty()) {
       // The card: the markers' cards side by side, in the plane through the light facing the sample.
       Board card;
-      const Eigen::Vector3d light = options.origin + options.light_distance * Eigen::Vector3d::UnitX();
-      card.center = light - options.light_card_drop * Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d light = options.scene.origin + options.scene.light_distance * Eigen::Vector3d::UnitX();
+      card.center = light - options.targets.light_card_drop * Eigen::Vector3d::UnitZ();
       card.normal = Eigen::Vector3d::UnitX();
       card.u_axis = Eigen::Vector3d::UnitY();
       card.v_axis = Eigen::Vector3d::UnitZ();
-      const double pitch = options.light_marker_size * (1.0 + 2.0 * options.card_margin);
-      card.half_u = 0.5 * pitch * options.light_marker_count;
+      const double pitch = options.targets.light_marker_size * (1.0 + 2.0 * options.targets.card_margin);
+      card.half_u = 0.5 * pitch * options.targets.light_marker_count;
       card.half_v = 0.5 * pitch;
-      card.background = options.target_white;
+      card.background = options.targets.white;
       card.markers = light_markers;
       boards_.push_back(card);
     }
@@ -194,9 +206,9 @@ class TargetScene {
     if (!sample_markers.empty()) {
       // The cylinder's top cap: a black disk carrying the sample's markers.
       Board cap;
-      cap.center = options.origin + 0.5 * options.cylinder_length * Eigen::Vector3d::UnitZ();
-      cap.radius = options.sample_radius;
-      cap.background = options.target_black;
+      cap.center = options.scene.origin + 0.5 * options.scene.cylinder_length * Eigen::Vector3d::UnitZ();
+      cap.radius = options.scene.sample_radius;
+      cap.background = options.targets.black;
       cap.markers = sample_markers;
       boards_.push_back(cap);
     }
@@ -238,11 +250,11 @@ class TargetScene {
       const Eigen::Vector3d x_axis = c[1] - c[0], y_axis = c[3] - c[0];
       const double u = (p - c[0]).dot(x_axis) / x_axis.squaredNorm();
       const double v = (p - c[0]).dot(y_axis) / y_axis.squaredNorm();
-      const double margin = options_.card_margin;
+      const double margin = options_.targets.card_margin;
       if (u < -margin || u >= 1.0 + margin || v < -margin || v >= 1.0 + margin) continue;
-      if (u < 0.0 || u >= 1.0 || v < 0.0 || v >= 1.0) return options_.target_white;  // the card's border
+      if (u < 0.0 || u >= 1.0 || v < 0.0 || v >= 1.0) return options_.targets.white;  // the card's border
       const int col = std::min(n - 1, int(u * n)), row = std::min(n - 1, int(v * n));
-      return board.modules[m][size_t(row) * n + col] ? options_.target_white : options_.target_black;
+      return board.modules[m][size_t(row) * n + col] ? options_.targets.white : options_.targets.black;
     }
     return board.background;
   }
@@ -347,211 +359,23 @@ Image RenderRadianceImpl(const Session& session, size_t photo_index, const Analy
 
 }  // namespace
 
-const char* SynthShapeName(SynthOptions::Shape shape) {
-  switch (shape) {
-    case SynthOptions::Shape::kNone:
-      return "none";
-    case SynthOptions::Shape::kSquash:
-      return "squash";
-    case SynthOptions::Shape::kPot:
-      return "pot";
-    case SynthOptions::Shape::kDent:
-      return "dent";
-  }
-  return "none";
-}
-
-SynthOptions::Shape SynthShapeFromName(const std::string& name) {
-  for (SynthOptions::Shape shape : {SynthOptions::Shape::kNone, SynthOptions::Shape::kSquash, SynthOptions::Shape::kPot,
-                                    SynthOptions::Shape::kDent}) {
-    if (name == SynthShapeName(shape)) return shape;
-  }
-  ThrowError("synth shape", "unknown shape \"" + name + "\" (expected squash, pot or dent)");
-}
-
-std::unique_ptr<ImplicitSample> MakeTrueShape(const SynthOptions& options) {
-  switch (options.shape) {
-    case SynthOptions::Shape::kNone:
+std::unique_ptr<ImplicitSample> MakeTrueShape(const SynthSceneOptions& scene) {
+  switch (scene.shape) {
+    case SynthShape::kNone:
       return nullptr;
-    case SynthOptions::Shape::kSquash:
-      return std::make_unique<SquashSample>(options.origin, options.squash);
-    case SynthOptions::Shape::kPot:
-      return std::make_unique<PotSample>(options.origin, options.pot);
-    case SynthOptions::Shape::kDent:
-      return std::make_unique<DentedSphereSample>(options.origin, options.dent);
+    case SynthShape::kSquash:
+      return std::make_unique<SquashSample>(scene.origin, scene.squash);
+    case SynthShape::kPot:
+      return std::make_unique<PotSample>(scene.origin, scene.pot);
+    case SynthShape::kDent:
+      return std::make_unique<DentedSphereSample>(scene.origin, scene.dent);
   }
   return nullptr;
 }
 
-Rigid3d ScanFromWorld(const SynthOptions& options) {
+Rigid3d ScanFromWorld(const SynthScanOptions& scan) {
   const Eigen::Quaterniond rotation(Eigen::AngleAxisd(35.0 * kDegree, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()));
-  return Rigid3d(rotation, options.scan_offset_m * Eigen::Vector3d(0.6, -0.48, 0.64));
-}
-
-std::vector<TargetSpec> TargetLayout(const SynthOptions& options) {
-  std::vector<TargetSpec> layout;
-  if (!options.targets) return layout;
-  const double z = PlatformHeight(options);
-  const double half = 0.5 * options.target_size;
-  // Printed upright for a viewer above: x east, y south, so x cross y points down into the platform.
-  const Eigen::Vector3d x_axis = Eigen::Vector3d::UnitX(), y_axis = -Eigen::Vector3d::UnitY();
-  for (int k = 0; k < options.target_count; ++k) {
-    const double angle = 2.0 * M_PI * (k + 0.5) / options.target_count;
-    const Eigen::Vector3d center = Eigen::Vector3d(options.origin.x(), options.origin.y(), z) +
-                                   options.target_ring_radius * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
-    TargetSpec target;
-    target.id = k;
-    target.corners = {center - half * x_axis - half * y_axis, center + half * x_axis - half * y_axis,
-                      center + half * x_axis + half * y_axis, center - half * x_axis + half * y_axis};
-    layout.push_back(target);
-  }
-  return layout;
-}
-
-LightTargetsSpec LightTargetLayout(const SynthOptions& options, std::vector<TargetSpec>* corners) {
-  LightTargetsSpec spec;
-  if (corners) corners->clear();
-  if (!options.targets || options.light_target_photos <= 0) return spec;
-  spec.size = options.light_marker_size;
-  const Eigen::Vector3d light = options.origin + options.light_distance * Eigen::Vector3d::UnitX();
-  // Printed upright for a viewer at the sample looking at the light: x along -y, y down (-z), so
-  // x cross y (into the print) points away from the sample, along +x.
-  const Eigen::Vector3d x_axis = -Eigen::Vector3d::UnitY(), y_axis = -Eigen::Vector3d::UnitZ();
-  Eigen::Matrix3d world_from_marker;
-  world_from_marker << x_axis, y_axis, x_axis.cross(y_axis);
-  const double pitch = options.light_marker_size * (1.0 + 2.0 * options.card_margin);
-  const double half = 0.5 * options.light_marker_size;
-  for (int k = 0; k < options.light_marker_count; ++k) {
-    const Eigen::Vector3d center = light - options.light_card_drop * Eigen::Vector3d::UnitZ() +
-                                   pitch * (k - 0.5 * (options.light_marker_count - 1)) * x_axis;
-    LightMarkerSpec marker;
-    marker.id = options.light_marker_first_id + k;
-    marker.light_in_marker = world_from_marker.transpose() * (light - center);
-    spec.markers.push_back(marker);
-    if (corners) {
-      TargetSpec target;
-      target.id = marker.id;
-      target.corners = {center - half * x_axis - half * y_axis, center + half * x_axis - half * y_axis,
-                        center + half * x_axis + half * y_axis, center - half * x_axis + half * y_axis};
-      corners->push_back(target);
-    }
-  }
-  return spec;
-}
-
-CameraEffects CameraEffects::None() {
-  CameraEffects effects;
-  effects.shot_noise = false;
-  effects.read_noise = false;
-  effects.bits = 0;
-  effects.srgb = false;
-  effects.black_level = 0.0;
-  effects.supersample = 1;
-  return effects;
-}
-
-bool CameraEffects::Check(std::string* why) const {
-  if (bits != 0 && (bits < 8 || bits > 16)) {
-    *why = "bits must be 0 (float) or 8 to 16";
-    return false;
-  }
-  if (!(full_well_e > 0.0) || !(read_noise_e >= 0.0)) {
-    *why = "full_well_e must be positive and read_noise_e non-negative";
-    return false;
-  }
-  if (!(black_level >= 0.0 && black_level < 0.5)) {
-    *why = "black_level must be in [0, 0.5)";
-    return false;
-  }
-  if (supersample < 1 || supersample > 16) {
-    *why = "supersample must be 1 to 16";
-    return false;
-  }
-  if (!(vignetting >= 0.0 && vignetting < 0.9)) {
-    *why = "vignetting must be in [0, 0.9)";
-    return false;
-  }
-  return true;
-}
-
-bool SynthOptions::Check(std::string* why) const {
-  if (sample == SampleSpec::Kind::kMesh) {
-    *why = "synth renders a sphere or a cylinder (or, with shape, a squash, pot or dent as a mesh sample)";
-    return false;
-  }
-  if (!(sample_radius > 0.0) || !(cylinder_length > 0.0)) {
-    *why = "sample sizes must be positive";
-    return false;
-  }
-  double bounding =
-      sample == SampleSpec::Kind::kCylinder ? std::hypot(sample_radius, 0.5 * cylinder_length) : sample_radius;
-  if (shape != Shape::kNone) {
-    if (!squash.Check(why) || !pot.Check(why) || !dent.Check(why) || !scanner.Check(why)) return false;
-    if (!targets) {
-      *why = "an irregular shape needs targets: the platform's markers register its scan to the photos";
-      return false;
-    }
-    if (!(scan_offset_m >= 0.0) || !(scan_target_noise_m >= 0.0) || !(truth_mesh_spacing_m > 0.0)) {
-      *why = "scan_offset_m and scan_target_noise_m must be >= 0, truth_mesh_spacing_m > 0";
-      return false;
-    }
-    bounding = MakeTrueShape(*this)->BoundingRadius();
-    if (!(scanner.distance_m > 1.5 * bounding)) {
-      *why = "the scanner must be well outside the sample";
-      return false;
-    }
-    if (!(truth_mesh_spacing_m < 0.1 * bounding)) {
-      *why = "truth_mesh_spacing_m must be below a tenth of the sample's size";
-      return false;
-    }
-  }
-  if (!(camera_distance > 1.5 * bounding) || !(light_distance > bounding)) {
-    *why = "the camera and the light must be well outside the sample";
-    return false;
-  }
-  if (num_photos < 1 || num_photos > 100000) {
-    *why = "num_photos must be 1 to 100000";
-    return false;
-  }
-  if (width < 8 || height < 8 || width > 20000 || height > 20000) {
-    *why = "image size must be 8 to 20000 pixels a side";
-    return false;
-  }
-  if (!(fill_light >= 0.0 && fill_light < 1.0)) {
-    *why = "fill_light must be in [0, 1)";
-    return false;
-  }
-  if (!(frame_fraction > 0.0 && frame_fraction <= 1.0) || !(exposure_target > 0.0 && exposure_target <= 1.0)) {
-    *why = "frame_fraction and exposure_target must be in (0, 1]";
-    return false;
-  }
-  if ((light_intensity.array() < 0.0).any() || !(light_intensity.maxCoeff() > 0.0)) {
-    *why = "light_intensity must be non-negative and not all zero";
-    return false;
-  }
-  if (targets) {
-    if (!(target_ring_radius > bounding + target_size)) {
-      *why = "targets: the marker ring must lie outside the sample";
-      return false;
-    }
-    if (target_count < 1 || !(target_size > 0.0) || !(platform_radius > target_ring_radius + target_size)) {
-      *why = "targets: need at least one marker, a positive size, and a platform wider than the ring";
-      return false;
-    }
-    if (!(target_white > target_black && target_black >= 0.0 && target_white <= 1.0)) {
-      *why = "targets: need 0 <= target_black < target_white <= 1";
-      return false;
-    }
-    if (light_target_photos < 0 ||
-        (light_target_photos > 0 &&
-         (light_marker_count < 1 || light_marker_first_id < target_count || !(light_marker_size > 0.0) ||
-          !(light_card_drop > 0.5 * light_marker_size * (1.0 + 2.0 * card_margin))))) {
-      *why = "targets: light markers need ids above the ring's, a positive size, and a card below the light";
-      return false;
-    }
-  }
-  if (!radiometry.Check(why)) return false;
-  return effects.Check(why);
+  return Rigid3d(rotation, scan.offset_m * Eigen::Vector3d(0.6, -0.48, 0.64));
 }
 
 Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material, int supersample,
@@ -629,7 +453,7 @@ namespace {
 // the mesh sample into `root`/session.json; returns the geometry's truth (truth.json "generator"."geometry").
 nlohmann::json WriteShapeFiles(const SynthOptions& options, const ImplicitSample& shape, const std::string& root,
                                SampleSpec* sample, SynthSummary* summary) {
-  const Rigid3d scan_from_world = ScanFromWorld(options);
+  const Rigid3d scan_from_world = ScanFromWorld(options.scan);
   const RayCaster caster = [&shape](const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double* t,
                                     Eigen::Vector3d* normal) {
     SurfaceHit hit;
@@ -638,7 +462,7 @@ nlohmann::json WriteShapeFiles(const SynthOptions& options, const ImplicitSample
     *normal = hit.normal;
     return true;
   };
-  RangeScannerOptions scanner = options.scanner;
+  RangeScannerOptions scanner = options.scan.scanner;
   scanner.seed = options.seed;
   const std::vector<ScanMesh> views =
       SimulateRangeScans(caster, shape.BoundingCenter(), shape.BoundingRadius(), scanner, scan_from_world);
@@ -662,17 +486,17 @@ nlohmann::json WriteShapeFiles(const SynthOptions& options, const ImplicitSample
     measured.id = target.id;
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector3d error(noise(rng), noise(rng), noise(rng));
-      measured.corners[k] = scan_from_world * target.corners[k] + options.scan_target_noise_m * error;
+      measured.corners[k] = scan_from_world * target.corners[k] + options.scan.target_noise_m * error;
     }
     sample->scan_targets.push_back(measured);
   }
-  WritePly((fs::path(root) / kTruthMesh).string(), TruthMesh(shape, options.truth_mesh_spacing_m));
+  WritePly((fs::path(root) / kTruthMesh).string(), TruthMesh(shape, options.scan.truth_mesh_spacing_m));
   const RangeScannerOptions& s = scanner;
   return {{"shape", shape.Describe()},
           {"truth_mesh", kTruthMesh},
           {"scan_from_world", RigidJson(scan_from_world)},
           {"world_from_scan", RigidJson(scan_from_world.Inverse())},
-          {"scan_target_noise_m", options.scan_target_noise_m},
+          {"scan_target_noise_m", options.scan.target_noise_m},
           {"scanner",
            {{"views_around", s.views_around},
             {"around_elevation_deg", s.around_elevation_deg},
@@ -682,6 +506,57 @@ nlohmann::json WriteShapeFiles(const SynthOptions& options, const ImplicitSample
             {"noise_m", s.noise_m},
             {"max_view_angle_deg", s.max_view_angle_deg}}}};
 }
+// Auto-exposure: the 99th percentile of the brightest channel over the sample's pixels (1 for none).
+double AutoExposureReference(const Image& radiance, const std::vector<uint8_t>& mask) {
+  std::vector<float> levels;
+  for (size_t p = 0; p < mask.size(); ++p) {
+    if (!mask[p]) continue;
+    const float* rgb = &radiance.pixels[p * 3];
+    const float level = std::max({rgb[0], rgb[1], rgb[2]});
+    if (level > 0.0f) levels.push_back(level);
+  }
+  return levels.empty() ? 1.0 : PercentileInPlace(&levels, 0.99);
+}
+
+// truth.json's "generator": the options that made the session (the keys predate the options' split).
+nlohmann::json GeneratorJson(const SynthOptions& options) {
+  const CameraEffects& effects = options.effects;
+  return {{"sample", options.scene.shape != SynthShape::kNone ? SynthShapeName(options.scene.shape)
+                                                              : SampleKindName(options.scene.sample)},
+          {"sample_radius", options.scene.sample_radius},
+          {"cylinder_length", options.scene.cylinder_length},
+          {"origin", ToJson(options.scene.origin)},
+          {"light_distance", options.scene.light_distance},
+          {"camera_distance", options.rig.camera_distance},
+          {"camera_elevation_deg", options.rig.camera_elevation_deg},
+          {"num_photos", options.rig.num_photos},
+          {"arc_start_deg", options.rig.arc_start_deg},
+          {"arc_end_deg", options.rig.arc_end_deg},
+          {"width", options.rig.width},
+          {"height", options.rig.height},
+          {"exposure_target", options.rig.exposure_target},
+          {"fill_light", options.scene.fill_light},
+          {"seed", options.seed},
+          {"targets", options.targets.enabled},
+          {"light_target_photos", options.targets.enabled ? options.targets.light_photos : 0},
+          {"effects",
+           {{"shot_noise", effects.shot_noise},
+            {"read_noise", effects.read_noise},
+            {"full_well_e", effects.full_well_e},
+            {"read_noise_e", effects.read_noise_e},
+            {"bits", effects.bits},
+            {"srgb", effects.srgb},
+            {"clip", effects.clip},
+            {"black_level", effects.black_level},
+            {"supersample", effects.supersample},
+            {"vignetting", effects.vignetting}}},
+          {"radiometry",
+           {{"brackets", options.radiometry.brackets},
+            {"bracket_step_ev", options.radiometry.bracket_step_ev},
+            {"light_unknown", options.radiometry.light_unknown},
+            {"light_intensity", ToJson(options.scene.light_intensity)}}}};
+}
+
 }  // namespace
 
 std::string SynthSummary::BriefReport() const {
@@ -711,39 +586,29 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   std::atomic<uint64_t> saturated{0};
   uint64_t shadowed = 0;
   const std::unique_ptr<AnalyticSample> truth = TrueSample(options, session);
-  const bool shadow_rays = options.shape != SynthOptions::Shape::kNone;
+  const bool shadow_rays = options.scene.shape != SynthShape::kNone;
   // The fill light's irradiance: fill_light times the point light's at the sample's centre, head on.
   const Eigen::Vector3d centre = truth->BoundingCenter();
   const Eigen::Vector3d to_light = IncidenceAt(session.light, centre, Eigen::Vector3d::UnitZ()).wi;
-  const Eigen::Vector3d fill_irradiance = options.fill_light * IncidenceAt(session.light, centre, to_light).irradiance;
+  const Eigen::Vector3d fill_irradiance =
+      options.scene.fill_light * IncidenceAt(session.light, centre, to_light).irradiance;
   ProgressBar progress("photos", session.photos.size());
-  std::unique_ptr<TargetScene> scene;
-  if (options.targets) scene = std::make_unique<TargetScene>(options);
+  std::unique_ptr<TargetScene> target_scene;
+  if (options.targets.enabled) target_scene = std::make_unique<TargetScene>(options);
   // Photos one after another; each renders and adds noise in parallel over rows.
   for (size_t i = 0; i < session.photos.size(); ++i) {
     std::vector<uint8_t> mask;
     Image image =
         RenderRadianceImpl(session, i, *truth, shadow_rays, material, effects.supersample, &mask,
                            session.photos[i].role == PhotoRole::kMeasurement ? &shadowed : nullptr, fill_irradiance);
-    // Auto-exposure: the 99th percentile of the brightest channel over the sample's pixels.
-    std::vector<float> levels;
-    for (size_t p = 0; p < mask.size(); ++p) {
-      if (!mask[p]) continue;
-      const float* rgb = &image.pixels[p * 3];
-      const float level = std::max({rgb[0], rgb[1], rgb[2]});
-      if (level > 0.0f) levels.push_back(level);
-    }
-    double reference = 1.0;
-    if (!levels.empty()) {
-      reference = PercentileInPlace(&levels, 0.99);
-    }
     PhotoSpec& photo = session.photos[i];
-    photo.exposure_s *= options.exposure_target / reference;  // exposure_s holds the bracket's factor (1 without)
+    photo.exposure_s *= options.rig.exposure_target /
+                        AutoExposureReference(image, mask);  // exposure_s holds the bracket's factor (1 without)
     photo.gain = 1.0;
 
     // Radiance to linear signal, then the platform (its values are already signal).
     for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
-    if (scene) CompositeTargets(session, i, *scene, *truth, mask, &image);
+    if (target_scene) CompositeTargets(session, i, *target_scene, *truth, mask, &image);
     ApplyVignetting(session.camera, effects.vignetting, &image);
     // The sensor (synthetic_radiometry.h): one random stream per (seed, photo, row).
     saturated += SimulateSensor(effects, options.seed, i, &image);
@@ -758,7 +623,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   WriteSynthCalibration(options, directory.temporary_path(), &session);  // radiometry hook: flat field, white reference
   // Irregular shapes: the range scan, the truth mesh, and the mesh sample's scan inputs and targets
   // (the sample's file, scan/mesh.ply, is the scan stage's output from those inputs).
-  const nlohmann::json shape_truth = options.shape != SynthOptions::Shape::kNone
+  const nlohmann::json shape_truth = options.scene.shape != SynthShape::kNone
                                          ? WriteShapeFiles(options, static_cast<const ImplicitSample&>(*truth),
                                                            directory.temporary_path(), &session.sample, &summary)
                                          : nlohmann::json();
@@ -769,46 +634,12 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
       {"version", 1},
       {"material_name", material_name},
       {"material", material.ToJson()},
-      {"generator",
-       {{"sample",
-         options.shape != SynthOptions::Shape::kNone ? SynthShapeName(options.shape) : SampleKindName(options.sample)},
-        {"sample_radius", options.sample_radius},
-        {"cylinder_length", options.cylinder_length},
-        {"origin", ToJson(options.origin)},
-        {"light_distance", options.light_distance},
-        {"camera_distance", options.camera_distance},
-        {"camera_elevation_deg", options.camera_elevation_deg},
-        {"num_photos", options.num_photos},
-        {"arc_start_deg", options.arc_start_deg},
-        {"arc_end_deg", options.arc_end_deg},
-        {"width", options.width},
-        {"height", options.height},
-        {"exposure_target", options.exposure_target},
-        {"fill_light", options.fill_light},
-        {"seed", options.seed},
-        {"targets", options.targets},
-        {"light_target_photos", options.targets ? options.light_target_photos : 0},
-        {"effects",
-         {{"shot_noise", effects.shot_noise},
-          {"read_noise", effects.read_noise},
-          {"full_well_e", effects.full_well_e},
-          {"read_noise_e", effects.read_noise_e},
-          {"bits", effects.bits},
-          {"srgb", effects.srgb},
-          {"clip", effects.clip},
-          {"black_level", effects.black_level},
-          {"supersample", effects.supersample},
-          {"vignetting", effects.vignetting}}},
-        {"radiometry",
-         {{"brackets", options.radiometry.brackets},
-          {"bracket_step_ev", options.radiometry.bracket_step_ev},
-          {"light_unknown", options.radiometry.light_unknown},
-          {"light_intensity", ToJson(options.light_intensity)}}}}},
+      {"generator", GeneratorJson(options)},
   };
   if (!shape_truth.is_null()) truth_json["generator"]["geometry"] = shape_truth;
   WriteJsonFile((fs::path(directory.temporary_path()) / "truth.json").string(), truth_json);
   directory.Commit();
-  summary.photos = options.num_photos;
+  summary.photos = options.rig.num_photos;
   summary.saturated_pixels = saturated;
   summary.total_s = timer.ElapsedSeconds();
   summary.success = true;

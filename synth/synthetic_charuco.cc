@@ -1,4 +1,4 @@
-#include "derender/synthetic_charuco.h"
+#include "synth/synthetic_charuco.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "derender/synthetic_shapes.h"
+#include "synth/synthetic_shapes.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,53 @@
+#include "synth/synth_request.h"
+
+#include "core/error.h"
+#include "core/session.h"
+
+namespace ibrdf {
+
+SynthOptions SynthOptionsFromRequest(const SynthRequest& request) {
+  SynthOptions options = request.options;
+  options.scene.sample = request.sample == "cylinder" ? SampleSpec::Kind::kCylinder : SampleSpec::Kind::kSphere;
+  options.effects = request.effects == "none" ? CameraEffects::None() : CameraEffects();
+  CameraEffects& e = options.effects;
+  if (request.bits >= 0) e.bits = request.bits;
+  if (request.supersample >= 0) e.supersample = request.supersample;
+  if (request.black_level >= 0) e.black_level = request.black_level;
+  if (request.full_well_e >= 0) e.full_well_e = request.full_well_e;
+  if (request.read_noise_e >= 0) e.read_noise_e = request.read_noise_e;
+  if (request.vignetting >= 0) e.vignetting = request.vignetting;
+  if (request.srgb) e.srgb = true;
+  if (request.no_shot_noise) e.shot_noise = false;
+  if (request.no_read_noise) e.read_noise = false;
+  if (request.no_clip) {
+    if (e.bits != 0) ThrowError("--no-clip", "unclipped values need float output (--bits 0)");
+    e.clip = false;
+  }
+  bool targets = request.targets;
+  if (!request.shape.empty()) {
+    options.scene.shape = SynthShapeFromName(request.shape);
+    targets = true;
+  }
+  if (targets) {
+    options.targets.enabled = true;
+    if (!request.camera_elevation_given) options.rig.camera_elevation_deg = 45.0;
+    if (!request.light_photos_given) options.targets.light_photos = 3;
+  }
+  const std::vector<double>& o = request.origin;
+  if (!o.empty() && o.size() != 3) ThrowError("--origin", "expected 3 values (x y z)");
+  if (!o.empty()) options.scene.origin = Eigen::Vector3d(o[0], o[1], o[2]);
+  const std::vector<double>& i = request.light_intensity;
+  if (!i.empty() && i.size() != 3) ThrowError("--light-intensity", "expected 3 values (R G B)");
+  if (!i.empty()) options.scene.light_intensity = Eigen::Vector3d(i[0], i[1], i[2]);
+  return options;
+}
+
+CharucoPhotosSummary WriteSessionCharucoPhotos(const std::string& session_dir, int num_photos, uint64_t session_seed) {
+  CharucoPhotoOptions board;
+  board.num_photos = num_photos;
+  board.seed = session_seed + 1000;
+  return WriteCharucoPhotos(Session::Load(session_dir).camera, board, session_dir + "/calibration",
+                            /*overwrite=*/false);
+}
+
+}  // namespace ibrdf

@@ -1,0 +1,43 @@
+// What the `ibrdf synth` command was asked for, before it becomes SynthOptions: the choices whose
+// meaning depends on other choices (presets, implied targets, defaults that change with targets), and
+// the ChArUco board photos that go beside the session. apps/synth_command.cc only parses flags into
+// a SynthRequest; the logic that turns it into options lives here, where it can be tested.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "synth/synth_options.h"
+#include "synth/synthetic_charuco.h"
+
+namespace ibrdf {
+
+// Values as given on the command line; negative numbers and empty strings or vectors mean "not given".
+struct SynthRequest {
+  SynthOptions options;             // the fields set directly (sizes, photos, arc, scan, ...)
+  std::string sample = "sphere";    // "sphere" or "cylinder"
+  std::string shape;                // "", "squash", "pot" or "dent"; a shape implies targets
+  std::string effects = "default";  // the camera-effects preset: "default" (12-bit, noise) or "none"
+  // Overrides of the preset's camera effects (< 0: the preset's value).
+  int bits = -1, supersample = -1;
+  double black_level = -1, full_well_e = -1, read_noise_e = -1, vignetting = -1;
+  bool srgb = false, no_shot_noise = false, no_read_noise = false;
+  bool no_clip = false;  // needs float output (bits 0)
+  // The marker platform; with it, cameras look down from 45 degrees and 3 light-target photos are
+  // taken unless camera_elevation_given or light_photos_given.
+  bool targets = false;
+  bool camera_elevation_given = false, light_photos_given = false;
+  std::vector<double> origin, light_intensity;  // 3 values each when given
+  int charuco_photos = 0;  // ChArUco board photos to write beside the session (WriteSessionCharucoPhotos)
+};
+
+// The options a request describes. Throws Error naming the flag for contradictory choices (--no-clip
+// without float output) or an unknown shape.
+SynthOptions SynthOptionsFromRequest(const SynthRequest& request);
+
+// Writes `num_photos` photos of the default ChArUco board (CharucoPhotoOptions) taken with the camera
+// of the session in `session_dir` into `session_dir`/calibration (for `ibrdf align --calibrate`),
+// seeded from the session's seed + 1000.
+CharucoPhotosSummary WriteSessionCharucoPhotos(const std::string& session_dir, int num_photos, uint64_t session_seed);
+
+}  // namespace ibrdf
