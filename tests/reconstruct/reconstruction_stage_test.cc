@@ -46,9 +46,9 @@ class ReconstructionStage : public ::testing::Test {
     fs::create_directories(dir_);
     SetVerbosity(0);
     SynthOptions synth;
-    synth.num_photos = 6;
-    synth.width = 200;
-    synth.height = 150;
+    synth.rig.num_photos = 6;
+    synth.rig.width = 200;
+    synth.rig.height = 150;
     const std::string session = dir_ + "/session";
     testing::MakeSession(session, synth, *LoadMaterial(MaterialPath("bluepaint")));
     samples_ = new std::vector<BrdfSample>(Derender(Session::Load(session), DerenderOptions()).samples);

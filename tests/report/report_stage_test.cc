@@ -73,9 +73,9 @@ class ReportTest : public ::testing::Test {
   void MakeRunFolder() {
     const std::string s = dir_ / "s", run = dir_ / "run";
     SynthOptions synth;
-    synth.width = 160;
-    synth.height = 120;
-    synth.num_photos = 6;
+    synth.rig.width = 160;
+    synth.rig.height = 120;
+    synth.rig.num_photos = 6;
     const std::unique_ptr<BrdfModel> material =
         LoadMaterial(std::string(IBRDF_SAMPLES_DIR) + "/materials/bluepaint.json");
     testing::MakeSession(s, synth, *material);
