@@ -33,6 +33,32 @@ bool SamePose(const Rigid3d& a, const Rigid3d& b) {
   return a.rotation.coeffs() == b.rotation.coeffs() && a.translation == b.translation;
 }
 
+// Adds photo i to a bracket (`group`, photos of one pose). A bracket merges exposures of one pose and
+// one light, so each of its photos must differ in exposure (exposure_s x gain): two photos of the same
+// pose and exposure are not a bracket (photos under different lights, or the same photo twice), and
+// averaging them would corrupt the samples silently. A bracket holds at most 255 exposures.
+void JoinBracket(const Session& session, size_t i, std::vector<size_t>* group) {
+  const PhotoSpec& photo = session.photos[i];
+  const double exposure = photo.exposure_s * photo.gain;
+  const std::string where = session.manifest_path + ": /photos/" + std::to_string(i);
+  for (size_t j : *group) {
+    const PhotoSpec& other = session.photos[j];
+    const double other_exposure = other.exposure_s * other.gain;
+    if (std::abs(exposure - other_exposure) <= 1e-9 * std::max(exposure, other_exposure)) {
+      ThrowError(where, "photos " + other.file + " (/photos/" + std::to_string(j) + ") and " + photo.file +
+                            " have the same camera pose and the same exposure (exposure_s x gain = " +
+                            std::to_string(exposure) +
+                            "), so they are not an exposure bracket; photos of one pose under different lights "
+                            "are separate measurements, which a session with one light cannot describe, and a "
+                            "repeated photo should be left out");
+    }
+  }
+  if (group->size() >= 255) {
+    ThrowError(where, "photo " + photo.file + " would be exposure 256 of one camera pose; a bracket holds at most 255");
+  }
+  group->push_back(i);
+}
+
 }  // namespace
 
 std::vector<std::vector<size_t>> ExposureGroups(const Session& session) {
@@ -60,7 +86,7 @@ std::vector<std::vector<size_t>> ExposureGroups(const Session& session) {
                          std::to_string(rotation * 180.0 / M_PI) + " degrees (a bracket is one camera pose)");
         }
       }
-      group.push_back(i);
+      JoinBracket(session, i, &group);
       continue;
     }
     // No bracket id: identical poses are one bracket.
@@ -69,7 +95,7 @@ std::vector<std::vector<size_t>> ExposureGroups(const Session& session) {
       for (std::vector<size_t>& group : groups) {
         const PhotoSpec& first = session.photos[group.front()];
         if (!first.bracket && first.camera_from_world && SamePose(*first.camera_from_world, *photo.camera_from_world)) {
-          group.push_back(i);
+          JoinBracket(session, i, &group);
           joined = true;
           break;
         }

@@ -45,8 +45,10 @@ struct RadianceImage {
 // group (an exposure bracket; their poses must agree to 1 mm and 0.06 degrees); measurement photos
 // without a bracket id form one group per distinct camera_from_world (identical poses are a bracket);
 // a photo without a pose is a group of its own. Alignment-only photos (role "targets") are in no
-// group. Groups are ordered by their first photo. Throws Error naming the manifest's photo for a
-// bracket whose poses disagree.
+// group. Groups are ordered by their first photo. A bracket's photos must differ in exposure
+// (exposure_s x gain): two photos of one pose and one exposure are never averaged. Throws Error naming
+// the manifest's photo (and, for a repeated exposure, both files) for a bracket whose poses disagree,
+// a repeated exposure, or more than 255 exposures.
 std::vector<std::vector<size_t>> ExposureGroups(const Session& session);
 
 // The session's radiometric chain, prepared once (response lookup table, flat field) and applied to

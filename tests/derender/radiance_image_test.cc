@@ -150,6 +150,9 @@ TEST(RadianceImage, ExposureGroupsByBracketAndByPose) {
                     photo(b, 7),
                     photo(b, std::nullopt, PhotoRole::kTargets),
                     photo(b, 8)};
+  // A bracket: the exposures of one pose differ.
+  session.photos[2].exposure_s = 4.0;
+  session.photos[3].gain = 0.25;
   const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
   ASSERT_EQ(groups.size(), 3u);
   EXPECT_EQ(groups[0], (std::vector<size_t>{0, 2}));
@@ -162,6 +165,57 @@ TEST(RadianceImage, ExposureGroupsByBracketAndByPose) {
     FAIL() << "a bracket of two poses was accepted";
   } catch (const Error& error) {
     EXPECT_NE(std::string(error.what()).find("/photos/3/bracket"), std::string::npos) << error.what();
+  }
+}
+
+// No silent merge (the real-rigs issue): two photos of one pose and one exposure (as under two
+// lights of a dome, or the same photo twice) are an error naming both files, with or without a bracket
+// id; different exposures of one pose still merge.
+TEST(RadianceImage, SamePoseAndExposureIsAnErrorNamingBothPhotos) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  const Rigid3d pose(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 1));
+  PhotoSpec first, second;
+  first.file = "light-07.png";
+  second.file = "light-12.png";
+  first.camera_from_world = second.camera_from_world = pose;
+  for (const std::optional<int> bracket : {std::optional<int>(), std::optional<int>(3)}) {
+    first.bracket = second.bracket = bracket;
+    session.photos = {first, second};
+    try {
+      ExposureGroups(session);
+      FAIL() << "two photos of one pose and exposure were merged";
+    } catch (const Error& error) {
+      const std::string message = error.what();
+      EXPECT_NE(message.find("light-07.png"), std::string::npos) << message;
+      EXPECT_NE(message.find("light-12.png"), std::string::npos) << message;
+      EXPECT_NE(message.find("/photos/1"), std::string::npos) << message;
+    }
+    // A real bracket (exposure x 4) still merges.
+    session.photos[1].exposure_s = 4.0 * session.photos[0].exposure_s;
+    const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
+    ASSERT_EQ(groups.size(), 1u);
+    EXPECT_EQ(groups[0], (std::vector<size_t>{0, 1}));
+  }
+}
+
+// More than 255 exposures of one pose is an error naming the photo, not an internal check.
+TEST(RadianceImage, TooManyExposuresOfOnePoseIsAnError) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  PhotoSpec photo;
+  photo.file = "x.png";
+  photo.camera_from_world = Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 1));
+  session.photos.clear();
+  for (int i = 0; i < 260; ++i) {
+    photo.exposure_s = 0.001 * (i + 1);
+    session.photos.push_back(photo);
+  }
+  try {
+    ExposureGroups(session);
+    FAIL() << "260 exposures of one pose were accepted";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("/photos/255"), std::string::npos) << error.what();
   }
 }
 
