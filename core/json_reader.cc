@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -12,18 +13,32 @@
 namespace ibrdf {
 
 nlohmann::json ReadJsonFile(const std::string& path) {
+  // A regular file of bounded size only: a FIFO or /dev/zero would otherwise hang or fill memory.
+  RequireFile(path, "JSON file");
+  constexpr uintmax_t kMaxJsonBytes = uintmax_t(256) << 20;
+  std::error_code error;
+  const uintmax_t bytes = std::filesystem::file_size(path, error);
+  if (error || bytes > kMaxJsonBytes) {
+    ThrowError(path, error ? "cannot read the file's size"
+                           : "is " + std::to_string(bytes) +
+                                 " bytes; JSON files of "
+                                 "ibrdf are at most 256 MiB");
+  }
   std::ifstream in(path);
   if (!in) ThrowError(path, "cannot open file");
   std::stringstream buffer;
   buffer << in.rdbuf();
+  const std::string text = buffer.str();
   try {
-    return nlohmann::json::parse(buffer.str());
+    return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     // Turn the byte offset into a line number.
-    const std::string text = buffer.str();
     const size_t offset = std::min<size_t>(e.byte, text.size());
     const long line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(offset), '\n');
     ThrowError(path + ":" + std::to_string(line), std::string("invalid JSON: ") + e.what());
+  } catch (const nlohmann::json::exception& e) {
+    // E.g. a number out of range ("1e400"): the library's message names no file.
+    ThrowError(path, std::string("invalid JSON: ") + e.what());
   }
 }
 

@@ -2,6 +2,7 @@
 // field or the line of a syntax error.
 #include "core/json_reader.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -216,6 +217,22 @@ TEST_F(JsonFileTest, EmptyFileIsAnError) {
   const std::string path = Path("empty.json");
   std::ofstream{path};
   ExpectError([&] { ReadJsonFile(path); }, {path});
+}
+
+// Not a regular file (a FIFO, /dev/zero, a folder): one line naming the path, no hang, no runaway memory.
+TEST_F(JsonFileTest, NonRegularFileIsRefused) {
+  const std::string fifo = Path("pipe.json");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  ExpectError([&] { ReadJsonFile(fifo); }, {fifo, "not a regular file"});
+  ExpectError([&] { ReadJsonFile("/dev/zero"); }, {"/dev/zero", "not a regular file"});
+  ExpectError([&] { ReadJsonFile(dir_); }, {dir_, "not a regular file"});
+}
+
+// A number JSON cannot hold ('1e400') is an Error naming the file, not the library's bare message.
+TEST_F(JsonFileTest, NumberOverflowNamesTheFile) {
+  const std::string path = Path("overflow.json");
+  std::ofstream(path) << "{\"exposure_s\": 1e400}\n";
+  ExpectError([&] { ReadJsonFile(path); }, {path, "invalid JSON"});
 }
 
 // WriteJsonFile round-trips through ReadJsonFile and leaves no temporary file behind.
