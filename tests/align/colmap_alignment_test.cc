@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "tests/error_of.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -29,14 +30,7 @@ using testing::ScratchDir;
 
 const std::string kModel = std::string(IBRDF_SHARED_DATA_DIR) + "/colmap-test-model/sparse/0";
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 Similarity3d RandomSimilarity(uint64_t seed) {
   std::mt19937_64 rng(seed);

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "tests/error_of.h"
 #include "tests/scratch_dir.h"
 
 namespace ibrdf {
@@ -27,14 +28,7 @@ const std::string kModel = std::string(IBRDF_SHARED_DATA_DIR) + "/colmap-test-mo
     GTEST_SKIP() << "../shared/data/colmap-test-model is absent: real-data test skipped"; \
   }
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 TEST(ColmapModel, BinaryAndTextAgree) {
   REQUIRE_SHARED_DATA();

@@ -15,6 +15,7 @@
 
 #include "align/colmap_model.h"
 #include "core/error.h"
+#include "tests/error_of.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -25,14 +26,7 @@ using testing::MakeSession;
 using testing::MaterialPath;
 using testing::ScratchDir;
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 std::string Script(const std::string& path, const std::string& body) {
   std::ofstream(path) << "#!/bin/sh\n" << body;

@@ -19,6 +19,7 @@
 #include "core/json_reader.h"
 #include "core/logging.h"
 #include "synth/synthetic_charuco.h"
+#include "tests/error_of.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -27,14 +28,7 @@ namespace {
 namespace fs = std::filesystem;
 using testing::ScratchDir;
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 // The largest distance, over a grid covering the image, between a pixel and where the estimated camera
 // projects the true camera's ray through it. With `same_centre`, the estimate's principal point is

@@ -17,6 +17,7 @@
 #include "core/npy.h"
 #include "core/session.h"
 #include "derender/derenderer.h"
+#include "tests/error_of.h"
 #include "tests/scratch_dir.h"
 #include "tests/test_util.h"
 
@@ -27,14 +28,7 @@ namespace fs = std::filesystem;
 using testing::MaterialPath;
 using testing::ScratchDir;
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 // One small session (bluepaint, 6 photos of 200 x 150), rendered and derendered once for the suite.
 class ReconstructionStage : public ::testing::Test {
