@@ -1,6 +1,7 @@
-// The subcommands of the ibrdf tool. Each subcommand lives in its own apps/<name>_command.cc and
-// registers itself with IBRDF_REGISTER_COMMAND; main() adds them in `order`. Library code never sees
-// argv.
+// The subcommands of the ibrdf tool. Each subcommand lives in its own apps/<name>_command.cc,
+// registers itself with IBRDF_REGISTER_COMMAND and is built into its own binary `ibrdf-<name>` by one
+// line of apps/CMakeLists.txt (ibrdf_add_command; apps/main.cc, the front end, says how to add one).
+// Library code never sees argv.
 #pragma once
 
 #include <string>
@@ -12,9 +13,12 @@ namespace ibrdf {
 
 using AddCommandFunction = void (*)(CLI::App& app);
 
-// Registers a subcommand at static-initialization time; `order` sets its place in --help (the
-// workflow's order: synth 10, scan 20, align 30, derender 40, reconstruct 50, check 60, report 70,
-// run 80, compare 90).
+// The exit status of a usage error (an unknown option or subcommand, a missing or malformed argument).
+constexpr int kUsageErrorExitCode = 2;
+
+// Registers a subcommand at static-initialization time; `order` sets its place among the subcommands
+// of one binary (the workflow's order: synth 10, scan 20, align 30, derender 40, reconstruct 50,
+// check 60, report 70, run 80, compare 90; the front end's listing takes it from apps/CMakeLists.txt).
 struct CommandRegistrar {
   CommandRegistrar(int order, AddCommandFunction add);
 };

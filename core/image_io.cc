@@ -63,15 +63,23 @@ ImageSpec ReadImageSpec(const std::string& path) {
 }
 
 Image ReadImage(const std::string& path) {
+  Image image;
+  ReadImage(path, &image);
+  return image;
+}
+
+void ReadImage(const std::string& path, Image* image) {
   auto input = Open(path);
   const OIIO::ImageSpec& spec = input->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) ThrowError(path, "image is empty");
-  Image image(spec.width, spec.height, spec.nchannels);
-  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
+  image->width = spec.width;
+  image->height = spec.height;
+  image->channels = spec.nchannels;
+  image->pixels.resize(size_t(spec.width) * spec.height * spec.nchannels);  // every value is overwritten
+  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image->pixels.data())) {
     ThrowError(path, "cannot decode image: " + input->geterror());
   }
   input->close();
-  return image;
 }
 
 void WriteImage(const std::string& path, const Image& image, PixelFormat format) {

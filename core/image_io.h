@@ -32,6 +32,10 @@ enum class PixelFormat { kUint8, kUint16, kHalf, kFloat };
 // Reads any image OpenImageIO can; throws Error naming the file on failure.
 Image ReadImage(const std::string& path);
 
+// As ReadImage, into `image`, whose pixel buffer is reused when it is large enough (a loop over photos
+// of one size allocates once).
+void ReadImage(const std::string& path, Image* image);
+
 // The size and channel count without decoding the pixels.
 struct ImageSpec {
   int width = 0, height = 0, channels = 0;

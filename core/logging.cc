@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <exception>
 #include <iostream>
 #include <sstream>
 
@@ -18,9 +19,12 @@ void Log(int level, const std::string& line) {
   if (g_verbosity >= level) std::cerr << line << std::endl;
 }
 
-StageLog::StageLog(std::string name) : name_(std::move(name)) { Log(1, "== " + name_); }
+StageLog::StageLog(std::string name) : name_(std::move(name)), exceptions_(std::uncaught_exceptions()) {
+  Log(1, "== " + name_);
+}
 
 StageLog::~StageLog() {
+  if (std::uncaught_exceptions() > exceptions_) return;  // failed: no timer before the error line
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%.2f s", timer_.ElapsedSeconds());
   Log(1, "-- " + name_ + ": " + buffer);

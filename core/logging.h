@@ -32,7 +32,7 @@ class Timer {
 };
 
 // A stage heading on construction ("== derender") and a timing line on destruction
-// ("-- derender: 1.23 s").
+// ("-- derender: 1.23 s"), left out when the stage ends by an exception (the error line follows).
 class StageLog {
  public:
   explicit StageLog(std::string name);
@@ -42,6 +42,7 @@ class StageLog {
  private:
   std::string name_;
   Timer timer_;
+  int exceptions_ = 0;  // std::uncaught_exceptions() at construction
 };
 
 // A thread-safe progress bar over a known number of work items. Redraws at most every 0.2 s, on a

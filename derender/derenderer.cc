@@ -9,7 +9,10 @@
 #include <mutex>
 
 #include <tbb/blocked_range.h>
+#include <tbb/concurrent_queue.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
 #include "core/brdf_coords.h"
@@ -24,8 +27,7 @@
 #include "derender/mesh_sample.h"
 #include "derender/radiance_image.h"
 #include "scan/convexity.h"
-#include "scan/scan_io.h"
-#include "scan/scan_pipeline.h"
+#include "scan/mesh_file.h"
 
 namespace ibrdf {
 namespace {
@@ -366,7 +368,7 @@ MeshPath PrepareMeshPath(const Session& session, const DerenderOptions& options)
     ThrowError(where, "the mesh " + file + " does not exist (`ibrdf scan` writes it from the scan_inputs)");
   }
   if (!fs::is_regular_file(file)) ThrowError(where, file + " is not a file");
-  const ScanMesh mesh = ReadScanFile(file);
+  const ScanMesh mesh = ReadTriangleMeshFile(file);
   path.mesh = std::make_unique<MeshSample>(mesh, session.sample.world_from_mesh, file);
   const Visibility visibility = options.visibility.value_or(session.sample.visibility);
   const std::string source = options.visibility ? "option" : "session";
@@ -418,8 +420,10 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   }
   const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
   bool any_sees = groups.empty();
+  std::vector<PixelBox> boxes;  // per group: the pixels that can see the sample
   for (const auto& group : groups) {
-    any_sees |= !SampleBox(session.camera, *session.photos[group.front()].camera_from_world, sample).Empty();
+    boxes.push_back(SampleBox(session.camera, *session.photos[group.front()].camera_from_world, sample));
+    any_sees |= !boxes.back().Empty();
   }
   if (!any_sees) {
     ThrowError(session.manifest_path,
@@ -430,37 +434,82 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   session.CheckPhotos();
 
   const std::vector<Eigen::Vector2f> rays = PixelRays(session.camera);
-  std::vector<std::vector<BrdfSample>> per_group(groups.size());
-  std::vector<RejectionCounts> per_group_rejected(groups.size());
-  std::vector<MeshPhotoStats> per_group_mesh(groups.size());
-  std::vector<double> decode_s(groups.size(), 0.0);
-  ProgressBar progress("photos", groups.size());
-  tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
-    const RadianceImage image = ReadRadianceImage(session, groups[g], options.min_signal, &decode_s[g]);
-    if (mesh_path) {
-      DerenderMeshPhoto(session, groups[g].front(), image, rays, *mesh_path, options, &per_group[g],
-                        &per_group_mesh[g]);
-      AddCounts(per_group_mesh[g].counts, &per_group_rejected[g]);
-    } else {
-      // Room for every examined pixel: only the pages written are touched, and the vector never regrows
-      // (regrowth copies and page faults cost more than the per-pixel geometry).
-      per_group[g].reserve(PixelsPerImage(session.camera, options.pixel_stride));
-      DerenderPhoto(session, groups[g].front(), image, rays, sample, options, &per_group[g], &per_group_rejected[g]);
-    }
-    progress.Add(1);
-  });
-  progress.Finish();
-
-  size_t total = 0;
-  for (const auto& samples : per_group) total += samples.size();
-  result.samples.reserve(total);
-  for (size_t g = 0; g < per_group.size(); ++g) {
-    result.samples.insert(result.samples.end(), per_group[g].begin(), per_group[g].end());
-    for (const auto& [reason, count] : per_group_rejected[g]) result.summary.rejected[reason] += count;
-    result.summary.decode_s += decode_s[g];
-    result.summary.shadow_rays += per_group_mesh[g].shadow_rays;
-    result.summary.shadow_tests_skipped += per_group_mesh[g].shadow_tests_skipped;
+  const RadianceReader reader(session);
+  // Each photo (exposure group) is linearized only inside the pixel box that can see the sample (the
+  // per-pixel loops below trace nothing outside it). A TBB pipeline keeps a few photos in flight, so
+  // one is decoded while another's pixels are worked on; each token's buffers (decoded files,
+  // radiance image, samples) are reused from photo to photo, and the samples are appended in photo
+  // order, byte-identical to a photo-by-photo loop.
+  struct PhotoWork {
+    size_t group = 0;
+    std::vector<Image> decoded;
+    RadianceImage image;
+    std::vector<BrdfSample> samples;
+    RejectionCounts rejected;
+    MeshPhotoStats mesh_stats;
+    double decode_s = 0.0;
+  };
+  const size_t tokens = size_t(std::max(2, 2 * tbb::this_task_arena::max_concurrency()));
+  std::vector<std::unique_ptr<PhotoWork>> work(tokens);
+  tbb::concurrent_queue<PhotoWork*> idle;
+  for (auto& w : work) {
+    w = std::make_unique<PhotoWork>();
+    idle.push(w.get());
   }
+  // Room for every pixel of every box: the samples never regrow, and only the pages written are touched.
+  const int stride = options.pixel_stride;
+  uint64_t box_pixels = 0;
+  for (const PixelBox& box : boxes) {
+    if (!box.Empty())
+      box_pixels += uint64_t((box.x1 - box.x0 + stride - 1) / stride) * ((box.y1 - box.y0 + stride - 1) / stride);
+  }
+  result.samples.reserve(box_pixels);
+  ProgressBar progress("photos", groups.size());
+  size_t next_group = 0;
+  tbb::parallel_pipeline(
+      tokens,
+      tbb::make_filter<void,
+                       PhotoWork*>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& control) -> PhotoWork* {
+        if (next_group == groups.size()) {
+          control.stop();
+          return nullptr;
+        }
+        PhotoWork* w = nullptr;
+        IBRDF_CHECK(idle.try_pop(w)) << "no idle photo buffers";
+        w->group = next_group++;
+        return w;
+      }) & tbb::make_filter<PhotoWork*, PhotoWork*>(tbb::filter_mode::parallel, [&](PhotoWork* w) {
+        const size_t g = w->group;
+        const PixelBox& box = boxes[g];
+        std::vector<PhotoSpec> exposures;
+        for (size_t i : groups[g]) exposures.push_back(session.photos[i]);
+        w->samples.clear();
+        w->rejected.clear();
+        w->mesh_stats = MeshPhotoStats();
+        w->decode_s = 0.0;
+        reader.ReadWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1}, &w->decoded,
+                          &w->image, &w->decode_s);
+        if (mesh_path) {
+          DerenderMeshPhoto(session, groups[g].front(), w->image, rays, *mesh_path, options, &w->samples,
+                            &w->mesh_stats);
+          AddCounts(w->mesh_stats.counts, &w->rejected);
+        } else {
+          // Room for every examined pixel: reserved once per buffer (regrowth copies and page
+          // faults cost more than the per-pixel geometry).
+          w->samples.reserve(PixelsPerImage(session.camera, options.pixel_stride));
+          DerenderPhoto(session, groups[g].front(), w->image, rays, sample, options, &w->samples, &w->rejected);
+        }
+        return w;
+      }) & tbb::make_filter<PhotoWork*, void>(tbb::filter_mode::serial_in_order, [&](PhotoWork* w) {
+        result.samples.insert(result.samples.end(), w->samples.begin(), w->samples.end());
+        for (const auto& [reason, count] : w->rejected) result.summary.rejected[reason] += count;
+        result.summary.decode_s += w->decode_s;
+        result.summary.shadow_rays += w->mesh_stats.shadow_rays;
+        result.summary.shadow_tests_skipped += w->mesh_stats.shadow_tests_skipped;
+        idle.push(w);
+        progress.Add(1);
+      }));
+  progress.Finish();
   const size_t measured = groups.size();
   result.summary.photos = measured;
   result.summary.pixels_examined = PixelsPerImage(session.camera, options.pixel_stride) * measured;

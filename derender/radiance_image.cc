@@ -160,17 +160,27 @@ RadianceReader::~RadianceReader() = default;
 double RadianceReader::Linear(double encoded) const { return impl_->ToLinear(encoded) - impl_->radiometry.black_level; }
 
 RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, double min_signal, double* decode_s) const {
+  std::vector<Image> decoded;
+  RadianceImage out;
+  ReadWindow(exposures, min_signal, PixelWindow{0, 0, impl_->width, impl_->height}, &decoded, &out, decode_s);
+  return out;
+}
+
+void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
+                                std::vector<Image>* decoded, RadianceImage* radiance_image, double* decode_s) const {
   IBRDF_CHECK(!exposures.empty());
   IBRDF_CHECK(exposures.size() < 256) << exposures.size() << " exposures";
   const Impl& impl = *impl_;
+  IBRDF_CHECK(window.x0 >= 0 && window.y0 >= 0 && window.x1 <= impl.width && window.y1 <= impl.height);
   const RadiometrySpec& radiometry = impl.radiometry;
   const size_t m = exposures.size();
-  std::vector<Image> images(m);
+  std::vector<Image>& images = *decoded;
+  if (images.size() < m) images.resize(m);
   std::vector<double> scale(m);  // exposure_s * gain
   for (size_t e = 0; e < m; ++e) {
     const std::string path = ResolvePath(impl.directory, exposures[e].file);
     Timer timer;
-    images[e] = ReadImage(path);
+    ReadImage(path, &images[e]);
     if (decode_s) *decode_s += timer.ElapsedSeconds();
     if (images[e].width != impl.width || images[e].height != impl.height) {
       ThrowError(path, "is " + std::to_string(images[e].width) + "x" + std::to_string(images[e].height) +
@@ -181,23 +191,29 @@ RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, doub
     }
     scale[e] = exposures[e].exposure_s * exposures[e].gain;
   }
-  RadianceImage out;
+  RadianceImage& out = *radiance_image;
   out.width = impl.width;
   out.height = impl.height;
   const size_t n = size_t(impl.width) * impl.height;
+  // Sized once; every pixel of the window is written below (sigma and exposures_used included), so
+  // nothing needs clearing between photos.
   out.radiance.resize(3 * n);
-  out.sigma.assign(3 * n, 0.0f);
-  out.flags.assign(n, 0);
-  if (m > 1) out.exposures_used.assign(n, 0);
+  out.sigma.resize(3 * n);
+  out.flags.resize(n);
+  if (m > 1) {
+    out.exposures_used.resize(n);
+  } else {
+    out.exposures_used.clear();
+  }
   const bool noise = radiometry.noise.has_value();
   const float* inverse_flat = impl.flat ? impl.flat->inverse.data() : nullptr;
 
-  tbb::parallel_for(tbb::blocked_range<int>(0, impl.height), [&](const tbb::blocked_range<int>& rows) {
+  tbb::parallel_for(tbb::blocked_range<int>(window.y0, window.y1), [&](const tbb::blocked_range<int>& rows) {
     // Per exposure of the pixel being worked on.
     std::vector<double> encoded(3 * m), radiance(3 * m);
     std::vector<uint8_t> flags(m);
     for (int y = rows.begin(); y < rows.end(); ++y) {
-      for (int x = 0; x < impl.width; ++x) {
+      for (int x = window.x0; x < window.x1; ++x) {
         const size_t p = size_t(y) * impl.width + x;
         double inverse[3] = {1.0, 1.0, 1.0};
         if (inverse_flat) {
@@ -239,7 +255,11 @@ RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, doub
             f = any_saturated ? kPixelSaturated : kPixelBelowSignal;
           }
           out.flags[p] = f;
-          for (int c = 0; c < 3; ++c) out.radiance[3 * p + c] = static_cast<float>(radiance[c]);
+          for (int c = 0; c < 3; ++c) {
+            out.radiance[3 * p + c] = static_cast<float>(radiance[c]);
+            out.sigma[3 * p + c] = 0.0f;
+          }
+          if (m > 1) out.exposures_used[p] = 0;
           continue;
         }
         int used = 0;
@@ -263,13 +283,13 @@ RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, doub
             used += c == 0;
           }
           out.radiance[3 * p + c] = static_cast<float>(weighted / weight_sum);
-          if (noise) out.sigma[3 * p + c] = static_cast<float>(1.0 / std::sqrt(weight_sum));
+          out.sigma[3 * p + c] = noise ? static_cast<float>(1.0 / std::sqrt(weight_sum)) : 0.0f;
         }
+        out.flags[p] = 0;
         if (m > 1) out.exposures_used[p] = static_cast<uint8_t>(used);
       }
     }
   });
-  return out;
 }
 
 RadianceImage ReadRadianceImage(const Session& session, const std::vector<size_t>& group, double min_signal,

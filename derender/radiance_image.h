@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include "core/image_io.h"
 #include "core/session.h"
 
 namespace ibrdf {
@@ -41,6 +42,11 @@ struct RadianceImage {
   size_t Index(int x, int y) const { return size_t(y) * width + x; }
 };
 
+// A rectangle of pixels [x0, x1) x [y0, y1) (the part of a photo that can see the sample).
+struct PixelWindow {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
 // The photos to derender, grouped by pose: measurement photos with the same `bracket` id form one
 // group (an exposure bracket; their poses must agree to 1 mm and 0.06 degrees); measurement photos
 // without a bracket id form one group per distinct camera_from_world (identical poses are a bracket);
@@ -65,6 +71,13 @@ class RadianceReader {
   // (DerenderOptions::min_signal). `decode_s`, when given, gets the seconds spent decoding files added.
   // Throws Error naming the photo for an unreadable or mis-sized file.
   RadianceImage Read(const std::vector<PhotoSpec>& exposures, double min_signal, double* decode_s = nullptr) const;
+
+  // As Read, into buffers reused from photo to photo (the derenderer's loop): `decoded` holds the
+  // decoded files and `out` the radiance image, both resized only when the camera's size changes.
+  // Only the pixels inside `window` are linearized and merged; outside it `out` keeps whatever it
+  // held, so the caller must read nothing there. Within the window the values are those of Read.
+  void ReadWindow(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
+                  std::vector<Image>* decoded, RadianceImage* out, double* decode_s = nullptr) const;
 
   // The linear signal of a file value (response inverted, black level subtracted), through a lookup
   // table for values in [1/64, 1] (exact for linear responses; within 3e-5 relative otherwise).

@@ -79,8 +79,6 @@ std::vector<ScanInputSpec> ResolveScanInputs(const ScanSources& sources, std::ve
   return inputs;
 }
 
-std::string ScanSidecarPath(const std::string& ply_path) { return ply_path + ".json"; }
-
 ScanResult RunScan(const std::vector<ScanInputSpec>& inputs, const ScanOptions& options) {
   std::string why;
   if (!options.Check(&why)) ThrowError("scan options", why);

@@ -14,6 +14,7 @@
 #include "scan/convexity.h"
 #include "scan/local_plane_normals.h"
 #include "scan/mesh_clean.h"
+#include "scan/mesh_file.h"  // ScanSidecarPath
 #include "scan/range_grid.h"
 #include "scan/scan_mesh.h"
 
@@ -91,7 +92,6 @@ ScanResult RunScan(const std::vector<ScanInputSpec>& inputs, const ScanOptions& 
 // both atomically.
 void WriteScanOutputs(const std::string& ply_path, const ScanResult& result, const ScanOptions& options);
 
-// The sidecar path: "<ply>.json".
-std::string ScanSidecarPath(const std::string& ply_path);
+// ScanSidecarPath (the sidecar path, "<ply>.json") is in scan/mesh_file.h, included above.
 
 }  // namespace ibrdf

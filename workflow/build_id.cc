@@ -2,7 +2,9 @@
 
 #include <elf.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -85,15 +87,51 @@ std::string FileContentHash(const std::string& path) {
   return "fnv1a64:" + Hex(bytes, 8);
 }
 
+namespace {
+
+std::string BinaryId(const std::string& path) {
+  const std::string elf = ElfBuildId(path);
+  return elf.empty() ? FileContentHash(path) : elf;
+}
+
+// The front end that started this process (apps/main.cc sets IBRDF_TOOL before it execs a
+// subcommand's binary), or "" when it was started directly.
+std::string ToolFrontEnd() {
+  const char* tool = std::getenv("IBRDF_TOOL");
+  if (!tool || !std::filesystem::is_regular_file(tool)) return "";
+  return tool;
+}
+
+}  // namespace
+
 std::string ExecutableBuildId() {
   static const std::string id = [] {
-    const std::string elf = ElfBuildId("/proc/self/exe");
-    return elf.empty() ? FileContentHash("/proc/self/exe") : elf;
+    const std::string tool = ToolFrontEnd();
+    if (tool.empty()) return BinaryId("/proc/self/exe");
+    // The tool is the front end and every ibrdf-<name> binary beside it: one id over all of them.
+    std::vector<std::string> binaries = {tool};
+    for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(tool).parent_path())) {
+      if (entry.path().filename().string().rfind("ibrdf-", 0) == 0 && entry.is_regular_file()) {
+        binaries.push_back(entry.path().string());
+      }
+    }
+    std::sort(binaries.begin() + 1, binaries.end());
+    uint64_t hash = 14695981039346656037ull;  // FNV-1a over "name=id;" of each binary
+    for (const std::string& binary : binaries) {
+      for (char c : std::filesystem::path(binary).filename().string() + "=" + BinaryId(binary) + ";") {
+        hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+      }
+    }
+    unsigned char bytes[8];
+    for (int i = 0; i < 8; ++i) bytes[i] = static_cast<unsigned char>(hash >> (56 - 8 * i));
+    return "ibrdf-tool:" + Hex(bytes, 8);
   }();
   return id;
 }
 
 std::string ExecutablePath() {
+  const std::string tool = ToolFrontEnd();
+  if (!tool.empty()) return tool;
   std::error_code error;
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
   IBRDF_CHECK(!error) << "cannot read /proc/self/exe: " << error.message();
