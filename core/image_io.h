@@ -1,7 +1,7 @@
-// Image I/O through OpenImageIO: every format it reads (8/16-bit PNG and TIFF, EXR, camera RAW ...)
-// into float pixels, file values normalized to [0, 1] for integer formats. Linearization is the
-// session's business (core/radiometry.h), except for camera RAW, which is decoded to a linear colour
-// space here, since OpenImageIO's RAW reader would otherwise apply an sRGB curve.
+// Image I/O through OpenImageIO (and libpng for plain PNGs): every format it reads (8/16-bit PNG and TIFF, EXR, camera
+// RAW ...) into float pixels, file values normalized to [0, 1] for integer formats. Linearization is the session's
+// business (core/radiometry.h), except for camera RAW, which is decoded to a linear colour space here, since
+// OpenImageIO's RAW reader would otherwise apply an sRGB curve.
 #pragma once
 
 #include <string>
@@ -33,8 +33,14 @@ enum class PixelFormat { kUint8, kUint16, kHalf, kFloat };
 Image ReadImage(const std::string& path);
 
 // As ReadImage, into `image`, whose pixel buffer is reused when it is large enough (a loop over photos
-// of one size allocates once).
+// of one size allocates once). Plain PNGs (8- or 16-bit grey or RGB, no alpha, palette, transparency
+// or interlacing) are decoded with libpng, to the same floats; everything else, and every write, goes
+// through OpenImageIO, loaded on first use (the module libibrdf_oiio.so: OpenImageIO's 260 shared
+// libraries are not loaded by a process that never needs them).
 void ReadImage(const std::string& path, Image* image);
+
+// ReadImage through OpenImageIO whatever the file (the reference for the PNG fast path).
+void ReadImageThroughOpenImageIO(const std::string& path, Image* image);
 
 // The size and channel count without decoding the pixels.
 struct ImageSpec {

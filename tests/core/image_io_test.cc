@@ -201,6 +201,43 @@ TEST_F(ImageIoTest, FailedWriteIsAnErrorAndLeavesNothing) {
   EXPECT_TRUE(Listing().empty());
 }
 
+// The libpng fast path gives OpenImageIO's floats bit for bit: every 16-bit and every 8-bit value, grey
+// and RGB; PNGs it does not handle (an alpha channel) still read, through OpenImageIO.
+TEST_F(ImageIoTest, PlainPngFastPathMatchesOpenImageIO) {
+  for (const auto& [format, levels] : {std::pair<PixelFormat, int>(PixelFormat::kUint16, 65536),
+                                       std::pair<PixelFormat, int>(PixelFormat::kUint8, 256)}) {
+    for (int channels : {1, 3, 4}) {
+      Image image(256, (levels * 3 + 255) / 256, channels);
+      for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = float(i % levels) / float(levels - 1);
+      const std::string path = Path("levels-" + std::to_string(levels) + "-" + std::to_string(channels) + ".png");
+      WriteImage(path, image, format);
+      Image fast, reference;
+      ReadImage(path, &fast);
+      ReadImageThroughOpenImageIO(path, &reference);
+      ASSERT_EQ(fast.channels, channels) << path;
+      ASSERT_EQ(fast.width, reference.width) << path;
+      ASSERT_EQ(fast.height, reference.height) << path;
+      ASSERT_EQ(fast.pixels.size(), reference.pixels.size()) << path;
+      size_t different = 0;
+      for (size_t i = 0; i < fast.pixels.size(); ++i) different += fast.pixels[i] != reference.pixels[i];
+      EXPECT_EQ(different, 0u) << path;
+      const ImageSpec spec = ReadImageSpec(path);
+      EXPECT_EQ(spec.width, reference.width);
+      EXPECT_EQ(spec.channels, channels);
+    }
+  }
+  // A corrupt PNG is an error naming the file, not a crash.
+  const std::string corrupt = Path("corrupt.png");
+  {
+    std::ifstream in(Path("levels-256-3.png"), std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    bytes.resize(bytes.size() / 2);
+    std::ofstream(corrupt, std::ios::binary) << bytes;
+  }
+  Image image;
+  ExpectErrorNamingPath([&] { ReadImage(corrupt, &image); }, corrupt);
+}
+
 TEST(IsRawExtension, KnowsCameraRawFormats) {
   EXPECT_TRUE(IsRawExtension("a/IMG_0001.CR2"));
   EXPECT_TRUE(IsRawExtension("b.nef"));

@@ -254,6 +254,36 @@ TEST(MeshDerender, ShadowRaysRejectWhatVisibilityOffAcceptsWrongly) {
       (unsigned long long)Rejected(with, "shadowed"), (unsigned long long)Rejected(with, "shadow_edge"));
 }
 
+// The scan stage's convexity verdict (<mesh>.json) is reused only when it describes the mesh at hand:
+// its mesh name and point and face counts match, and the mesh is not newer than it. A sidecar that
+// says "not convex" for the convex UV sphere shows which verdict was taken.
+TEST(MeshDerender, ScanSidecarIsReusedOnlyForTheSameMesh) {
+  ScratchDir dir;
+  const Session analytic = LambertianSession(dir / "s", SmallSphere());
+  const ScanMesh sphere = MakeUvEllipsoid(Eigen::Vector3d::Constant(0.04), 45, 90);
+  WritePly(dir / "s/sphere.ply", sphere);
+  const Session session = WithMesh(analytic, "sphere.ply");
+  auto write_sidecar = [&](const std::string& mesh, size_t faces) {
+    const nlohmann::json sidecar = {{"mesh", mesh},
+                                    {"points", sphere.points.size()},
+                                    {"faces", faces},
+                                    {"convexity", {{"needs_shadow_rays", true}}}};
+    std::ofstream(dir / "s/sphere.ply.json") << sidecar.dump();
+  };
+  write_sidecar("sphere.ply", sphere.faces.size());
+  DerenderResult result = Derender(session, DerenderOptions());
+  EXPECT_TRUE(result.summary.shadow_rays_on) << result.summary.visibility_reason;
+  EXPECT_NE(result.summary.visibility_reason.find("the scan's convexity report"), std::string::npos)
+      << result.summary.visibility_reason;
+  for (const auto& [mesh, faces] : {std::pair<std::string, size_t>("sphere.ply", sphere.faces.size() + 1),
+                                    std::pair<std::string, size_t>("other.ply", sphere.faces.size())}) {
+    write_sidecar(mesh, faces);
+    result = Derender(session, DerenderOptions());
+    EXPECT_FALSE(result.summary.shadow_rays_on) << result.summary.visibility_reason;
+    EXPECT_NE(result.summary.visibility_reason.find("is stale"), std::string::npos) << result.summary.visibility_reason;
+  }
+}
+
 TEST(MeshDerender, ReferenceMarkerInFrontOfTheSampleIsMasked) {
   ScratchDir dir;
   const Session analytic = LambertianSession(dir / "s", SmallSphere());
