@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -698,8 +699,15 @@ DerenderResult Derender(const Session& measured_session, const DerenderOptions& 
   const Session session = ApplyLightCalibration(measured_session, &calibration, calibration_options);
   if (calibration.calibrated) Log(1, calibration.BriefReport());
   if (session.sample.kind != SampleSpec::Kind::kMesh) return DerenderAnalytic(session, options);
+  const Timer setup;
   const MeshPath path = PrepareMeshPath(session, options);
-  return RunDerender(session, options, *path.mesh, &path);
+  const double setup_s = setup.ElapsedSeconds();
+  char seconds[32];
+  std::snprintf(seconds, sizeof(seconds), "%.2f s", setup_s);
+  Log(1, std::string("mesh set-up (read, ray-tracing scene, convexity): ") + seconds);
+  DerenderResult result = RunDerender(session, options, *path.mesh, &path);
+  result.summary.mesh_setup_s = setup_s;
+  return result;
 }
 
 nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options, const DerenderSummary& summary) {
@@ -735,6 +743,7 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
       {"timings_s", {{"total", summary.total_s}, {"decode_cpu", summary.decode_s}}},
   };
   if (session.sample.kind == SampleSpec::Kind::kMesh) {
+    sidecar["timings_s"]["mesh_setup"] = summary.mesh_setup_s;
     sidecar["mesh"] = {
         {"file", session.sample.mesh_file},          {"faces", summary.mesh_faces},
         {"shadow_rays", summary.shadow_rays_on},     {"visibility", summary.visibility_reason},

@@ -76,6 +76,7 @@ struct DerenderSummary {
   uint64_t shadow_tests_skipped = 0;  // pixels that would have had shadow rays, with visibility off
   double decode_s = 0.0;              // summed over threads: time to decode the photos
   double total_s = 0.0;               // wall clock
+  double mesh_setup_s = 0.0;          // mesh: reading it, the ray-tracing scene, the convexity verdict
   // "derender: 1234567 samples from 20 photos in 2.1 s; rejected: off_sample 10, saturated 3"
   std::string BriefReport() const;
 };
