@@ -398,11 +398,13 @@ ColmapModel ColmapModel::ReadText(const std::string& directory) {
       ColmapPoint3D point;
       point.id = ParseUnsigned(fields[0], where, "point id", UINT64_MAX);
       for (int c = 0; c < 3; ++c) point.xyz[c] = ParseReal(fields[1 + c], where, "coordinate");
-      for (int c = 0; c < 3; ++c) point.rgb[c] = static_cast<uint8_t>(ParseUnsigned(fields[4 + c], where, "colour", 255));
+      for (int c = 0; c < 3; ++c)
+        point.rgb[c] = static_cast<uint8_t>(ParseUnsigned(fields[4 + c], where, "colour", 255));
       point.error = ParseReal(fields[7], where, "error");
       for (size_t f = 8; f < fields.size(); f += 2) {
-        point.track.emplace_back(static_cast<uint32_t>(ParseUnsigned(fields[f], where, "track image id", UINT32_MAX)),
-                                 static_cast<uint32_t>(ParseUnsigned(fields[f + 1], where, "track point index", UINT32_MAX)));
+        point.track.emplace_back(
+            static_cast<uint32_t>(ParseUnsigned(fields[f], where, "track image id", UINT32_MAX)),
+            static_cast<uint32_t>(ParseUnsigned(fields[f + 1], where, "track point index", UINT32_MAX)));
       }
       const uint64_t id = point.id;
       if (!model.points.emplace(id, std::move(point)).second) ThrowError(where, "point id listed twice");

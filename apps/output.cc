@@ -51,10 +51,12 @@ void RequireOutputOutsideInputs(const std::string& output, const std::vector<std
   const std::filesystem::path out = Resolved(output);
   for (const std::string& input : inputs) {
     if (input.empty()) continue;
-    if (SameFile(output, input)) ThrowError(output, "is an input of this stage (" + input + "); no stage overwrites its inputs");
+    if (SameFile(output, input))
+      ThrowError(output, "is an input of this stage (" + input + "); no stage overwrites its inputs");
     if (IsWithin(Resolved(input), out)) {
-      ThrowError(output, "holds " + input + ", an input of this stage; writing there would replace it (--overwrite "
-                         "does not change this)");
+      ThrowError(output, "holds " + input +
+                             ", an input of this stage; writing there would replace it (--overwrite "
+                             "does not change this)");
     }
   }
 }

@@ -6,8 +6,8 @@
 #include <fstream>
 #include <limits>
 #include <set>
-#include <vector>
 #include <sstream>
+#include <vector>
 
 #include "core/error.h"
 #include "core/file_util.h"

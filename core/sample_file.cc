@@ -25,8 +25,12 @@ std::string InvalidSampleReason(const BrdfSample& s) {
   constexpr float kPi = 3.14159265358979f;
   constexpr float kAngleSlack = 1e-4f;  // float32 rounding of angles at the ends of their range
   constexpr float kUnitSlack = 1e-3f;   // float32 rounding of unit vectors
-  const auto finite3 = [](const float v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); };
-  const auto length = [](const float v[3]) { return std::sqrt(double(v[0]) * v[0] + double(v[1]) * v[1] + double(v[2]) * v[2]); };
+  const auto finite3 = [](const float v[3]) {
+    return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+  };
+  const auto length = [](const float v[3]) {
+    return std::sqrt(double(v[0]) * v[0] + double(v[1]) * v[1] + double(v[2]) * v[2]);
+  };
   if (!finite3(s.wi) || !finite3(s.wo)) return "wi or wo is not finite";
   if (std::abs(length(s.wi) - 1.0) > kUnitSlack) return "|wi| = " + std::to_string(length(s.wi)) + ", not 1";
   if (std::abs(length(s.wo) - 1.0) > kUnitSlack) return "|wo| = " + std::to_string(length(s.wo)) + ", not 1";
@@ -44,7 +48,8 @@ std::string InvalidSampleReason(const BrdfSample& s) {
       return "brdf[" + std::to_string(c) + "] = " + std::to_string(s.brdf[c]) + " is not a finite, non-negative value";
     }
     if (!(std::isfinite(s.sigma[c]) && s.sigma[c] >= 0)) {
-      return "sigma[" + std::to_string(c) + "] = " + std::to_string(s.sigma[c]) + " is not a finite, non-negative value";
+      return "sigma[" + std::to_string(c) + "] = " + std::to_string(s.sigma[c]) +
+             " is not a finite, non-negative value";
     }
   }
   return "";

@@ -55,11 +55,22 @@ inline std::vector<std::string> SplitParts(const uint8_t* data, size_t size, siz
   return parts;
 }
 
+// Set by the replay for the inputs of regressions/: each was accepted silently once and must now be
+// refused by every read of the target.
+inline bool& MustFail() {
+  static bool must_fail = false;
+  return must_fail;
+}
+
 // Runs `read`; returns normally for no exception or an ibrdf::Error naming a file under `dir`, aborts
-// for anything else.
+// for anything else (and for no exception when MustFail()).
 inline void ExpectCleanFailure(const std::string& dir, const std::function<void()>& read) {
   try {
     read();
+    if (MustFail()) {
+      std::fprintf(stderr, "a regression input was accepted: the reader must refuse it\n");
+      std::abort();
+    }
   } catch (const Error& error) {
     const std::string message = error.what();
     if (message.find(dir) == std::string::npos) {

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "fuzz/fuzz_input.h"
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
 int main(int argc, char** argv) {
@@ -36,6 +38,7 @@ int main(int argc, char** argv) {
   }
   for (const fs::path& file : files) {
     std::fprintf(stderr, "replay %s\n", file.c_str());
+    ibrdf::fuzz::MustFail() = file.string().find("/regressions/") != std::string::npos;
     std::ifstream in(file, std::ios::binary);
     const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     LLVMFuzzerTestOneInput(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());

@@ -88,7 +88,8 @@ std::string ReadWholeFile(const std::string& path) {
   std::error_code size_error;
   const uintmax_t bytes = std::filesystem::file_size(path, size_error);
   if (size_error || bytes > kMaxPlyBytes) {
-    ThrowError(path, size_error ? "cannot read the file's size" : "is " + std::to_string(bytes) + " bytes; PLY files are read up to 8 GiB");
+    ThrowError(path, size_error ? "cannot read the file's size"
+                                : "is " + std::to_string(bytes) + " bytes; PLY files are read up to 8 GiB");
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) ThrowError(path, "cannot open for reading");

@@ -77,8 +77,8 @@ TEST_F(NpyTest, HugeVersion2HeaderLengthIsAnError) {
 }
 
 TEST_F(NpyTest, DuplicateShapeKeyIsAnError) {
-  const std::string message = ReadError(
-      Npy1("{'descr': '<f8', 'fortran_order': False, 'shape': (1,), 'shape': (2,), }", Doubles({1, 2})));
+  const std::string message =
+      ReadError(Npy1("{'descr': '<f8', 'fortran_order': False, 'shape': (1,), 'shape': (2,), }", Doubles({1, 2})));
   EXPECT_NE(message.find("more than once"), std::string::npos) << message;
 }
 
@@ -114,8 +114,7 @@ TEST_F(NpyTest, NonRegularFilesAreRefused) {
   std::vector<size_t> shape;
   EXPECT_NE(ErrorOf([&] { ReadNpyArray(fifo, &shape); }).find("not a regular file"), std::string::npos);
   EXPECT_NE(ErrorOf([&] { ReadNpyArray("/dev/zero", &shape); }).find("/dev/zero"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ReadNpyArray(scratch_ / "missing.npy", &shape); }).find("does not exist"),
-            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ReadNpyArray(scratch_ / "missing.npy", &shape); }).find("does not exist"), std::string::npos);
 }
 
 }  // namespace
