@@ -105,7 +105,8 @@ std::vector<std::string> RemoveStaleTemporariesOf(const std::string& final_path,
   for (const fs::directory_entry& entry : it) {
     const std::string name = entry.path().filename().string();
     if (name.compare(0, prefix.size(), prefix) != 0) continue;
-    if (!is_directory && !final.extension().empty() && name.find(final.extension().string(), prefix.size()) == std::string::npos) {
+    if (!is_directory && !final.extension().empty() &&
+        name.find(final.extension().string(), prefix.size()) == std::string::npos) {
       continue;  // another file of the same stem
     }
     const int pid = std::atoi(name.c_str() + prefix.size());

@@ -690,8 +690,8 @@ DerenderResult DerenderToFile(const Session& session, const DerenderOptions& opt
              SampleKindName(session.sample.kind) + " sample, response " + session.radiometry.response.Describe());
   DerenderResult result = Derender(session, options);
   if (result.samples.empty()) {
-    ThrowError(session.manifest_path, "no BRDF samples: every pixel was rejected (" + result.summary.BriefReport() +
-                                          "); nothing written");
+    ThrowError(session.manifest_path,
+               "no BRDF samples: every pixel was rejected (" + result.summary.BriefReport() + "); nothing written");
   }
   // The samples and their sidecar as one unit (core/file_util.h): never a new file beside an old sidecar.
   AtomicFile samples_file(samples_path), sidecar_file(SidecarPath(samples_path));

@@ -36,8 +36,8 @@ StageInputs LoadInputs(const ReconstructOptions& options) {
       // Validated where read: a point outside the angles' ranges would be answered, wrongly.
       if (!(points[3 * i] >= 0 && points[3 * i] <= M_PI / 2 && points[3 * i + 1] >= 0 &&
             points[3 * i + 1] <= M_PI / 2 && std::abs(points[3 * i + 2]) <= M_PI)) {
-        ThrowError(options.eval_file, "row " + std::to_string(i) +
-                                          ": expected theta_i, theta_e in [0, pi/2] and delta_phi in [-pi, pi]");
+        ThrowError(options.eval_file,
+                   "row " + std::to_string(i) + ": expected theta_i, theta_e in [0, pi/2] and delta_phi in [-pi, pi]");
       }
       inputs.eval_wi.push_back(FromSpherical(points[3 * i], 0.0));
       inputs.eval_wo.push_back(FromSpherical(points[3 * i + 1], points[3 * i + 2]));
