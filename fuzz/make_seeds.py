@@ -88,14 +88,15 @@ for name in sorted(os.listdir(mats)):
     put("corpus", "material_json", name, open(os.path.join(mats, name), "rb").read())
     put("corpus", "truth_json", name, json.dumps({"format": "ibrdf-truth", "version": 1,
                                                   "material": json.load(open(os.path.join(mats, name)))}))
-synth = os.environ.get("SYNTH_DIR")
-if synth:
-    put("corpus", "truth_json", "synth-truth.json", open(os.path.join(synth, "truth.json"), "rb").read())
-    put("corpus", "session_json", "synth-session.json", open(os.path.join(synth, "session.json"), "rb").read())
+# SYNTH_DIR: session folders written by `ibrdf synth`, separated by ':' (e.g. a sphere and a --shape
+# squash --brackets 2 --light-unknown session, for the mesh, bracket and white-reference blocks).
+for k, synth in enumerate(filter(None, os.environ.get("SYNTH_DIR", "").split(":"))):
+    put("corpus", "truth_json", "synth-truth-%d.json" % k, open(os.path.join(synth, "truth.json"), "rb").read())
+    put("corpus", "session_json", "synth-session-%d.json" % k, open(os.path.join(synth, "session.json"), "rb").read())
 for t in ("material_json", "truth_json", "session_json"):
     put("regressions", t, "number_overflow.json", '{"format": 1e400}')
     put("regressions", t, "duplicate_key.json", '{"a": 1, "a": 2}')
-    put("regressions", t, "deep.json", "[" * 100000 + "]" * 100000)
+    put("regressions", t, "deep.json", "[" * 1000 + "]" * 1000)
     put("regressions", t, "not_json.json", "\x00\xff{")
 lam = open(os.path.join(mats, "lambertian50.json")).read()
 put("regressions", "material_json", "huge_number.json", lam.replace("0.5", "1e300", 1))
