@@ -98,8 +98,9 @@ for t in ("material_json", "truth_json", "session_json"):
     put("regressions", t, "duplicate_key.json", '{"a": 1, "a": 2}')
     put("regressions", t, "deep.json", "[" * 1000 + "]" * 1000)
     put("regressions", t, "not_json.json", "\x00\xff{")
-lam = open(os.path.join(mats, "lambertian50.json")).read()
-put("regressions", "material_json", "huge_number.json", lam.replace("0.5", "1e300", 1))
+put("regressions", "material_json", "huge_number.json", '{"model": "lambertian", "albedo": [1e300, 0.5, 0.5]}')
+put("regressions", "material_json", "huge_lobe.json",
+    '{"model": "lafortune", "diffuse": [0.1, 0.1, 0.1], "lobes": [{"Cxy": [-1, -1, -1], "Cz": [1e300, 1, 1], "n": [10, 10, 10]}]}')
 
 # .npy: sample files and plain arrays.
 def npy(descr, shape, data, version=1, header_extra=""):

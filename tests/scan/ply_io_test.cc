@@ -153,7 +153,11 @@ TEST(PlyIo, TruncatedAsciiIsAnError) {
   ScratchDir dir;
   const std::string text = kTriangleAscii;
   WriteText(dir / "cut.ply", text.substr(0, text.find("0 1 0\n")));
-  ExpectPlyError(dir / "cut.ply", "ends after 2 of 3 vertices");
+  // Caught before reading: the header's counts need more bytes than the file holds.
+  ExpectPlyError(dir / "cut.ply", "3 vertex entries need at least 6 bytes each, but only 13 bytes follow");
+  // Cut inside the face list, the body is read and ends early.
+  WriteText(dir / "cut2.ply", text.substr(0, text.size() - 2) + "  \n");
+  ExpectPlyError(dir / "cut2.ply", "the file ends inside face 0");
 }
 
 TEST(PlyIo, TruncatedHeaderIsAnError) {
