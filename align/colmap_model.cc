@@ -1,6 +1,10 @@
 #include "align/colmap_model.h"
 
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -126,10 +130,45 @@ std::vector<std::pair<int, std::string>> DataLines(const std::string& path) {
   return lines;
 }
 
-template <typename T>
-T Parse(std::istringstream& in, const std::string& where, const char* what) {
-  T value;
-  if (!(in >> value)) ThrowError(where, std::string("expected ") + what);
+std::vector<std::string> Fields(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> fields;
+  std::string field;
+  while (in >> field) fields.push_back(field);
+  return fields;
+}
+
+// Whole-token number parsing: "12x.5" or "0.1" in an integer field is an error naming the line, not 12
+// or 0 (stream extraction stopped at the first bad character and std::stod threw a bare "stod").
+uint64_t ParseUnsigned(const std::string& token, const std::string& where, const char* what, uint64_t max) {
+  if (token.empty() || !std::isdigit(static_cast<unsigned char>(token[0]))) {
+    ThrowError(where, std::string(what) + " '" + token + "' is not a non-negative integer");
+  }
+  errno = 0;
+  char* end = nullptr;
+  const unsigned long long value = std::strtoull(token.c_str(), &end, 10);
+  if (*end != '\0') ThrowError(where, std::string(what) + " '" + token + "' is not a non-negative integer");
+  if (errno == ERANGE || value > max) {
+    ThrowError(where, std::string(what) + " " + token + " is out of range (at most " + std::to_string(max) + ")");
+  }
+  return value;
+}
+
+int64_t ParseSigned(const std::string& token, const std::string& where, const char* what) {
+  errno = 0;
+  char* end = nullptr;
+  const long long value = std::strtoll(token.c_str(), &end, 10);
+  if (token.empty() || *end != '\0') ThrowError(where, std::string(what) + " '" + token + "' is not an integer");
+  if (errno == ERANGE) ThrowError(where, std::string(what) + " " + token + " is out of range");
+  return value;
+}
+
+// A finite real number, the whole token.
+double ParseReal(const std::string& token, const std::string& where, const char* what) {
+  char* end = nullptr;
+  const double value = std::strtod(token.c_str(), &end);
+  if (token.empty() || *end != '\0') ThrowError(where, std::string(what) + " '" + token + "' is not a number");
+  if (!std::isfinite(value)) ThrowError(where, std::string(what) + " " + token + " is not finite");
   return value;
 }
 
@@ -218,7 +257,10 @@ ColmapModel ColmapModel::ReadBinary(const std::string& directory) {
                               " (ibrdf reads SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL and OPENCV)");
       }
       std::vector<double> params(CameraModelNumParams(supported));
-      for (double& p : params) p = in.Read<double>("camera parameter");
+      for (double& p : params) {
+        p = in.Read<double>("camera parameter");
+        if (!std::isfinite(p)) ThrowError(where, "a camera parameter is not finite");
+      }
       if (!model.cameras.emplace(id, MakeCamera(name, width, height, params, where)).second) {
         ThrowError(where, "camera id listed twice");
       }
@@ -244,6 +286,7 @@ ColmapModel ColmapModel::ReadBinary(const std::string& directory) {
       for (uint64_t p = 0; p < points; ++p) {
         image.points2d[p].x() = in.Read<double>("2D point x");
         image.points2d[p].y() = in.Read<double>("2D point y");
+        if (!image.points2d[p].allFinite()) ThrowError(where, "2D point " + std::to_string(p) + " is not finite");
         const uint64_t id = in.Read<uint64_t>("3D point id");
         image.point3d_ids[p] = id == std::numeric_limits<uint64_t>::max() ? -1 : static_cast<int64_t>(id);
       }
@@ -260,6 +303,9 @@ ColmapModel ColmapModel::ReadBinary(const std::string& directory) {
       for (int c = 0; c < 3; ++c) point.xyz[c] = in.Read<double>("point coordinate");
       for (int c = 0; c < 3; ++c) point.rgb[c] = in.Read<uint8_t>("point colour");
       point.error = in.Read<double>("point error");
+      if (!point.xyz.allFinite() || !std::isfinite(point.error)) {
+        ThrowError(in.path() + ": point " + std::to_string(point.id), "coordinates or error not finite");
+      }
       const uint64_t track = in.Count("track length", 8);
       point.track.resize(track);
       for (auto& element : point.track) {
@@ -283,15 +329,19 @@ ColmapModel ColmapModel::ReadText(const std::string& directory) {
     const std::string path = Find(directory, "cameras.txt");
     for (const auto& [number, line] : DataLines(path)) {
       const std::string where = path + ":" + std::to_string(number);
-      std::istringstream in(line);
-      const uint32_t id = Parse<uint32_t>(in, where, "a camera id");
-      const std::string name = Parse<std::string>(in, where, "a camera model");
-      const uint64_t width = Parse<uint64_t>(in, where, "a width");
-      const uint64_t height = Parse<uint64_t>(in, where, "a height");
+      const std::vector<std::string> fields = Fields(line);
+      if (fields.size() < 4) ThrowError(where, "expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]");
+      const uint32_t id = static_cast<uint32_t>(ParseUnsigned(fields[0], where, "camera id", UINT32_MAX));
+      const std::string& name = fields[1];
+      const uint64_t width = ParseUnsigned(fields[2], where, "width", UINT32_MAX);
+      const uint64_t height = ParseUnsigned(fields[3], where, "height", UINT32_MAX);
       std::vector<double> params;
-      double p;
-      while (in >> p) params.push_back(p);
-      if (!in.eof()) ThrowError(where, "expected numeric camera parameters");
+      for (size_t f = 4; f < fields.size(); ++f) params.push_back(ParseReal(fields[f], where, "camera parameter"));
+      CameraModelId supported;
+      if (CameraModelFromName(name, &supported) && static_cast<int>(params.size()) != CameraModelNumParams(supported)) {
+        ThrowError(where, "camera model " + name + " has " + std::to_string(CameraModelNumParams(supported)) +
+                              " parameters, the line gives " + std::to_string(params.size()));
+      }
       if (!model.cameras.emplace(id, MakeCamera(name, width, height, params, where)).second) {
         ThrowError(where, "camera id listed twice");
       }
@@ -304,29 +354,31 @@ ColmapModel ColmapModel::ReadText(const std::string& directory) {
     // DataLines drops, so pair lines by content: a pose line has 10 fields, ending in the name.
     for (size_t i = 0; i < lines.size(); ++i) {
       const std::string where = path + ":" + std::to_string(lines[i].first);
-      std::istringstream in(lines[i].second);
+      const std::vector<std::string> pose = Fields(lines[i].second);
+      if (pose.size() != 10) {
+        ThrowError(where, "expected an image line IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME (10 fields), got " +
+                              std::to_string(pose.size()) + " fields");
+      }
       ColmapImage image;
-      image.id = Parse<uint32_t>(in, where, "an image id");
+      image.id = static_cast<uint32_t>(ParseUnsigned(pose[0], where, "image id", UINT32_MAX));
       double v[7];
-      for (double& x : v) x = Parse<double>(in, where, "a pose number");
+      for (int k = 0; k < 7; ++k) v[k] = ParseReal(pose[1 + k], where, "pose number");
       image.camera_from_world = MakePose(v[0], v[1], v[2], v[3], v[4], v[5], v[6], where);
-      image.camera_id = Parse<uint32_t>(in, where, "a camera id");
-      image.name = Parse<std::string>(in, where, "an image name");
+      image.camera_id = static_cast<uint32_t>(ParseUnsigned(pose[8], where, "camera id", UINT32_MAX));
+      image.name = pose[9];
       // The points line, if the next data line is not itself a pose line.
       if (i + 1 < lines.size()) {
-        std::istringstream points(lines[i + 1].second);
-        std::vector<std::string> fields;
-        std::string field;
-        while (points >> field) fields.push_back(field);
+        const std::vector<std::string> fields = Fields(lines[i + 1].second);
         const bool is_pose_line = fields.size() == 10;
         if (!is_pose_line) {
           ++i;
-          if (fields.size() % 3 != 0) {
-            ThrowError(path + ":" + std::to_string(lines[i].first), "expected triples X Y POINT3D_ID");
-          }
+          const std::string points_where = path + ":" + std::to_string(lines[i].first);
+          if (fields.size() % 3 != 0) ThrowError(points_where, "expected triples X Y POINT3D_ID");
           for (size_t f = 0; f < fields.size(); f += 3) {
-            image.points2d.emplace_back(std::stod(fields[f]), std::stod(fields[f + 1]));
-            image.point3d_ids.push_back(std::stoll(fields[f + 2]));
+            const double x = ParseReal(fields[f], points_where, "2D point x");
+            const double y = ParseReal(fields[f + 1], points_where, "2D point y");
+            image.points2d.emplace_back(x, y);
+            image.point3d_ids.push_back(ParseSigned(fields[f + 2], points_where, "3D point id"));
           }
         }
       }
@@ -338,19 +390,22 @@ ColmapModel ColmapModel::ReadText(const std::string& directory) {
     const std::string path = Find(directory, "points3D.txt");
     for (const auto& [number, line] : DataLines(path)) {
       const std::string where = path + ":" + std::to_string(number);
-      std::istringstream in(line);
-      ColmapPoint3D point;
-      point.id = Parse<uint64_t>(in, where, "a point id");
-      for (int c = 0; c < 3; ++c) point.xyz[c] = Parse<double>(in, where, "a coordinate");
-      for (int c = 0; c < 3; ++c) {
-        const int value = Parse<int>(in, where, "a colour");
-        if (value < 0 || value > 255) ThrowError(where, "colour out of range");
-        point.rgb[c] = static_cast<uint8_t>(value);
+      const std::vector<std::string> fields = Fields(line);
+      if (fields.size() < 8 || (fields.size() - 8) % 2 != 0) {
+        ThrowError(where, "expected POINT3D_ID X Y Z R G B ERROR and (IMAGE_ID POINT2D_IDX) pairs, got " +
+                              std::to_string(fields.size()) + " fields");
       }
-      point.error = Parse<double>(in, where, "an error");
-      uint32_t image_id, point_index;
-      while (in >> image_id >> point_index) point.track.emplace_back(image_id, point_index);
-      if (!in.eof()) ThrowError(where, "expected track pairs IMAGE_ID POINT2D_IDX");
+      ColmapPoint3D point;
+      point.id = ParseUnsigned(fields[0], where, "point id", UINT64_MAX);
+      for (int c = 0; c < 3; ++c) point.xyz[c] = ParseReal(fields[1 + c], where, "coordinate");
+      for (int c = 0; c < 3; ++c)
+        point.rgb[c] = static_cast<uint8_t>(ParseUnsigned(fields[4 + c], where, "colour", 255));
+      point.error = ParseReal(fields[7], where, "error");
+      for (size_t f = 8; f < fields.size(); f += 2) {
+        point.track.emplace_back(
+            static_cast<uint32_t>(ParseUnsigned(fields[f], where, "track image id", UINT32_MAX)),
+            static_cast<uint32_t>(ParseUnsigned(fields[f + 1], where, "track point index", UINT32_MAX)));
+      }
       const uint64_t id = point.id;
       if (!model.points.emplace(id, std::move(point)).second) ThrowError(where, "point id listed twice");
     }

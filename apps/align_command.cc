@@ -71,6 +71,16 @@ void AddAlignCommand(CLI::App& app) {
     options.align.fit_light = !args->no_light;
     options.align.fit_cylinder = !args->no_cylinder;
     options.colmap_runner.fix_intrinsics = !args->colmap_refine_intrinsics;
+    // The output guard: the session folder, its files, the COLMAP model and the calibration photos.
+    std::vector<std::string> inputs = session.InputFiles();
+    inputs.push_back(session.manifest_path);
+    inputs.push_back(session.directory);
+    for (const std::string& folder : {options.colmap_model, options.calibration_dir}) {
+      if (folder.empty()) continue;
+      inputs.push_back(folder);
+      for (const std::string& file : FilesUnder(folder)) inputs.push_back(file);
+    }
+    RequireWritableOutput(args->out, options.overwrite, inputs);
     AlignSessionToFolder(session, options, args->out);
     Log(1, "aligned session written to " + args->out + "/session.json");
   });

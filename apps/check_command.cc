@@ -39,7 +39,7 @@ void AddCheckCommand(CLI::App& app) {
   command->add_flag("--overwrite", args->overwrite, "Replace an existing report");
   command->callback([args] {
     StageLog stage("check");
-    RequireWritableOutput(args->out, args->overwrite, {args->samples});
+    RequireWritableOutput(args->out, args->overwrite, {args->samples, SidecarPath(args->samples)});
     const std::vector<BrdfSample> samples = ReadSamples(args->samples);
     WriteJsonFile(args->out, CheckSamples(samples, args->options, args->regression ? &args->prediction : nullptr));
     Log(1, "report written to " + args->out);

@@ -26,9 +26,20 @@ struct CommandRegistrar {
 // The registered subcommands, sorted by order.
 std::vector<AddCommandFunction> RegisteredCommands();
 
-// Throws Error unless `output` may be written: it must not be one of the stage's inputs, and an
-// existing file is replaced only with --overwrite.
+// The output guard of every subcommand: throws Error unless `output` (a file or a folder the command
+// writes or replaces) may be written. It must not be one of the command's inputs, nor a folder that
+// holds one (symlinks resolved), --overwrite or not; an existing output is replaced only with
+// --overwrite; its parent folder must exist. `inputs`: every file the command reads (missing ones and
+// "" are ignored), and every input folder.
 void RequireWritableOutput(const std::string& output, bool overwrite, const std::vector<std::string>& inputs);
+
+// The first half of RequireWritableOutput: `output` is no input and holds none (for `run`, whose folder
+// is resumed rather than replaced).
+void RequireOutputOutsideInputs(const std::string& output, const std::vector<std::string>& inputs);
+
+// Every regular file under `folder`, recursively (none if it is not a folder): the inputs of a command
+// that reads a whole folder (a run folder, a COLMAP model, a calibration folder).
+std::vector<std::string> FilesUnder(const std::string& folder);
 
 }  // namespace ibrdf
 

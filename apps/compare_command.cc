@@ -29,8 +29,10 @@ void AddCompareCommand(CLI::App& app) {
   command->add_flag("--overwrite", args->overwrite, "Replace an existing output");
   command->callback([args] {
     StageLog stage("compare");
-    if (!args->out.empty()) RequireWritableOutput(args->out, args->overwrite, {args->samples});
     const std::string truth_path = args->truth.empty() ? TruthPathFromSidecar(args->samples) : args->truth;
+    if (!args->out.empty()) {
+      RequireWritableOutput(args->out, args->overwrite, {args->samples, SidecarPath(args->samples), truth_path});
+    }
     const std::unique_ptr<BrdfModel> truth = LoadTruthMaterial(truth_path);
     const std::vector<BrdfSample> samples = ReadSamples(args->samples);
     const TruthComparison comparison = CompareWithTruth(samples, *truth);

@@ -61,6 +61,8 @@ void AddDerenderCommand(CLI::App& app) {
     const Session session = Session::Load(args->session);
     std::vector<std::string> inputs = session.InputFiles();
     inputs.push_back(session.manifest_path);
+    inputs.push_back(session.directory);
+    if (!session.sample.mesh_file.empty()) inputs.push_back(session.AbsolutePath(session.sample.mesh_file) + ".json");
     RequireWritableOutput(args->out, args->overwrite, inputs);
     RequireWritableOutput(SidecarPath(args->out), args->overwrite, inputs);
     DerenderToFile(session, args->options, args->out);

@@ -2,6 +2,7 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/logging.h"
+#include "core/sample_file.h"
 #include "reconstruct/reconstruction_stage.h"
 
 namespace ibrdf {
@@ -70,7 +71,8 @@ void AddReconstructCommand(CLI::App& app) {
   command->callback([args] {
     StageLog stage("reconstruct");
     ReconstructOptions& options = args->o;
-    RequireWritableOutput(args->out, options.overwrite, {args->samples});
+    RequireWritableOutput(args->out, options.overwrite,
+                          {args->samples, SidecarPath(args->samples), options.truth_file, options.eval_file});
     if (args->no_fold) options.regression.fold_reciprocity = options.regression.fold_bilateral = false;
     if (args->linear_values) options.regression.log_space = false;
     options.fits = !args->no_fits;

@@ -1,4 +1,6 @@
 // ibrdf report: the consistency report of a run folder (report/report_stage.h) behind flags.
+#include <filesystem>
+
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/logging.h"
@@ -33,6 +35,14 @@ void AddReportCommand(CLI::App& app) {
     StageLog stage("report");
     const int size = args->options.render_size;
     if (size < 16 || size > 4096) ThrowError("ibrdf report", "--render-size must be in [16, 4096]");
+    // The output guard: every file of the run folder is an input, except the default report's own.
+    const std::filesystem::path own_report = std::filesystem::path(args->run_dir) / "report";
+    std::vector<std::string> inputs = {args->run_dir};
+    for (const std::string& file : FilesUnder(args->run_dir)) {
+      if (std::filesystem::path(file).lexically_relative(own_report).string().rfind("..", 0) != 0) continue;
+      inputs.push_back(file);
+    }
+    RequireWritableOutput(args->out.empty() ? own_report.string() : args->out, args->options.overwrite, inputs);
     WriteReport(args->run_dir, args->options, args->out);
   });
 }

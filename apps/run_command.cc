@@ -70,6 +70,8 @@ void AddRunCommand(CLI::App& app) {
     Timer wall;
     std::string why;
     if (!args->options.Check(&why)) ThrowError("ibrdf run", why);
+    // The output guard: the run folder is resumed, not replaced, but it must not be (or hold) the input.
+    RequireOutputOutsideInputs(args->out, {args->input});
     // The input: a recipe folder, or a session (validated here, so a bad one is one clear line).
     const MeasurementInput input = OpenMeasurementInput(args->input, args->out);
     WorkflowRun run({args->out, ExecutableBuildId(), "ibrdf 0.1.0", args->options.force, args->options.stop_after});

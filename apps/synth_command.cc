@@ -93,6 +93,7 @@ void AddSynthCommand(CLI::App& app) {
     request.light_photos_given = light_photos->count() > 0;
     const SynthOptions options = SynthOptionsFromRequest(request);
     StageLog stage("synth");
+    RequireWritableOutput(args->out, args->overwrite, {args->material});
     const std::unique_ptr<BrdfModel> material = LoadMaterial(args->material);
     const SynthSummary summary = WriteSyntheticSession(options, *material, args->material, args->out, args->overwrite);
     Log(1, summary.BriefReport());

@@ -1,5 +1,6 @@
 #include "core/brdf_model.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -65,8 +66,33 @@ nlohmann::json GgxBrdf::ToJson() const {
 namespace {
 Eigen::Vector3d NonNegative(JsonObject& object, const std::string& key) {
   const Eigen::Vector3d v = object.Vector3(key);
-  if ((v.array() < 0.0).any()) ThrowError(object.Where(key), "expected non-negative values");
+  if (!v.allFinite() || (v.array() < 0.0).any()) ThrowError(object.Where(key), "expected non-negative values");
   return v;
+}
+
+// An albedo or reflectance: in [0, 1] (energy conservation of the diffuse term).
+Eigen::Vector3d Reflectance(JsonObject& object, const std::string& key) {
+  const Eigen::Vector3d v = NonNegative(object, key);
+  if ((v.array() > 1.0).any()) ThrowError(object.Where(key), "expected reflectances in [0, 1]");
+  return v;
+}
+
+// Lafortune lobe coefficients: |C| <= 10 and 0 < n <= 10000, and a lobe peak max(|Cxy|, |Cz|)^n of at
+// most 1e6 /sr (a material with Cz 1e300 made synth expose its photos for 0 s).
+void CheckLobe(const LafortuneLobe& lobe, JsonObject& object) {
+  constexpr double kMaxCoefficient = 10.0, kMaxExponent = 1e4, kMaxPeak = 1e6;
+  for (int c = 0; c < 3; ++c) {
+    if (!(std::abs(lobe.cxy[c]) <= kMaxCoefficient)) ThrowError(object.Where("Cxy"), "expected |Cxy| <= 10");
+    if (!(std::abs(lobe.cz[c]) <= kMaxCoefficient)) ThrowError(object.Where("Cz"), "expected |Cz| <= 10");
+    if (!(lobe.n[c] > 0.0 && lobe.n[c] <= kMaxExponent)) {
+      ThrowError(object.Where("n"), "exponents must be positive and at most 10000");
+    }
+    const double peak = std::pow(std::max(std::abs(lobe.cxy[c]), std::abs(lobe.cz[c])), lobe.n[c]);
+    if (!(peak <= kMaxPeak)) {
+      ThrowError(object.Where(), "the lobe peaks at " + std::to_string(peak) +
+                                     " /sr (max(|Cxy|, |Cz|)^n); at most 1e6 is physically plausible");
+    }
+  }
 }
 }  // namespace
 
@@ -79,23 +105,23 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
   const std::string model = object.String("model");
   std::unique_ptr<BrdfModel> brdf;
   if (model == "lambertian") {
-    brdf = std::make_unique<LambertianBrdf>(NonNegative(object, "albedo"));
+    brdf = std::make_unique<LambertianBrdf>(Reflectance(object, "albedo"));
   } else if (model == "lafortune") {
-    const Eigen::Vector3d diffuse = NonNegative(object, "diffuse");
+    const Eigen::Vector3d diffuse = Reflectance(object, "diffuse");
     std::vector<LafortuneLobe> lobes;
     for (JsonObject& lobe_object : object.Objects("lobes")) {
       LafortuneLobe lobe;
       lobe.cxy = lobe_object.Vector3("Cxy");
       lobe.cz = lobe_object.Vector3("Cz");
       lobe.n = lobe_object.Vector3("n");
-      if ((lobe.n.array() <= 0.0).any()) ThrowError(lobe_object.Where("n"), "exponents must be positive");
+      CheckLobe(lobe, lobe_object);
       lobe_object.Finish();
       lobes.push_back(lobe);
     }
     brdf = std::make_unique<LafortuneBrdf>(diffuse, std::move(lobes));
   } else if (model == "ggx") {
-    const Eigen::Vector3d diffuse = NonNegative(object, "diffuse_albedo");
-    const Eigen::Vector3d f0 = NonNegative(object, "specular_f0");
+    const Eigen::Vector3d diffuse = Reflectance(object, "diffuse_albedo");
+    const Eigen::Vector3d f0 = Reflectance(object, "specular_f0");
     const double alpha = object.Number("alpha");
     if (!(alpha > 0.0 && alpha <= 1.0)) ThrowError(object.Where("alpha"), "expected 0 < alpha <= 1");
     brdf = std::make_unique<GgxBrdf>(diffuse, f0, alpha);

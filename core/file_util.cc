@@ -1,11 +1,15 @@
 #include "core/file_util.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstdlib>
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/logging.h"
 
 namespace fs = std::filesystem;
 
@@ -25,6 +29,7 @@ AtomicFile::AtomicFile(std::string final_path) : final_path_(std::move(final_pat
   const fs::path temporary =
       final.parent_path() / ("." + final.stem().string() + UniqueSuffix() + final.extension().string());
   temporary_path_ = temporary.string();
+  RemoveStaleTemporariesOf(final_path_, false);
 }
 
 AtomicFile::~AtomicFile() {
@@ -51,6 +56,7 @@ AtomicDirectory::AtomicDirectory(std::string final_path, bool replace_existing)
   const fs::path parent = final.has_parent_path() ? final.parent_path() : fs::path(".");
   if (!fs::is_directory(parent)) ThrowError(final_path_, "parent folder does not exist");
   temporary_path_ = (parent / ("." + final.filename().string() + UniqueSuffix())).string();
+  RemoveStaleTemporariesOf(final_path_, true);
   fs::create_directories(temporary_path_);
 }
 
@@ -78,6 +84,39 @@ void AtomicDirectory::Commit() {
   }
   committed_ = true;
   if (!old_path.empty()) fs::remove_all(old_path, error);
+}
+
+void CommitWithManifest(AtomicFile* data, AtomicFile* manifest) {
+  std::error_code error;
+  fs::remove(manifest->final_path(), error);
+  if (error) ThrowError(manifest->final_path(), "cannot remove the previous file: " + error.message());
+  data->Commit();
+  manifest->Commit();
+}
+
+std::vector<std::string> RemoveStaleTemporariesOf(const std::string& final_path, bool is_directory) {
+  std::vector<std::string> removed;
+  const fs::path final(final_path);
+  const fs::path parent = final.has_parent_path() ? final.parent_path() : fs::path(".");
+  const std::string prefix = "." + (is_directory ? final.filename().string() : final.stem().string()) + ".tmp-";
+  std::error_code error;
+  fs::directory_iterator it(parent, error);
+  if (error) return removed;
+  for (const fs::directory_entry& entry : it) {
+    const std::string name = entry.path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    if (!is_directory && !final.extension().empty() &&
+        name.find(final.extension().string(), prefix.size()) == std::string::npos) {
+      continue;  // another file of the same stem
+    }
+    const int pid = std::atoi(name.c_str() + prefix.size());
+    if (pid <= 0 || ::kill(pid, 0) == 0 || errno != ESRCH) continue;  // its writer may still run
+    std::error_code ignored;
+    fs::remove_all(entry.path(), ignored);
+    removed.push_back(entry.path().string());
+    Log(1, "removed the leftover of an interrupted write: " + entry.path().string());
+  }
+  return removed;
 }
 
 void RequireFile(const std::string& path, const std::string& what) {

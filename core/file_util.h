@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace ibrdf {
 
@@ -44,6 +45,16 @@ class AtomicDirectory {
   bool replace_existing_;
   bool committed_ = false;
 };
+
+// Moves two finished files into place as one unit: `manifest` (the sidecar that describes `data`) is
+// removed first and moved into place last, so a process stopped in between leaves `data` without a
+// manifest (visibly incomplete), never a new `data` beside the previous run's manifest.
+void CommitWithManifest(AtomicFile* data, AtomicFile* manifest);
+
+// Removes the temporaries a killed writer of `final_path` left beside it (".NAME.tmp-PID-N..." whose
+// process no longer exists); those of live processes are kept. Called by AtomicFile and
+// AtomicDirectory, so each stage cleans up after its own interrupted runs. Returns the paths removed.
+std::vector<std::string> RemoveStaleTemporariesOf(const std::string& final_path, bool is_directory);
 
 // Throws Error unless `path` is an existing regular file.
 void RequireFile(const std::string& path, const std::string& what);

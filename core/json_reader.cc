@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
+#include <vector>
 
 #include "core/error.h"
 #include "core/file_util.h"
@@ -29,8 +31,36 @@ nlohmann::json ReadJsonFile(const std::string& path) {
   std::stringstream buffer;
   buffer << in.rdbuf();
   const std::string text = buffer.str();
+  // Nesting depth and duplicate keys are checked while parsing: a stamp nested 10^5 deep overflowed
+  // the stack of later recursive copies, and of two values of one key the library silently keeps the
+  // last (numpy and Python keep the last too, other tools the first): a duplicate is an error.
+  constexpr int kMaxDepth = 64;
+  std::vector<std::set<std::string>> keys;  // per open container; arrays get an empty, unused set
+  std::vector<std::string> pointer;         // the key of each open container, for messages
+  std::string last_key;
+  const auto callback = [&](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    if (event == Event::object_start || event == Event::array_start) {
+      if (depth >= kMaxDepth) {
+        ThrowError(path, "invalid JSON: nested deeper than " + std::to_string(kMaxDepth) + " levels");
+      }
+      pointer.push_back(keys.empty() ? "" : last_key);
+      keys.emplace_back();
+    } else if (event == Event::object_end || event == Event::array_end) {
+      if (!keys.empty()) keys.pop_back();
+      if (!pointer.empty()) pointer.pop_back();
+    } else if (event == Event::key) {
+      last_key = parsed.get<std::string>();
+      if (!keys.empty() && !keys.back().insert(last_key).second) {
+        std::string where;
+        for (size_t i = 1; i < pointer.size(); ++i) where += "/" + pointer[i];
+        ThrowError(path + ": " + where + "/" + last_key, "invalid JSON: the key appears more than once in its object");
+      }
+    }
+    return true;
+  };
   try {
-    return nlohmann::json::parse(text);
+    return nlohmann::json::parse(text, callback);
   } catch (const nlohmann::json::parse_error& e) {
     // Turn the byte offset into a line number.
     const size_t offset = std::min<size_t>(e.byte, text.size());

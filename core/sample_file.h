@@ -41,8 +41,12 @@ const char* BrdfSampleDtype();
 // Writes samples as .npy atomically.
 void WriteSamples(const std::string& path, const std::vector<BrdfSample>& samples);
 
+// Why a sample is not a valid measurement ("" when it is): non-finite values, |wi| or |wo| not 1,
+// theta_i or theta_e outside [0, pi/2], delta_phi outside [-pi, pi], a negative BRDF or sigma.
+std::string InvalidSampleReason(const BrdfSample& sample);
+
 // Reads a .npy written by WriteSamples (or by NumPy with the same dtype); throws Error naming the file
-// if the header, dtype or size do not match.
+// if the header, dtype or size do not match, or naming the first invalid sample (InvalidSampleReason).
 std::vector<BrdfSample> ReadSamples(const std::string& path);
 
 // The sidecar path for a sample file: "<path>.json".

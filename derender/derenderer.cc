@@ -765,8 +765,15 @@ DerenderResult DerenderToFile(const Session& session, const DerenderOptions& opt
   Log(1, "session " + session.name + ": " + std::to_string(session.photos.size()) + " photos, " +
              SampleKindName(session.sample.kind) + " sample, response " + session.radiometry.response.Describe());
   DerenderResult result = Derender(session, options);
-  WriteSamples(samples_path, result.samples);
-  WriteJsonFile(SidecarPath(samples_path), DerenderSidecar(session, options, result.summary));
+  if (result.samples.empty()) {
+    ThrowError(session.manifest_path,
+               "no BRDF samples: every pixel was rejected (" + result.summary.BriefReport() + "); nothing written");
+  }
+  // The samples and their sidecar as one unit (core/file_util.h): never a new file beside an old sidecar.
+  AtomicFile samples_file(samples_path), sidecar_file(SidecarPath(samples_path));
+  WriteSamples(samples_file.temporary_path(), result.samples);
+  WriteJsonFile(sidecar_file.temporary_path(), DerenderSidecar(session, options, result.summary));
+  CommitWithManifest(&samples_file, &sidecar_file);
   Log(1, result.summary.BriefReport());
   return result;
 }

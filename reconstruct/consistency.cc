@@ -122,9 +122,10 @@ ConsistencyReport CheckConsistency(const std::vector<BrdfSample>& samples, const
   std::unordered_map<int, std::vector<const BrdfSample*>> bins;
   for (const BrdfSample& s : samples) {
     if (!std::isfinite(s.theta_i) || !std::isfinite(s.theta_e) || !std::isfinite(s.delta_phi)) continue;
-    const int i = std::min(grid.n_theta - 1, static_cast<int>(s.theta_i / grid.theta_step));
-    const int j = std::min(grid.n_theta - 1, static_cast<int>(s.theta_e / grid.theta_step));
-    const int k = std::clamp(static_cast<int>((s.delta_phi + M_PI) / grid.phi_step), 0, grid.n_phi - 1);
+    // Clamped before the cast: a float beyond int's range is undefined behaviour (UBSan, issue 17).
+    const int i = static_cast<int>(std::clamp(s.theta_i / grid.theta_step, -1.0, grid.n_theta - 1.0));
+    const int j = static_cast<int>(std::clamp(s.theta_e / grid.theta_step, -1.0, grid.n_theta - 1.0));
+    const int k = static_cast<int>(std::clamp((s.delta_phi + M_PI) / grid.phi_step, 0.0, grid.n_phi - 1.0));
     if (i < 0 || j < 0) continue;
     bins[grid.Index(i, j, k)].push_back(&s);
   }

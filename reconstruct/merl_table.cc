@@ -103,6 +103,9 @@ MerlTable ReadMerl(const std::string& path) {
   in.read(reinterpret_cast<char*>(table.stored().data()),
           static_cast<std::streamsize>(3 * kMerlCells * sizeof(double)));
   if (!in) ThrowError(path, "read failed");
+  for (size_t i = 0; i < table.stored().size(); ++i) {
+    if (!std::isfinite(table.stored()[i])) ThrowError(path, "value " + std::to_string(i) + " is not finite");
+  }
   return table;
 }
 

@@ -1,5 +1,6 @@
 #include "reconstruct/reconstruction_stage.h"
 
+#include <cmath>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -29,9 +30,15 @@ StageInputs LoadInputs(const ReconstructOptions& options) {
   StageInputs inputs;
   if (!options.eval_file.empty()) {
     std::vector<size_t> shape;
-    const std::vector<double> points = ReadNpyArray(options.eval_file, &shape);
+    const std::vector<double> points = ReadNpyArray(options.eval_file, &shape, /*require_finite=*/true);
     if (shape.size() != 2 || shape[1] != 3) ThrowError(options.eval_file, "expected a float64 array of shape (N, 3)");
     for (size_t i = 0; i < shape[0]; ++i) {
+      // Validated where read: a point outside the angles' ranges would be answered, wrongly.
+      if (!(points[3 * i] >= 0 && points[3 * i] <= M_PI / 2 && points[3 * i + 1] >= 0 &&
+            points[3 * i + 1] <= M_PI / 2 && std::abs(points[3 * i + 2]) <= M_PI)) {
+        ThrowError(options.eval_file,
+                   "row " + std::to_string(i) + ": expected theta_i, theta_e in [0, pi/2] and delta_phi in [-pi, pi]");
+      }
       inputs.eval_wi.push_back(FromSpherical(points[3 * i], 0.0));
       inputs.eval_wo.push_back(FromSpherical(points[3 * i + 1], points[3 * i + 2]));
     }

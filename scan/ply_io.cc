@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -82,6 +83,14 @@ struct Header {
 
 std::string ReadWholeFile(const std::string& path) {
   RequireFile(path, "scan file");
+  // Bounded before reading: the whole file is held in memory.
+  constexpr uintmax_t kMaxPlyBytes = uintmax_t(8) << 30;
+  std::error_code size_error;
+  const uintmax_t bytes = std::filesystem::file_size(path, size_error);
+  if (size_error || bytes > kMaxPlyBytes) {
+    ThrowError(path, size_error ? "cannot read the file's size"
+                                : "is " + std::to_string(bytes) + " bytes; PLY files are read up to 8 GiB");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) ThrowError(path, "cannot open for reading");
   std::ostringstream buffer;
@@ -438,7 +447,14 @@ void ReadInstance(const Element& element, const ElementLayout& layout, uint64_t 
     if (static_cast<int>(p) == layout.ilist) values->list.clear();
     for (int k = 0; k < static_cast<int>(count); ++k) {
       if (!reader->Read(property.type, &value)) fail();
-      if (static_cast<int>(p) == layout.ilist) values->list.push_back(static_cast<int>(value));
+      if (static_cast<int>(p) == layout.ilist) {
+        // An index outside int (a uint32 over 2^31, an ASCII 1e12) would overflow the cast.
+        if (!(value >= 0 && value <= double(std::numeric_limits<int>::max()))) {
+          ThrowError(path, element.name + " " + std::to_string(i) + ": vertex index " + std::to_string(value) +
+                               " is negative or too large" + reader->Context());
+        }
+        values->list.push_back(static_cast<int>(value));
+      }
     }
   }
   if (reader->ascii() && reader->LineHasMore()) {
@@ -451,6 +467,18 @@ void ReadInstance(const Element& element, const ElementLayout& layout, uint64_t 
 void StoreInstance(const ElementLayout& layout, uint64_t i, const InstanceValues& values, const std::string& path,
                    std::vector<std::vector<int>>* polygons, ScanMesh* mesh) {
   if (layout.is_vertex) {
+    // Per-vertex values must be usable: finite, the scan stage's fit quality not negative.
+    if (layout.iquality >= 0 && !(values.quality >= 0 && std::isfinite(values.quality))) {
+      ThrowError(path, "vertex " + std::to_string(i) + ": quality (fit RMS, metres) " + std::to_string(values.quality) +
+                           " is not a finite, non-negative number");
+    }
+    if (layout.ineighbours >= 0 && !(values.neighbours >= 0 && values.neighbours <= 1e9)) {
+      ThrowError(path, "vertex " + std::to_string(i) + ": fit_neighbours " + std::to_string(values.neighbours) +
+                           " is not a count");
+    }
+    if (layout.ihull >= 0 && !std::isfinite(values.hull)) {
+      ThrowError(path, "vertex " + std::to_string(i) + ": hull_distance is not finite");
+    }
     mesh->points.emplace_back(values.point[0], values.point[1], values.point[2]);
     if (layout.inx >= 0) mesh->normals.emplace_back(values.normal[0], values.normal[1], values.normal[2]);
     if (layout.iquality >= 0) mesh->fit_rms_m.push_back(static_cast<float>(values.quality));
@@ -500,11 +528,40 @@ void FinishMesh(const std::vector<std::vector<int>>& polygons, const std::string
   if (mesh->points.empty()) ThrowError(path, "no vertices");
 }
 
+// Every element count checked against the bytes that remain before anything is allocated: an instance
+// takes at least its fixed-size properties' bytes (binary) or one character and a separator per
+// property (ASCII). A 300-byte file declaring a 100000 x 20000 range grid is an error, not 8 GB.
+void CheckCountsAgainstSize(const Header& header, size_t data_size, const std::string& path) {
+  uint64_t remaining = data_size - std::min(data_size, header.body_offset) + 1;  // + 1: a final line without '\n'
+  for (const Element& element : header.elements) {
+    uint64_t min_bytes = 0;
+    for (const Property& property : element.properties) {
+      if (header.format == Format::kAscii) {
+        min_bytes += 2;
+      } else {
+        min_bytes += static_cast<uint64_t>(TypeSize(property.is_list ? property.count_type : property.type));
+      }
+    }
+    if (min_bytes == 0) {
+      if (element.count > 0) ThrowError(path, "element '" + element.name + "' has instances but no properties");
+      continue;
+    }
+    if (element.count > remaining / min_bytes) {
+      ThrowError(path, "header line " + std::to_string(element.header_line) + ": " + std::to_string(element.count) +
+                           " " + element.name + " entries need at least " + std::to_string(min_bytes) +
+                           " bytes each, but only " + std::to_string(remaining) +
+                           " bytes follow the header (truncated file, or a wrong count)");
+    }
+    remaining -= element.count * min_bytes;
+  }
+}
+
 }  // namespace
 
 ScanMesh ReadPly(const std::string& path) {
   const std::string data = ReadWholeFile(path);
   const Header header = ParseHeader(data, path);
+  CheckCountsAgainstSize(header, data.size(), path);
   ScanMesh mesh;
   BodyReader reader(data, header, path);
   bool have_grid = false;

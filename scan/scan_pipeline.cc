@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/file_util.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
 #include "scan/adapters.h"
@@ -278,8 +279,11 @@ void WriteScanOutputs(const std::string& ply_path, const ScanResult& result, con
                         {"hull_tolerance_m", options.convexity.tolerance_m},
                         {"hull_tolerance_fraction", options.convexity.tolerance_fraction},
                         {"min_convex_fraction", options.convexity.min_convex_fraction}};
-  WritePly(ply_path, result.mesh);
-  WriteJsonFile(ScanSidecarPath(ply_path), sidecar);
+  // The mesh and its sidecar as one unit (core/file_util.h): never a new mesh beside an old sidecar.
+  AtomicFile mesh_file(ply_path), sidecar_file(ScanSidecarPath(ply_path));
+  WritePly(mesh_file.temporary_path(), result.mesh);
+  WriteJsonFile(sidecar_file.temporary_path(), sidecar);
+  CommitWithManifest(&mesh_file, &sidecar_file);
 }
 
 }  // namespace ibrdf

@@ -164,5 +164,42 @@ TEST(ColmapModelText, UnknownModelAndDanglingReferences) {
   EXPECT_EQ(model.points.at(5).track.size(), 1u);
 }
 
+// Issue 17: the text reader took "12x.5" as 12, "0.1" in an integer field as 0, ignored extra fields
+// and NaN, and let std::stod/std::stoll throw bare messages. Each is now one line naming file:line.
+TEST(ColmapModelText, NumbersAreWholeTokensAndFinite) {
+  ScratchDir dir;
+  const std::string cameras = "1 SIMPLE_RADIAL 640 480 500 320 240 0.01\n";
+  const std::string images = "1 1 0 0 0 0.1 0 1 1 a.jpg\n10 20 1 30 40 -1\n";
+  const std::string points = "1 0.5 0.2 3 10 20 30 0.7 1 0\n";
+  auto write = [&](const std::string& c, const std::string& i, const std::string& p) {
+    std::ofstream(dir / "cameras.txt") << c;
+    std::ofstream(dir / "images.txt") << i;
+    std::ofstream(dir / "points3D.txt") << p;
+  };
+  write(cameras, images, points);
+  EXPECT_EQ(ColmapModel::ReadText(dir.str()).points.size(), 1u);  // the base case reads
+  const struct {
+    std::string cameras, images, points, file, expected;
+  } cases[] = {
+      {cameras, "1 1 0 0 0 12x.5 0 1 1 a.jpg\n10 20 1 30 40 -1\n", points, "images.txt:1", "'12x.5' is not a number"},
+      {"1 SIMPLE_RADIAL 0.1 480 500 320 240 0.01\n", images, points, "cameras.txt:1", "'0.1' is not a non-negative"},
+      {"1 SIMPLE_RADIAL 640 480 500 320 240 0.01 7\n", images, points, "cameras.txt:1", "has 4 parameters"},
+      {"1 SIMPLE_RADIAL 640 480 500 320 240\n", images, points, "cameras.txt:1", "has 4 parameters"},
+      {cameras, "1 1 0 0 0 0.1 0 1 1 a.jpg extra\n10 20 1\n", points, "images.txt:1", "10 fields"},
+      {cameras, images, "1 nan 0.2 3 10 20 30 0.7 1 0\n", "points3D.txt:1", "not finite"},
+      {cameras, images, "1 0.5 0.2 3 10 20 30 0.7 1\n", "points3D.txt:1", "pairs"},
+      {cameras, "1 1 0 0 0 1e999 0 1 1 a.jpg\n10 20 1\n", points, "images.txt:1", "not finite"},
+      {cameras, "1 1 0 0 0 0.1 0 1 1 a.jpg\n10 20 99999999999999999999\n", points, "images.txt:2", "out of range"},
+      {cameras, images, "1 0.5 0.2 3 10 20 300 0.7 1 0\n", "points3D.txt:1", "colour 300 is out of range"},
+  };
+  for (const auto& c : cases) {
+    write(c.cameras, c.images, c.points);
+    const std::string message = ErrorOf([&] { ColmapModel::ReadText(dir.str()); });
+    EXPECT_NE(message.find(c.file), std::string::npos) << message;
+    EXPECT_NE(message.find(c.expected), std::string::npos) << c.expected << ": " << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+}
+
 }  // namespace
 }  // namespace ibrdf

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/error_of.h"
+
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -351,6 +353,35 @@ TEST(LoadMaterial, ReadsFileAndNamesItInErrors) {
   }
   EXPECT_THROW(LoadMaterial(dir + "/missing.json"), Error);
   std::filesystem::remove_all(dir);
+}
+
+// Issue 17: a material with Cz 1e300 made `synth` write exposure_s 0. Values are validated where read:
+// each message names the file and the field.
+TEST(MaterialFromJson, ImplausibleValuesAreErrors) {
+  json lafortune = Bluepaint().ToJson();
+  lafortune["lobes"][0]["Cz"] = {1e300, 0.5, 0.5};
+  std::string message = testing::ErrorOf([&] { MaterialFromJson(lafortune, "m.json"); });
+  EXPECT_NE(message.find("m.json: /lobes/0/Cz"), std::string::npos) << message;
+  lafortune = Bluepaint().ToJson();
+  lafortune["lobes"][0]["Cz"] = {1.5, 0.5, 0.5};
+  lafortune["lobes"][0]["n"] = {200, 20, 20};  // 1.5^200 = 1.6e35 /sr at the peak
+  message = testing::ErrorOf([&] { MaterialFromJson(lafortune, "m.json"); });
+  EXPECT_NE(message.find("m.json: /lobes/0"), std::string::npos) << message;
+  EXPECT_NE(message.find("physically plausible"), std::string::npos) << message;
+  const json lambertian = {{"model", "lambertian"}, {"albedo", {1.5, 0.5, 0.5}}};
+  message = testing::ErrorOf([&] { MaterialFromJson(lambertian, "l.json"); });
+  EXPECT_NE(message.find("l.json: /albedo"), std::string::npos) << message;
+  const json ggx = {
+      {"model", "ggx"}, {"diffuse_albedo", {0.5, 0.5, 0.5}}, {"specular_f0", {0.04, 2, 0.04}}, {"alpha", 0.3}};
+  message = testing::ErrorOf([&] { MaterialFromJson(ggx, "g.json"); });
+  EXPECT_NE(message.find("g.json: /specular_f0"), std::string::npos) << message;
+}
+
+// Every material of samples/materials still loads under these bounds.
+TEST(MaterialFromJson, SampleMaterialsLoad) {
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(IBRDF_SAMPLES_DIR) + "/materials")) {
+    EXPECT_NO_THROW(LoadMaterial(entry.path().string())) << entry.path();
+  }
 }
 
 }  // namespace

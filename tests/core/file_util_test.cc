@@ -2,6 +2,7 @@
 // folder unless asked to.
 #include "core/file_util.h"
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -201,6 +202,51 @@ TEST_F(FileUtilTest, SameFile) {
   EXPECT_FALSE(SameFile(Path("a.txt"), Path("b.txt")));
   EXPECT_TRUE(SameFile(Path("new.txt"), dir_ + "/x/../new.txt"));  // neither exists yet
   EXPECT_FALSE(SameFile(Path("new.txt"), Path("other.txt")));
+}
+
+// Issue 17: a killed writer's temporaries (".NAME.tmp-PID-N") were cleaned only by `ibrdf run`; now
+// the next writer of the same output removes them, and keeps those of live processes.
+TEST_F(FileUtilTest, StaleTemporariesAreRemovedByTheNextWriter) {
+  // A process id that no longer exists: a child that has exited and been reaped.
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  ASSERT_GT(child, 0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  const std::string dead = std::to_string(child), live = std::to_string(getpid());
+  fs::create_directories(Path(".rec.tmp-" + dead + "-3/sub"));
+  fs::create_directories(Path(".rec.tmp-" + live + "-9"));
+  std::ofstream(Path(".samples.tmp-" + dead + "-1.npy")) << "x";
+  std::ofstream(Path(".other.tmp-" + dead + "-1.npy")) << "x";
+  {
+    AtomicDirectory directory(Path("rec"), false);
+    AtomicFile file(Path("samples.npy"));
+  }
+  EXPECT_EQ(Listing(), (std::vector<std::string>{".other.tmp-" + dead + "-1.npy", ".rec.tmp-" + live + "-9"}));
+}
+
+// Issue 17: the samples and their sidecar were renamed separately; stopped in between, a new file sat
+// beside the previous run's sidecar. CommitWithManifest removes the old manifest first and moves the
+// new one last: a failure between leaves the data without a manifest, never paired with the old one.
+TEST_F(FileUtilTest, CommitWithManifestNeverPairsNewDataWithOldManifest) {
+  std::ofstream(Path("data")) << "old";
+  std::ofstream(Path("data.json")) << "old";
+  {
+    AtomicFile data(Path("data")), manifest(Path("data.json"));
+    std::ofstream(manifest.temporary_path()) << "new";
+    // The data's temporary is missing: its rename fails after the old manifest was removed.
+    EXPECT_THROW(CommitWithManifest(&data, &manifest), Error);
+  }
+  EXPECT_EQ(ReadText(Path("data")), "old");
+  EXPECT_FALSE(fs::exists(Path("data.json")));
+  std::ofstream(Path("data.json")) << "old";
+  AtomicFile data(Path("data")), manifest(Path("data.json"));
+  std::ofstream(data.temporary_path()) << "new";
+  std::ofstream(manifest.temporary_path()) << "new";
+  CommitWithManifest(&data, &manifest);
+  EXPECT_EQ(ReadText(Path("data")), "new");
+  EXPECT_EQ(ReadText(Path("data.json")), "new");
+  EXPECT_EQ(Listing(), (std::vector<std::string>{"data", "data.json"}));
 }
 
 }  // namespace

@@ -250,5 +250,24 @@ TEST_F(JsonFileTest, WriteReadRoundTrip) {
   EXPECT_EQ(files, 1u);
 }
 
+// Issue 17: of two values of one key the library kept the last silently; now an Error naming the key.
+TEST_F(JsonFileTest, DuplicateKeyIsAnError) {
+  const std::string path = Path("twice.json");
+  std::ofstream(path) << "{\"light\": {\"intensity\": 1, \"intensity\": 2}}\n";
+  ExpectError([&] { ReadJsonFile(path); }, {path, "/light/intensity", "more than once"});
+  // The same key in two different objects is fine.
+  std::ofstream(path) << "{\"a\": {\"x\": 1}, \"b\": {\"x\": 2}, \"c\": [{\"x\": 1}, {\"x\": 2}]}\n";
+  EXPECT_EQ(ReadJsonFile(path)["b"]["x"], 2);
+}
+
+// Issue 17: a run-folder stamp nested 10^5 deep overflowed the stack of a later recursive copy.
+TEST_F(JsonFileTest, DeepNestingIsAnError) {
+  const std::string path = Path("deep.json");
+  std::ofstream(path) << std::string(100000, '[') << std::string(100000, ']');
+  ExpectError([&] { ReadJsonFile(path); }, {path, "nested deeper than 64"});
+  std::ofstream(path) << std::string(60, '[') << std::string(60, ']');
+  EXPECT_TRUE(ReadJsonFile(path).is_array());
+}
+
 }  // namespace
 }  // namespace ibrdf

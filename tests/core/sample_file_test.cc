@@ -9,7 +9,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -17,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "tests/error_of.h"
 #include "tests/scratch_dir.h"
 
 namespace fs = std::filesystem;
@@ -26,20 +29,21 @@ namespace {
 
 constexpr char kPython[] = "/usr/bin/python3";
 
-// Three rows with distinct, exactly representable values in every field.
+// Three rows with distinct, exactly representable values in every field, each a valid sample (unit
+// directions, angles in range, non-negative BRDF and sigma).
 std::vector<BrdfSample> TestSamples() {
   std::vector<BrdfSample> samples(3);
   for (size_t r = 0; r < samples.size(); ++r) {
     BrdfSample& s = samples[r];
     const float base = static_cast<float>(r);
     for (int k = 0; k < 3; ++k) {
-      s.wi[k] = base + 0.125f * k;
-      s.wo[k] = -base - 0.25f * k;
+      s.wi[k] = k == 2 - static_cast<int>(r) ? 1.0f : 0.0f;
+      s.wo[k] = k == static_cast<int>(r) ? 1.0f : 0.0f;
       s.brdf[k] = 0.25f * (k + 1) + base;
       s.sigma[k] = 0.0625f * (k + 1);
     }
-    s.theta_i = 0.5f + base;
-    s.theta_e = 0.75f + base;
+    s.theta_i = 0.25f + 0.25f * base;
+    s.theta_e = 0.125f + 0.25f * base;
     s.delta_phi = -0.5f - base;
     s.image = static_cast<uint32_t>(7 * r + 1);
     s.pixel[0] = static_cast<uint32_t>(640 + r);
@@ -237,7 +241,7 @@ TEST_F(SampleFileTest, NumpyLoadsTheFile) {
       "assert s.dtype.itemsize == 72, s.dtype\n"
       "assert s['brdf'].shape == (3, 3), s['brdf'].shape\n"
       "assert s['brdf'][1, 2] == 1.75, s['brdf'][1]\n"
-      "assert s['wi'][2, 1] == 2.125, s['wi'][2]\n"
+      "assert list(s['wi'][2]) == [1, 0, 0], s['wi'][2]\n"
       "assert s['delta_phi'][1] == -1.5, s['delta_phi']\n"
       "assert s['image'][2] == 15, s['image']\n"
       "assert list(s['pixel'][2]) == [642, 484], s['pixel']\n"
@@ -255,6 +259,8 @@ TEST_F(SampleFileTest, ReadsFileWrittenByNumpy) {
       "('theta_e', '<f4'), ('delta_phi', '<f4'), ('brdf', '<f4', (3,)), ('sigma', '<f4', (3,)), "
       "('image', '<u4'), ('pixel', '<u4', (2,))])\n"
       "a = numpy.zeros(2, dtype=dt)\n"
+      "a['wi'][:] = [0, 0, 1]\n"
+      "a['wo'][:] = [0, 0, 1]\n"
       "a['brdf'][1] = [0.25, 0.5, 0.75]\n"
       "a['theta_e'][1] = 1.5\n"
       "a['pixel'][1] = [3, 4]\n"
@@ -269,6 +275,33 @@ TEST_F(SampleFileTest, ReadsFileWrittenByNumpy) {
   EXPECT_EQ(samples[1].pixel[0], 3u);
   EXPECT_EQ(samples[1].pixel[1], 4u);
   EXPECT_EQ(samples[0].image, 9u);
+}
+
+// Issue 17: sample files with NaN or infinite values, angles out of range, |wi| != 1, negative sigma or
+// BRDF were read silently (and NaN reached `check` and `compare` outputs). Each is now an Error naming
+// the file and the first bad sample.
+TEST_F(SampleFileTest, InvalidSamplesAreErrors) {
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<std::pair<std::function<void(BrdfSample*)>, std::string>> cases = {
+      {[&](BrdfSample* s) { s->brdf[1] = nan; }, "brdf[1]"},
+      {[&](BrdfSample* s) { s->wi[0] = inf; }, "not finite"},
+      {[&](BrdfSample* s) { s->theta_i = 7.0f; }, "theta_i"},
+      {[&](BrdfSample* s) { s->theta_e = -0.5f; }, "theta_e"},
+      {[&](BrdfSample* s) { s->delta_phi = 4.0f; }, "delta_phi"},
+      {[&](BrdfSample* s) { s->wi[2] = 1.5f; }, "|wi|"},
+      {[&](BrdfSample* s) { s->wo[0] = 0.5f; }, "|wo|"},
+      {[&](BrdfSample* s) { s->sigma[0] = -1.0f; }, "sigma[0]"},
+      {[&](BrdfSample* s) { s->brdf[2] = -0.5f; }, "brdf[2]"},
+  };
+  const std::string path = Path("bad.npy");
+  for (const auto& [spoil, expected] : cases) {
+    std::vector<BrdfSample> samples = TestSamples();
+    spoil(&samples[1]);
+    WriteSamples(path, samples);
+    const std::string message = testing::ErrorOf([&] { ReadSamples(path); });
+    EXPECT_NE(message.find(path + ": sample 1: "), std::string::npos) << message;
+    EXPECT_NE(message.find(expected), std::string::npos) << expected << ": " << message;
+  }
 }
 
 }  // namespace

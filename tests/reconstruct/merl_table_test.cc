@@ -4,6 +4,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -94,6 +95,20 @@ TEST(MerlTable, BadFilesAreClearErrors) {
   }
   EXPECT_THROW(ReadMerl(dir / "bad.binary"), Error);
   EXPECT_THROW(ReadMerl(dir / "missing.binary"), Error);
+}
+
+// Issue 17: a NaN in a table was read silently; now an Error naming the file and the value's index.
+TEST(MerlTable, NonFiniteValueIsAnError) {
+  ScratchDir dir;
+  MerlTable table;
+  table.stored()[12345] = std::numeric_limits<double>::quiet_NaN();
+  WriteMerl(dir / "nan.binary", table);
+  try {
+    ReadMerl(dir / "nan.binary");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(dir / "nan.binary: value 12345 is not finite"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

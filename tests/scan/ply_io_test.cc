@@ -153,7 +153,11 @@ TEST(PlyIo, TruncatedAsciiIsAnError) {
   ScratchDir dir;
   const std::string text = kTriangleAscii;
   WriteText(dir / "cut.ply", text.substr(0, text.find("0 1 0\n")));
-  ExpectPlyError(dir / "cut.ply", "ends after 2 of 3 vertices");
+  // Caught before reading: the header's counts need more bytes than the file holds.
+  ExpectPlyError(dir / "cut.ply", "3 vertex entries need at least 6 bytes each, but only 13 bytes follow");
+  // Cut inside the face list, the body is read and ends early.
+  WriteText(dir / "cut2.ply", text.substr(0, text.size() - 2) + "  \n");
+  ExpectPlyError(dir / "cut2.ply", "the file ends inside face 0");
 }
 
 TEST(PlyIo, TruncatedHeaderIsAnError) {
@@ -237,6 +241,42 @@ TEST(PlyIo, MalformedHeadersAreErrors) {
   WriteText(dir / "f.ply",
             std::string(kTriangleAscii).replace(std::string(kTriangleAscii).find("1 0 0\n"), 6, "1 x 0\n"));
   ExpectPlyError(dir / "f.ply", "'x' is not a number");
+}
+
+// Issue 17: a 300-byte file declaring a 100000 x 20000 range grid allocated 8 GB before reading data.
+TEST(PlyIo, CountsAreCheckedAgainstTheFileSizeBeforeAllocating) {
+  ScratchDir dir;
+  WriteText(dir / "huge.ply",
+            "ply\nformat ascii 1.0\nobj_info num_cols 100000\nobj_info num_rows 20000\nelement vertex 1\n"
+            "property float x\nproperty float y\nproperty float z\nelement range_grid 2000000000\n"
+            "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0\n");
+  ExpectPlyError(dir / "huge.ply", "range_grid entries need at least");
+  std::string binary =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n";
+  binary.append(12, '\0');
+  WriteText(dir / "huge_binary.ply", binary);
+  ExpectPlyError(dir / "huge_binary.ply", "vertex entries need at least 12 bytes");
+}
+
+// Issue 17: negative range-grid indices and NaN quality were accepted silently.
+TEST(PlyIo, NegativeIndicesAndNonFiniteValuesAreErrors) {
+  ScratchDir dir;
+  WriteText(dir / "g.ply",
+            "ply\nformat ascii 1.0\nobj_info num_cols 2\nobj_info num_rows 1\nelement vertex 1\nproperty float x\n"
+            "property float y\nproperty float z\nelement range_grid 2\nproperty list uchar int vertex_indices\n"
+            "end_header\n0 0 0\n1 -5\n0\n");
+  ExpectPlyError(dir / "g.ply", "vertex index -5");
+  WriteText(dir / "q.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "property float quality\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0 nan\n1 0 0 1\n0 1 0 1\n3 0 1 2\n");
+  ExpectPlyError(dir / "q.ply", "vertex 0: quality");
+  WriteText(dir / "big.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "element face 1\nproperty list uchar uint vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+            "3 0 1 4000000000\n");
+  ExpectPlyError(dir / "big.ply", "negative or too large");
 }
 
 }  // namespace
