@@ -13,7 +13,7 @@ void AddCheckCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "check",
       "Check measured samples for reciprocity, f(ti, te, dphi) = f(te, ti, -dphi), and bilateral\n"
-      "symmetry, f(ti, te, dphi) = f(ti, te, -dphi): each sample against the measured sample nearest its\n"
+      "symmetry, f(ti, te, dphi) = f(ti, te, -dphi): each sample against the measured samples around its\n"
       "reciprocal (mirrored) point, binned; headline median and 95th percentile over bins, the worst bins\n"
       "located; writes the figures as JSON (docs/cli.md).");
   struct Args {
@@ -33,8 +33,9 @@ void AddCheckCommand(CLI::App& app) {
       ->add_option("--min-pairs,--min-samples", args->options.min_samples_per_bin,
                    "Sample pairs a bin needs to be reported (--min-samples: the old name, for one release)")
       ->capture_default_str();
-  command->add_option("--match-deg", args->options.match_deg,
-                      "A partner lies within this angle of the reciprocal (mirrored) point")
+  command
+      ->add_option("--match-deg", args->options.match_deg,
+                   "A partner lies within this angle of the reciprocal (mirrored) point")
       ->capture_default_str();
   command->add_option("--max-theta-deg", args->options.max_theta_deg, "Compare bins up to this theta")
       ->capture_default_str();

@@ -33,16 +33,19 @@ void AddReportCommand(CLI::App& app) {
                       "Reconstruction folder of `ibrdf reconstruct` (or its brdf.binary) to show, wherever it is\n"
                       "(default: RUN_DIR/reconstruction); the fits beside it are shown too");
   command->add_option("--photo", o.photo, "Photo index shown beside the renders (default: median phase angle)");
-  command->add_option("--angles-deg,--angles", o.angles_deg,
-                      "Incidence-plane angles theta_0, 1 to 8 in [0, 85] (--angles: the same, for one release)")
+  command
+      ->add_option("--angles-deg,--angles", o.angles_deg,
+                   "Incidence-plane angles theta_0, 1 to 8 in [0, 85] (--angles: the same, for one release)")
       ->delimiter(',')
       ->expected(1, 8)
       ->capture_default_str();
   command->add_option("--title", o.title, "Report title (default: the recipe's or session's name)");
-  command->add_option("--render-size-px,--render-size", o.render_size_px,
-                      "Rendered sphere size, pixels (--render-size: the old name, for one release)")
+  command
+      ->add_option("--render-size-px,--render-size", o.render_size_px,
+                   "Rendered sphere size, pixels (--render-size: the old name, for one release)")
       ->capture_default_str();
-  command->add_flag("!--no-explorer", o.explorer, "Skip explorer.html");
+  command->add_flag_callback(
+      "--no-explorer", [args] { args->options.explorer = false; }, "Skip explorer.html");
   command->add_flag("--overwrite", o.overwrite, "Replace an existing report folder");
   command->callback([args] {
     StageLog stage("report");

@@ -102,9 +102,12 @@ void AddRunCommand(CLI::App& app) {
                       "reconstruct: kernel radius along the sheets (default: reconstruct's)");
   command->add_option("--radius-d-deg", o.radius_d_deg,
                       "reconstruct: kernel radius across the sheets (default: reconstruct's)");
-  command->add_flag("!--no-fits", o.fits, "reconstruct: skip the Lafortune and GGX fits");
+  // Plain flags inverted in the callback: CLI11 shows a negated flag ("!--no-fits") as "--no-fits{false}".
+  command->add_flag_callback(
+      "--no-fits", [args] { args->options.fits = false; }, "reconstruct: skip the Lafortune and GGX fits");
   command->add_flag("--check-regression", o.check_regression, "check: also the regression checks (held-out photos)");
-  command->add_flag("!--no-report", o.report, "Skip the HTML report");
+  command->add_flag_callback(
+      "--no-report", [args] { args->options.report = false; }, "Skip the HTML report");
   command->add_flag("--force", o.force, "Re-run every stage, up to date or not");
   // Named pass-through options: each goes to its stage unchanged.
   struct Named {
@@ -129,11 +132,10 @@ void AddRunCommand(CLI::App& app) {
             std::string(named.stage) + ": " + named.help + " (passed to `ibrdf " + named.stage + " " + flag + "`)")
         ->type_name("VALUE");
   }
-  for (auto [flag, target, stage] :
-       {std::tuple{"--derender-args", &args->derender_args, "derender"},
-        std::tuple{"--check-args", &args->check_args, "check"},
-        std::tuple{"--reconstruct-args", &args->reconstruct_args, "reconstruct"},
-        std::tuple{"--report-args", &args->report_args, "report"}}) {
+  for (auto [flag, target, stage] : {std::tuple{"--derender-args", &args->derender_args, "derender"},
+                                     std::tuple{"--check-args", &args->check_args, "check"},
+                                     std::tuple{"--reconstruct-args", &args->reconstruct_args, "reconstruct"},
+                                     std::tuple{"--report-args", &args->report_args, "report"}}) {
     command
         ->add_option(flag, *target,
                      std::string("More arguments for `ibrdf ") + stage +

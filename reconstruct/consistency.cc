@@ -38,24 +38,33 @@ class PartnerGrid {
     }
   }
 
-  // The sample nearest to `target` within `radius` (<= the cell size), or -1.
-  int64_t Nearest(const Eigen::Vector3d& target, double radius) const {
+  // The partner of `target`: the samples within `radius` (<= the cell size) whose centroid lies within
+  // `radius` * kMaxCentroidOffset of it, so that the target is surrounded by them (interpolation, not
+  // extrapolation: the BRDF's slope cancels to first order in their mean). Returns false otherwise, or
+  // when `exclude` is among them only.
+  bool Partner(const Eigen::Vector3d& target, double radius, uint32_t exclude, Eigen::Vector3d* value) const {
+    constexpr double kMaxCentroidOffset = 0.25;
     const Eigen::Vector3i c = Cell(target);
-    double best = radius * radius;
-    int64_t found = -1;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), sum = Eigen::Vector3d::Zero();
+    int n = 0;
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dz = -1; dz <= 1; ++dz) {
           const auto it = cells_.find(Key(c + Eigen::Vector3i(dx, dy, dz)));
           if (it == cells_.end()) continue;
           for (const uint32_t index : it->second) {
-            const double d2 = (points_[index] - target).squaredNorm();
-            if (d2 <= best) best = d2, found = index;
+            if (index == exclude || (points_[index] - target).squaredNorm() > radius * radius) continue;
+            centroid += points_[index];
+            const BrdfSample& s = samples_[index];
+            sum += Eigen::Vector3d(s.brdf[0], s.brdf[1], s.brdf[2]);
+            ++n;
           }
         }
       }
     }
-    return found;
+    if (n == 0 || (centroid / n - target).norm() > kMaxCentroidOffset * radius) return false;
+    *value = sum / n;
+    return true;
   }
 
  private:
@@ -97,22 +106,21 @@ struct BinGrid {
 // Bins the pairs of every sample that `take` selects with its partner near `partner_point(sample)`.
 template <typename Take, typename PartnerPoint>
 ConsistencyFigure PairedFigure(const std::vector<BrdfSample>& samples, const std::vector<uint32_t>& usable,
-                             const PartnerGrid& grid, const BinGrid& bins, const ConsistencyOptions& options,
-                             Take take, PartnerPoint partner_point) {
+                               const PartnerGrid& grid, const BinGrid& bins, const ConsistencyOptions& options,
+                               Take take, PartnerPoint partner_point) {
   std::unordered_map<int, BinPairs> by_bin;
   const double radius = options.match_deg * kDegree;
   for (const uint32_t index : usable) {
     const BrdfSample& a = samples[index];
     if (!take(a)) continue;
-    const int64_t partner = grid.Nearest(partner_point(a), radius);
-    if (partner < 0 || partner == index) continue;
-    const BrdfSample& b = samples[partner];
+    Eigen::Vector3d b;
+    if (!grid.Partner(partner_point(a), radius, index, &b)) continue;
     BinPairs& pairs = by_bin[bins.Index(a)];
     for (int c = 0; c < 3; ++c) {
-      const double mean = 0.5 * (double(a.brdf[c]) + double(b.brdf[c]));
-      pairs.signed_diff[c].push_back(mean > 0.0 ? (double(a.brdf[c]) - double(b.brdf[c])) / mean : 0.0);
+      const double mean = 0.5 * (double(a.brdf[c]) + b[c]);
+      pairs.signed_diff[c].push_back(mean > 0.0 ? (double(a.brdf[c]) - b[c]) / mean : 0.0);
       pairs.a[c].push_back(a.brdf[c]);
-      pairs.b[c].push_back(b.brdf[c]);
+      pairs.b[c].push_back(b[c]);
     }
   }
   std::vector<int> order;
@@ -145,8 +153,7 @@ ConsistencyFigure PairedFigure(const std::vector<BrdfSample>& samples, const std
     for (int c = 0; c < 3; ++c) figure.per_channel_rel_error[c] = Percentile(channel_errors[c], 0.5);
     std::vector<size_t> worst(figure.bins.size());
     for (size_t i = 0; i < worst.size(); ++i) worst[i] = i;
-    std::stable_sort(worst.begin(), worst.end(),
-                     [&](size_t x, size_t y) { return errors[x] > errors[y]; });
+    std::stable_sort(worst.begin(), worst.end(), [&](size_t x, size_t y) { return errors[x] > errors[y]; });
     worst.resize(std::min<size_t>(worst.size(), size_t(options.worst_bins)));
     figure.worst = worst;
   }
@@ -156,11 +163,16 @@ ConsistencyFigure PairedFigure(const std::vector<BrdfSample>& samples, const std
 nlohmann::json Rgb(const Eigen::Vector3d& v) { return {v[0], v[1], v[2]}; }
 
 nlohmann::json BinJson(const BinComparison& bin) {
-  return {{"theta_i_deg", bin.center_deg[0]}, {"theta_e_deg", bin.center_deg[1]},
-          {"delta_phi_deg", bin.center_deg[2]}, {"pairs", bin.count_a},
-          {"count_a", bin.count_a},            {"count_b", bin.count_b},
-          {"value_a", Rgb(bin.value_a)},       {"value_b", Rgb(bin.value_b)},
-          {"rel_error_rgb", Rgb(bin.rel_error)}, {"rel_error", bin.mean_rel_error}};
+  return {{"theta_i_deg", bin.center_deg[0]},
+          {"theta_e_deg", bin.center_deg[1]},
+          {"delta_phi_deg", bin.center_deg[2]},
+          {"pairs", bin.count_a},
+          {"count_a", bin.count_a},
+          {"count_b", bin.count_b},
+          {"value_a", Rgb(bin.value_a)},
+          {"value_b", Rgb(bin.value_b)},
+          {"rel_error_rgb", Rgb(bin.rel_error)},
+          {"rel_error", bin.mean_rel_error}};
 }
 
 nlohmann::json FigureJson(const ConsistencyFigure& figure, int min_pairs) {
@@ -280,8 +292,9 @@ nlohmann::json ToJson(const ConsistencyReport& report, const ConsistencyOptions&
           {"version", 2},
           {"samples", report.samples},
           {"method",
-           "each sample paired with the measured sample nearest to its reciprocal (mirrored) point within "
-           "match_deg (no estimate, no extrapolation); signed relative difference (a - b) / ((a + b) / 2) per "
+           "each sample paired with the mean of the measured samples within match_deg of its reciprocal "
+           "(mirrored) point, where their centroid lies within match_deg / 4 of it (no extrapolation); signed relative "
+           "difference (a - b) / ((a + b) / 2) per "
            "pair; a bin of (theta_i, theta_e, delta_phi) reports |median of its pairs' differences|; "
            "overall_rel_error = median over bins, p95_rel_error = 95th percentile over bins"},
           {"options",

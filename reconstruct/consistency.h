@@ -4,13 +4,14 @@
 //    of directions with light and camera exchanged;
 //  - bilateral symmetry: f(theta_i, theta_e, delta_phi) against f(theta_i, theta_e, -delta_phi) (the JSON
 //    keeps "isotropy" as an alias of "bilateral_symmetry" for one release).
-// Samples are compared with samples, never with an extrapolated estimate: each sample is paired with the
-// measured sample nearest to its reciprocal (or mirrored) point, when one lies within `match_deg`. Each
-// pair gives a signed relative difference (a - b) / ((a + b) / 2); a bin of (theta_i, theta_e,
-// delta_phi) reports |median of its pairs' signed differences|, so camera noise and the BRDF's slope over
-// the small offsets between partners (which fall on either side) cancel, while a real violation (a bias
-// of one sign) does not. The headline figures are the median and the 95th percentile over bins, and the
-// worst bins are listed with where they are.
+// Samples are compared with samples, never with an extrapolated estimate: each sample's partner is the
+// mean of the measured samples within `match_deg` of its reciprocal (or mirrored) point, taken only
+// where their centroid lies within a quarter of that radius of the point (the point is surrounded, so
+// the BRDF's slope cancels to first order; a point at the edge of the measured sheets gets no partner).
+// Each pair gives a signed relative difference (a - b) / ((a + b) / 2); a bin of (theta_i, theta_e,
+// delta_phi) reports |median of its pairs' signed differences|, so camera noise and the remaining
+// offsets (which fall on either side) cancel, while a real violation (a bias of one sign) does not. The headline
+// figures are the median and the 95th percentile over bins, and the worst bins are listed with where they are.
 #pragma once
 
 #include <string>
@@ -24,11 +25,11 @@
 namespace ibrdf {
 
 struct ConsistencyOptions {
-  double theta_bin_deg = 10.0;  // bin width in theta_i and theta_e, in (0, 45]
-  double phi_bin_deg = 20.0;    // bin width in delta_phi, divides 360
+  double theta_bin_deg = 10.0;   // bin width in theta_i and theta_e, in (0, 45]
+  double phi_bin_deg = 20.0;     // bin width in delta_phi, divides 360
   int min_samples_per_bin = 20;  // sample pairs a bin needs to be reported (CLI --min-pairs)
   double max_theta_deg = 80.0;   // samples beyond this theta_i or theta_e are not compared
-  double match_deg = 0.5;        // a partner lies within this angle of the reciprocal (mirrored) point, (0, 5]
+  double match_deg = 0.5;        // partners lie within this angle of the reciprocal (mirrored) point, [0.01, 5]
   int worst_bins = 5;            // the worst bins listed in the report, [0, 100]
   // False with `*why` naming the failing constraint.
   bool Check(std::string* why) const;
@@ -46,12 +47,12 @@ struct BinComparison {
 // One check's bins and headline figures.
 struct ConsistencyFigure {
   std::vector<BinComparison> bins;
-  size_t pairs = 0;                       // sample pairs in reported bins
-  double overall_rel_error = 0.0;         // the headline: the median over bins of mean_rel_error
+  size_t pairs = 0;                // sample pairs in reported bins
+  double overall_rel_error = 0.0;  // the headline: the median over bins of mean_rel_error
   Eigen::Vector3d per_channel_rel_error = Eigen::Vector3d::Zero();  // per channel, median over bins
-  double median_rel_error = 0.0;          // = overall_rel_error
-  double p95_rel_error = 0.0;             // the 95th percentile over bins
-  std::vector<size_t> worst;              // indices into `bins`, worst first
+  double median_rel_error = 0.0;                                    // = overall_rel_error
+  double p95_rel_error = 0.0;                                       // the 95th percentile over bins
+  std::vector<size_t> worst;                                        // indices into `bins`, worst first
   bool valid() const { return !bins.empty(); }
   // "0.12 % median, 0.80 % p95 over 312 bins (worst 2.1 % at theta_i 15, theta_e 45, delta_phi 170 deg)",
   // or "invalid: no bin had N sample pairs".

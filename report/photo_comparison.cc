@@ -43,7 +43,6 @@ PhotoRender RenderPhotoPixels(const Image& photo, const PixelBox& box, const std
   render.model = model;
   render.linear = Image(box.width(), box.height(), 3);
   render.difference = Image(box.width(), box.height(), 1);
-  std::fill(render.linear.pixels.begin(), render.linear.pixels.end(), NAN);
   std::fill(render.difference.pixels.begin(), render.difference.pixels.end(), NAN);
   const int stride = SampleStride(samples);
   const int before = stride / 2;

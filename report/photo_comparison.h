@@ -25,7 +25,7 @@ struct PixelBox {
 // One model's rendering of the photo's crop and its signed difference from the photo.
 struct PhotoRender {
   std::string model;  // "reconstruction", "lafortune", "ggx", "truth"
-  Image linear;       // RGB, the photo's units; NaN where the model has no value or no sample fell
+  Image linear;       // RGB, the photo's units; 0 where no sample fell, NaN where the model has no value
   Image difference;   // one channel: (render - photo) / photo in luminance; NaN where either is missing
   double median_abs_difference = 0.0;  // over the pixels that have one
 };

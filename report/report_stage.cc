@@ -67,10 +67,12 @@ std::string ReconstructionTable(const fs::path& run_dir, const std::string& give
   }
   if (fs::is_directory(given)) {
     const fs::path path = fs::path(given) / "brdf.binary";
-    if (!fs::is_regular_file(path)) ThrowError(given, "is a folder without brdf.binary (not an `ibrdf reconstruct` output)");
+    if (!fs::is_regular_file(path))
+      ThrowError(given, "is a folder without brdf.binary (not an `ibrdf reconstruct` output)");
     return path.string();
   }
-  if (!fs::is_regular_file(given)) ThrowError(given, "does not exist (--reconstruction: a reconstruction folder or its brdf.binary)");
+  if (!fs::is_regular_file(given))
+    ThrowError(given, "does not exist (--reconstruction: a reconstruction folder or its brdf.binary)");
   return given;
 }
 
@@ -103,9 +105,8 @@ RunModels LoadRunModels(const fs::path& run_dir, const std::string& reconstructi
   }
   for (size_t i = 0; i < models.fits.size(); ++i) {
     const BrdfModel* fit = models.fits[i].get();
-    models.named.push_back({models.fit_names[i], [fit](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) {
-                              return fit->Eval(wi, wo);
-                            }});
+    models.named.push_back({models.fit_names[i],
+                            [fit](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) { return fit->Eval(wi, wo); }});
   }
   if (models.truth) {
     const BrdfModel* truth = models.truth.get();
@@ -309,8 +310,11 @@ nlohmann::json IncidencePlanes(const std::vector<BrdfSample>& samples, const Run
 //  explorer-table-M.npy (32 x 32 x 32 cells, MERL's axes: theta_h on the square-root axis, theta_d,
 //    phi_d over [0, 180), at cell centres, RGB) for the lit sphere.
 nlohmann::json ExplorerGrids(const std::vector<BrdfSample>& samples, const RunModels& models, const fs::path& tmp) {
-  nlohmann::json grids = {{"theta_i_deg", {0, 85, 5}}, {"phi_deg", {0, 180, 15}}, {"theta_e_deg", {-89, 89, 1}},
-                          {"table_cells", 32}, {"models", nlohmann::json::array()}};
+  nlohmann::json grids = {{"theta_i_deg", {0, 85, 5}},
+                          {"phi_deg", {0, 180, 15}},
+                          {"theta_e_deg", {-89, 89, 1}},
+                          {"table_cells", 32},
+                          {"models", nlohmann::json::array()}};
   auto value = [](const Eigen::Vector3d& f, std::vector<float>* out) {
     for (int c = 0; c < 3; ++c) out->push_back(std::isfinite(f[c]) && f[c] >= 0.0 ? float(f[c]) : -1.0f);
   };

@@ -15,15 +15,15 @@
 namespace ibrdf {
 
 struct ReportOptions {
-  int photo = -1;                                   // the measured photo shown (negative: the one of median phase angle)
-  int render_size_px = 256;                         // pixels, square renders of a sphere, in [16, 4096]
+  int photo = -1;            // the measured photo shown (negative: the one of median phase angle)
+  int render_size_px = 256;  // pixels, square renders of a sphere, in [16, 4096]
   std::vector<double> angles_deg = {15, 30, 45, 60};  // incidence-plane angles theta_0, 1 to 8 in [0, 85]
-  std::string reconstruction;                       // the reconstruction folder or its brdf.binary (empty: RUN_DIR/reconstruction)
-  std::string title;                                // the report's title (empty: the recipe's or session's name)
-  bool explorer = true;                             // write explorer.html
-  bool overwrite = false;                           // replace an existing report folder
-  std::string script;                               // the plotting script (empty: FindReportScript())
-  std::string python;                               // the python3 that runs it (empty: ReportPython())
+  std::string reconstruction;  // the reconstruction folder or its brdf.binary (empty: RUN_DIR/reconstruction)
+  std::string title;           // the report's title (empty: the recipe's or session's name)
+  bool explorer = true;        // write explorer.html
+  bool overwrite = false;      // replace an existing report folder
+  std::string script;          // the plotting script (empty: FindReportScript())
+  std::string python;          // the python3 that runs it (empty: ReportPython())
   // False with `*why` naming the failing constraint.
   bool Check(std::string* why) const;
 };
@@ -50,8 +50,8 @@ struct ReportResult {
   std::string photo_note;       // why not, when the samples' session could not be read
   bool reconstruction = false;  // a reconstruction was found (its path in reconstruction_path)
   std::string reconstruction_path;
-  std::vector<std::string> fits;  // the fitted models found beside it ("lafortune", "ggx")
-  bool truth = false;             // the run's truth-comparison.json names a truth
+  std::vector<std::string> fits;     // the fitted models found beside it ("lafortune", "ggx")
+  bool truth = false;                // the run's truth-comparison.json names a truth
   std::vector<BandAgreement> bands;  // incidence-plane agreement of the reconstruction with the samples
   // One line: where, which photo, what was rendered.
   std::string BriefReport() const;

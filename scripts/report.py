@@ -386,9 +386,10 @@ def appearance_html(data, out, figures):
         parts.append(figure_html(out, photo["file"], f"measured photo {photo['index']} (linearized, full resolution, "
                                  f"pixels {x0}-{x1} x {y0}-{y1}, light {photo['phase_deg']:.0f} deg from the view)"))
         for r in photo.get("renders", []):
-            parts.append(figure_html(out, r["file"], f"{r['model']} rendered at the photo's own pixels (same camera, "
-                                     f"geometry and light; every {photo['stride']}th pixel, shown as blocks; "
-                                     "the photo's tone scale)"))
+            every = "every pixel" if photo["stride"] == 1 else \
+                f"every {photo['stride']}th pixel (the derender stride) shown as a block"
+            parts.append(figure_html(out, r["file"], f"{r['model']} rendered from the photo's camera ({every}; "
+                                     "black: no sample; magenta: no model value; the photo's tone scale)"))
         parts.append("<br>" + figure_html(out, figures.get("difference"), "signed difference of each render from "
                                           "the photo at the samples' pixels"))
     if "photo_note" in data:
@@ -744,7 +745,7 @@ def main():
 body {{ font-family: sans-serif; margin: 2em; max-width: 1500px; }}
 table {{ border-collapse: collapse; }} th, td {{ border: 1px solid #ccc; padding: 3px 8px; text-align: left; }}
 th {{ font-weight: normal; color: #444; }} figure {{ display: inline-block; margin: 0.5em; vertical-align: top; }}
-figure img {{ max-width: 100%; }} figcaption {{ font-size: 0.85em; color: #555; max-width: 40em; }}
+figure img {{ max-width: 100%; }} figcaption {{ font-size: 0.85em; color: #555; max-width: 24em; }}
 </style></head><body>
 <h1>ibrdf consistency report: {html.escape(title)}</h1>
 <p>Run folder: <code>{html.escape(os.path.abspath(run_dir))}</code>. Figures after Marschner et al. 1999, Image-Based

@@ -79,11 +79,10 @@ TEST_F(RunFolderTest, RunRefusesAnotherInputsFolderUnlessOverwrite) {
   EXPECT_NE(refused.exit_code, 0);
   EXPECT_NE(refused.output.find(out), std::string::npos) << refused.output;
   EXPECT_NE(refused.output.find(dir_ / "a"), std::string::npos) << refused.output;  // names the other input
-  EXPECT_EQ(ReadJson(out + "/run-input.json")["input"], dir_ / "a");                 // nothing changed
+  EXPECT_EQ(ReadJson(out + "/run-input.json")["input"], dir_ / "a");                // nothing changed
   // The same input resumes.
   EXPECT_EQ(RunIbrdf("run " + dir_ / "a" + " --out " + out + " --stop-after derender").exit_code, 0);
-  const RunResult overwritten =
-      RunIbrdf("run " + dir_ / "b" + " --out " + out + " --stop-after derender --overwrite");
+  const RunResult overwritten = RunIbrdf("run " + dir_ / "b" + " --out " + out + " --stop-after derender --overwrite");
   ASSERT_EQ(overwritten.exit_code, 0) << overwritten.output;
   EXPECT_EQ(ReadJson(out + "/run-input.json")["input"], dir_ / "b");
   EXPECT_EQ(ReadJson(out + "/summary.json")["input"], dir_ / "b");
@@ -152,21 +151,24 @@ namespace {
 // The README's demo figures come from a run's summary.json through scripts/readme_figures.py, not typed.
 TEST(ReportCli, ReadmeFiguresAreRegeneratedFromTheRun) {
   ScratchDir dir;
-  const nlohmann::json summary = {
-      {"samples", {{"accepted", 1234}}},
-      {"timings_s", {{"stages_total", 26.04}}},
-      {"truth",
-       {{"samples_median_rel_error", {0.01, 0.02, 0.03}},
-        {"brdf_rel_rmse", {0.004, 0.005, 0.006}},
-        {"brdf_cells_scored", 777}}},
-      {"consistency", {{"reciprocity", 0.0012}, {"isotropy", 0.0034}}},
-      {"report", "/x/report/index.html"}};
+  const nlohmann::json summary = {{"samples", {{"accepted", 1234}}},
+                                  {"timings_s", {{"stages_total", 26.04}}},
+                                  {"truth",
+                                   {{"samples_median_rel_error", {0.01, 0.02, 0.03}},
+                                    {"brdf_rel_rmse", {0.004, 0.005, 0.006}},
+                                    {"brdf_cells_scored", 777}}},
+                                  {"consistency", {{"reciprocity", 0.0012}, {"isotropy", 0.0034}}},
+                                  {"report", "/x/report/index.html"}};
   { std::ofstream(dir / "summary.json") << summary.dump(); }
-  { std::ofstream(dir / "README.md") << "intro\n<!-- readme-figures -->\n```\n1117060 samples; stages took 146.8 s\n```\n<!-- /readme-figures -->\nrest\n"; }
+  {
+    std::ofstream(dir / "README.md") << "intro\n<!-- readme-figures -->\n```\n1117060 samples; stages took 146.8 "
+                                        "s\n```\n<!-- /readme-figures -->\nrest\n";
+  }
   const std::string script = std::string(IBRDF_SAMPLES_DIR) + "/../scripts/readme_figures.py";
-  ASSERT_EQ(std::system(("/usr/bin/python3 " + script + " " + dir.str() + " --update " + dir / "README.md" +
-                         " > /dev/null").c_str()),
-            0);
+  ASSERT_EQ(
+      std::system(
+          ("/usr/bin/python3 " + script + " " + dir.str() + " --update " + dir / "README.md" + " > /dev/null").c_str()),
+      0);
   std::ifstream in(dir / "README.md");
   std::stringstream text;
   text << in.rdbuf();

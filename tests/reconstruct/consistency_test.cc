@@ -109,23 +109,24 @@ TEST(Consistency, BilateralSymmetryNameWithIsotropyAlias) {
 // The worst bins are located: listed worst first, at a bin where the violation was put.
 TEST(Consistency, WorstBinsAreLocated) {
   std::vector<BrdfSample> samples = BluepaintSamples(CameraEffects::None());
-  // Break reciprocity only in one region: theta_e in [40, 50) deg, theta_i < 20 deg, delta_phi in [20, 40).
+  // Break reciprocity only in one region (on the side theta_i < theta_e): theta_i in [20, 40) deg,
+  // theta_e in [40, 60), any delta_phi.
+  auto inside = [](double ti, double te) { return ti >= 20.0 && ti < 40.0 && te >= 40.0 && te < 60.0; };
   for (BrdfSample& s : samples) {
-    const double ti = s.theta_i * 180.0 / M_PI, te = s.theta_e * 180.0 / M_PI, dp = s.delta_phi * 180.0 / M_PI;
-    if (te >= 40.0 && te < 50.0 && ti < 20.0 && dp >= 20.0 && dp < 40.0) {
+    if (inside(s.theta_i * 180.0 / M_PI, s.theta_e * 180.0 / M_PI)) {
       for (float& f : s.brdf) f *= 1.3f;
     }
   }
   const ConsistencyReport report = CheckConsistency(samples, ConsistencyOptions());
-  ASSERT_FALSE(report.reciprocity.worst.empty());
-  const BinComparison& worst = report.reciprocity.bins[report.reciprocity.worst.front()];
-  EXPECT_GT(worst.mean_rel_error, 0.2);
-  EXPECT_NEAR(worst.center_deg[1], 45.0, 1e-9);
-  EXPECT_LT(worst.center_deg[0], 20.0);
-  EXPECT_NEAR(worst.center_deg[2], 30.0, 1e-9);
+  ASSERT_GE(report.reciprocity.worst.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    const BinComparison& worst = report.reciprocity.bins[report.reciprocity.worst[i]];
+    EXPECT_GT(worst.mean_rel_error, 0.2) << i;
+    EXPECT_TRUE(inside(worst.center_deg[0], worst.center_deg[1])) << worst.center_deg.transpose();
+  }
   EXPECT_LT(report.reciprocity.median_rel_error, 0.01);  // the rest is reciprocal
   const nlohmann::json json = ToJson(report, ConsistencyOptions());
-  EXPECT_NEAR(json["reciprocity"]["worst_bins"][0]["theta_e_deg"].get<double>(), 45.0, 1e-9);
+  EXPECT_GT(json["reciprocity"]["worst_bins"][0]["rel_error"].get<double>(), 0.2);
 }
 
 // The independent-renderer case: an exact glossy sample set (synth noise-free, GGX alpha 0.09) is

@@ -17,18 +17,18 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "core/brdf_coords.h"
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
 #include "core/sample_file.h"
 #include "core/session.h"
-#include "core/brdf_coords.h"
-#include "reconstruct/merl_table.h"
-#include "report/table_interpolation.h"
 #include "derender/derenderer.h"
 #include "reconstruct/consistency.h"
+#include "reconstruct/merl_table.h"
 #include "reconstruct/reconstruction_stage.h"
 #include "reconstruct/truth_comparison.h"
+#include "report/table_interpolation.h"
 #include "tests/scratch_dir.h"
 #include "tests/test_util.h"
 
@@ -115,13 +115,19 @@ TEST_F(ReportTest, WritesEveryFigureAndTheHtmlShowsThemInHeadlessChromium) {
   EXPECT_EQ(data.at("incidence_plane").size(), 4u);
   EXPECT_EQ(data.at("incidence_plane")[0].at("centre_abscissa_deg").size(),
             data.at("incidence_plane")[0].at("centre").at("truth").size());
-  // The title is the run folder's name here (no recipe; the session's name is the generator's "test").
-  EXPECT_EQ(data.at("title"), "run");
+  // The title is the session's name here (no recipe; not a generator's default "synth...").
+  EXPECT_EQ(data.at("title"), "s");
   for (const char* figure :
-       {"coverage.png", "incidence-plane.png", "reciprocity-curves.png", "reciprocity.png", "bilateral_symmetry.png",
-        "timings.png", "truth-bands.png", "photo.png", "photo-render-reconstruction.png", "photo-render-truth.png",
+       {"coverage.png", "incidence-plane.png", "reciprocity-curves.png", "timings.png", "truth-bands.png", "photo.png", "photo-render-reconstruction.png", "photo-render-truth.png",
         "photo-difference.png", "sphere-reconstruction.png", "sphere-truth.png", "explorer.html"}) {
     EXPECT_TRUE(fs::exists(folder + "/" + figure)) << figure;
+  }
+  // A consistency figure is drawn where it is valid, and said invalid where it is not.
+  const nlohmann::json consistency = ReadJsonFile(dir_ / "run/consistency.json");
+  for (const char* figure : {"reciprocity", "bilateral_symmetry"}) {
+    const bool valid = consistency.at(figure).at("valid");
+    EXPECT_EQ(fs::exists(folder + "/" + figure + ".png"), valid) << figure;
+    if (!valid) EXPECT_NE(Slurp(folder + "/index.html").find("invalid: no bin had"), std::string::npos);
   }
   // The reconstruction rendered at the photo's own pixels matches the photo (the truth exactly, up to
   // the camera noise of the samples).
@@ -250,7 +256,8 @@ TEST_F(ReportTest, ExplorerSliderChangesTheCurveAsTheTableSays) {
         << "no test output; DOM (first 500 characters): " << dom.substr(0, 500);
     std::string text = match[1];
     for (const auto& [from, to] : {std::pair<std::string, std::string>{"&quot;", "\""}, {"&amp;", "&"}}) {
-      for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at)) text.replace(at, from.size(), to);
+      for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at))
+        text.replace(at, from.size(), to);
     }
     const nlohmann::json drawn = nlohmann::json::parse(text);
     EXPECT_EQ(drawn.at("theta_i"), theta);
@@ -269,7 +276,8 @@ TEST_F(ReportTest, ExplorerSliderChangesTheCurveAsTheTableSays) {
         continue;
       }
       ASSERT_FALSE(values[k].is_null()) << x;
-      EXPECT_NEAR(values[k].get<double>(), expected[1], 1e-5 * expected[1] + 1e-7) << "theta_i " << theta << ", x " << x;
+      EXPECT_NEAR(values[k].get<double>(), expected[1], 1e-5 * expected[1] + 1e-7)
+          << "theta_i " << theta << ", x " << x;
       ++compared;
     }
     EXPECT_GT(compared, 100) << theta;
