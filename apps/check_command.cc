@@ -35,7 +35,8 @@ void AddCheckCommand(CLI::App& app) {
       ->capture_default_str();
   command
       ->add_option("--match-deg", args->options.match_deg,
-                   "A partner lies within this angle of the reciprocal (mirrored) point")
+                   "Partners lie within this angle of the reciprocal (mirrored) point; 0: automatic, the first of\n"
+                   "0.5, 1, 2, 4 deg giving both figures 20 bins (the JSON's match_deg_used)")
       ->capture_default_str();
   command->add_option("--max-theta-deg", args->options.max_theta_deg, "Compare bins up to this theta")
       ->capture_default_str();

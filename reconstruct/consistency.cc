@@ -222,7 +222,7 @@ bool ConsistencyOptions::Check(std::string* why) const {
   }
   IBRDF_CHECK_OPTION_RANGE(min_samples_per_bin, 1, 1000000);
   IBRDF_CHECK_OPTION_RANGE(max_theta_deg, 1.0, 90.0);
-  IBRDF_CHECK_OPTION_RANGE(match_deg, 0.01, 5.0);
+  IBRDF_CHECK_OPTION(match_deg == 0.0 || (match_deg >= 0.01 && match_deg <= 5.0));
   IBRDF_CHECK_OPTION_RANGE(worst_bins, 0, 100);
   return true;
 }
@@ -264,26 +264,38 @@ ConsistencyReport CheckConsistency(const std::vector<BrdfSample>& samples, const
     if (!(std::isfinite(s.brdf[0]) && std::isfinite(s.brdf[1]) && std::isfinite(s.brdf[2]))) continue;
     usable.push_back(uint32_t(i));
   }
-  const PartnerGrid grid(samples, usable, options.match_deg * kDegree);
-
   ConsistencyReport report;
   report.samples = samples.size();
   report.min_pairs = options.min_samples_per_bin;
-  // Each unordered pair once: reciprocity from the side theta_i < theta_e, bilateral symmetry from
-  // delta_phi < 0.
-  report.reciprocity = PairedFigure(
-      samples, usable, grid, bins, options, [](const BrdfSample& s) { return s.theta_i < s.theta_e; },
-      [](const BrdfSample& s) { return Embed(s.theta_e, s.theta_i, -s.delta_phi); });
-  report.bilateral_symmetry = PairedFigure(
-      samples, usable, grid, bins, options, [](const BrdfSample& s) { return s.delta_phi < 0.0f; },
-      [](const BrdfSample& s) { return Embed(s.theta_i, s.theta_e, -s.delta_phi); });
+  const std::vector<double> radii =
+      options.match_deg > 0.0 ? std::vector<double>{options.match_deg} : std::vector<double>{0.5, 1.0, 2.0, 4.0};
+  for (const double radius : radii) {
+    ConsistencyOptions at = options;
+    at.match_deg = radius;
+    const PartnerGrid grid(samples, usable, radius * kDegree);
+    report.match_deg = radius;
+    // Each unordered pair once: reciprocity from the side theta_i < theta_e, bilateral symmetry from
+    // delta_phi < 0.
+    report.reciprocity = PairedFigure(
+        samples, usable, grid, bins, at, [](const BrdfSample& s) { return s.theta_i < s.theta_e; },
+        [](const BrdfSample& s) { return Embed(s.theta_e, s.theta_i, -s.delta_phi); });
+    report.bilateral_symmetry = PairedFigure(
+        samples, usable, grid, bins, at, [](const BrdfSample& s) { return s.delta_phi < 0.0f; },
+        [](const BrdfSample& s) { return Embed(s.theta_i, s.theta_e, -s.delta_phi); });
+    if (report.reciprocity.bins.size() >= ConsistencyReport::kAutoMinBins &&
+        report.bilateral_symmetry.bins.size() >= ConsistencyReport::kAutoMinBins) {
+      break;
+    }
+  }
   report.success = true;
   return report;
 }
 
 std::string ConsistencyReport::BriefReport() const {
-  return "check: " + std::to_string(samples) + " samples; reciprocity " + reciprocity.Headline(min_pairs) +
-         "; bilateral symmetry " + bilateral_symmetry.Headline(min_pairs);
+  char radius[64];
+  std::snprintf(radius, sizeof(radius), " (partners within %g deg)", match_deg);
+  return "check: " + std::to_string(samples) + " samples" + radius + "; reciprocity " +
+         reciprocity.Headline(min_pairs) + "; bilateral symmetry " + bilateral_symmetry.Headline(min_pairs);
 }
 
 nlohmann::json ToJson(const ConsistencyReport& report, const ConsistencyOptions& options) {
@@ -303,6 +315,7 @@ nlohmann::json ToJson(const ConsistencyReport& report, const ConsistencyOptions&
             {"min_samples_per_bin", options.min_samples_per_bin},
             {"max_theta_deg", options.max_theta_deg},
             {"match_deg", options.match_deg}}},
+          {"match_deg_used", report.match_deg},
           {"reciprocity", FigureJson(report.reciprocity, report.min_pairs)},
           {"bilateral_symmetry", bilateral},
           {"isotropy", bilateral},  // the old name, kept for one release

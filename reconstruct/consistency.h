@@ -29,8 +29,11 @@ struct ConsistencyOptions {
   double phi_bin_deg = 20.0;     // bin width in delta_phi, divides 360
   int min_samples_per_bin = 20;  // sample pairs a bin needs to be reported (CLI --min-pairs)
   double max_theta_deg = 80.0;   // samples beyond this theta_i or theta_e are not compared
-  double match_deg = 0.5;        // partners lie within this angle of the reciprocal (mirrored) point, [0.01, 5]
-  int worst_bins = 5;            // the worst bins listed in the report, [0, 100]
+  // Partners lie within this angle of the reciprocal (mirrored) point, [0.01, 5]; 0: automatic, the
+  // first of 0.5, 1, 2 and 4 degrees at which both figures have kAutoMinBins bins (sparse sample sets,
+  // e.g. a derender stride, need a wider radius).
+  double match_deg = 0.0;
+  int worst_bins = 5;  // the worst bins listed in the report, [0, 100]
   // False with `*why` naming the failing constraint.
   bool Check(std::string* why) const;
 };
@@ -61,9 +64,11 @@ struct ConsistencyFigure {
 
 // Both checks of a sample set.
 struct ConsistencyReport {
+  static constexpr size_t kAutoMinBins = 20;
   bool success = false;
   size_t samples = 0;
-  int min_pairs = 0;  // the options' min_samples_per_bin, for the headlines
+  double match_deg = 0.0;  // the radius used
+  int min_pairs = 0;       // the options' min_samples_per_bin, for the headlines
   ConsistencyFigure reciprocity;
   ConsistencyFigure bilateral_symmetry;
   // One line: both headlines.

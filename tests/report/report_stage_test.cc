@@ -127,7 +127,9 @@ TEST_F(ReportTest, WritesEveryFigureAndTheHtmlShowsThemInHeadlessChromium) {
   for (const char* figure : {"reciprocity", "bilateral_symmetry"}) {
     const bool valid = consistency.at(figure).at("valid");
     EXPECT_EQ(fs::exists(folder + "/" + figure + ".png"), valid) << figure;
-    if (!valid) EXPECT_NE(Slurp(folder + "/index.html").find("invalid: no bin had"), std::string::npos);
+    if (!valid) {
+      EXPECT_NE(Slurp(folder + "/index.html").find("invalid: no bin had"), std::string::npos);
+    }
   }
   // The reconstruction rendered at the photo's own pixels matches the photo (the truth exactly, up to
   // the camera noise of the samples).
