@@ -132,14 +132,15 @@ void AddRunCommand(CLI::App& app) {
             std::string(named.stage) + ": " + named.help + " (passed to `ibrdf " + named.stage + " " + flag + "`)")
         ->type_name("VALUE");
   }
-  for (auto [flag, target, stage] : {std::tuple{"--derender-args", &args->derender_args, "derender"},
-                                     std::tuple{"--check-args", &args->check_args, "check"},
-                                     std::tuple{"--reconstruct-args", &args->reconstruct_args, "reconstruct"},
-                                     std::tuple{"--report-args", &args->report_args, "report"}}) {
+  for (auto [flag, target, stage, example] :
+       {std::tuple{"--derender-args", &args->derender_args, "derender", "--shadow-edge-deg 2"},
+        std::tuple{"--check-args", &args->check_args, "check", "--theta-bin-deg 5 --phi-bin-deg 10"},
+        std::tuple{"--reconstruct-args", &args->reconstruct_args, "reconstruct", "--degree 1 --no-fold"},
+        std::tuple{"--report-args", &args->report_args, "report", "--angles-deg 20,40,60"}}) {
     command
         ->add_option(flag, *target,
-                     std::string("More arguments for `ibrdf ") + stage +
-                         "`, one string split at spaces, e.g. \"--degree 1 --no-fold\"")
+                     std::string("More arguments for `ibrdf ") + stage + "`, one string split at spaces, e.g. \"" +
+                         example + "\"")
         ->type_name("\"ARGS\"");
   }
   command->add_option("--stop-after", o.stop_after,

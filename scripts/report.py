@@ -41,6 +41,7 @@ FIXED_EXITANCE_COLOUR = "#17becf"
 COVERAGE_THETAS = (0, 15, 30, 45, 60, 75)
 THETA_TOLERANCE_DEG = 2.5   # |theta - theta_0| for the coverage plots
 MAX_POINTS = 4000           # per scatter panel, a fixed-seed subset beyond that
+ZOOM_TARGET_PX = 260        # small photo crops are shown enlarged (integer factor, up to 4) to about this width
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 
 
@@ -373,10 +374,13 @@ def embed(out, name):
         return "data:image/png;base64," + base64.b64encode(f.read()).decode("ascii")
 
 
-def figure_html(out, name, caption, width=None):
+def figure_html(out, name, caption, width=None, zoom_width=None):
+    """An embedded figure; `zoom_width`: show a small image that many pixels wide, pixels kept sharp."""
     if not name:
         return ""
     style = f' style="max-width:{width}px"' if width else ""
+    if zoom_width:
+        style = f' style="width:{zoom_width}px; image-rendering: pixelated"'
     return (f'<figure><img src="{embed(out, name)}" alt="{html.escape(name)}"{style}>'
             f'<figcaption>{html.escape(caption)} ({html.escape(name)})</figcaption></figure>\n')
 
@@ -386,13 +390,18 @@ def appearance_html(data, out, figures):
     photo = data.get("photo")
     if photo:
         x0, y0, x1, y1 = photo["crop"]
-        parts.append(figure_html(out, photo["file"], f"measured photo {photo['index']} (linearized, full resolution, "
-                                 f"pixels {x0}-{x1} x {y0}-{y1}, light {photo['phase_deg']:.0f} deg from the view)"))
+        zoom = max(1, min(4, ZOOM_TARGET_PX // (x1 - x0 + 1)))
+        shown = (x1 - x0 + 1) * zoom if zoom > 1 else None
+        enlarged = f", shown {zoom}x enlarged" if zoom > 1 else ""
+        parts.append(figure_html(out, photo["file"], f"measured photo {photo['index']} (linearized, full resolution{enlarged}, "
+                                 f"pixels {x0}-{x1} x {y0}-{y1}, light {photo['phase_deg']:.0f} deg from the view)",
+                                 zoom_width=shown))
         for r in photo.get("renders", []):
             every = "every pixel" if photo["stride"] == 1 else \
                 f"every {photo['stride']}th pixel (the derender stride) shown as a block"
             parts.append(figure_html(out, r["file"], f"{r['model']} rendered from the photo's camera ({every}; "
-                                     "black: no sample; magenta: no model value; the photo's tone scale)"))
+                                     f"black: no sample; magenta: no model value; the photo's tone scale{enlarged})",
+                                     zoom_width=shown))
         parts.append("<br>" + figure_html(out, figures.get("difference"), "signed difference of each render from "
                                           "the photo at the samples' pixels"))
     if "photo_note" in data:
