@@ -116,14 +116,16 @@ RunModels LoadRunModels(const fs::path& run_dir, const std::string& reconstructi
   return models;
 }
 
-// The report's title: the option, else the recipe's name (summary.json's input), else the session's
-// name unless it is a generator's default ("synth..."), else the run folder's name.
+// The report's title: the option, else the recipe's name (the run's input, from run-input.json or
+// summary.json), else the session's name unless it is a generator's default ("synth..."), else the run
+// folder's name.
 std::string ReportTitle(const fs::path& run_dir, const std::string& samples_path, const std::string& given) {
   if (!given.empty()) return given;
-  const fs::path summary = run_dir / "summary.json";
   std::string session_name;
-  if (fs::is_regular_file(summary)) {
-    const nlohmann::json json = ReadJsonFile(summary.string());
+  for (const char* name : {"run-input.json", "summary.json"}) {
+    const fs::path path = run_dir / name;
+    if (!fs::is_regular_file(path)) continue;
+    const nlohmann::json json = ReadJsonFile(path.string());
     if (json.contains("input") && json["input"].is_string()) {
       const fs::path recipe = fs::path(json["input"].get<std::string>()) / "recipe.json";
       if (fs::is_regular_file(recipe)) {

@@ -117,7 +117,7 @@ TEST_F(RunFolderTest, RunPassesStageOptionsThrough) {
 }
 
 // `report` on a run whose reconstruction lies elsewhere, with the old option names still accepted, and a
-// title from the run folder (not the generator's "synth").
+// title from the session's name (not the generator's "synth").
 TEST_F(RunFolderTest, ReportFindsTheGivenReconstructionAndAcceptsOldNames) {
   const std::string out = dir_ / "my-measurement";
   ASSERT_EQ(RunIbrdf("run " + dir_ / "a" + " --out " + out + " --no-report --no-fits").exit_code, 0);
@@ -127,7 +127,11 @@ TEST_F(RunFolderTest, ReportFindsTheGivenReconstructionAndAcceptsOldNames) {
   ASSERT_EQ(report.exit_code, 0) << report.output;
   const nlohmann::json data = ReadJson(out + "/report/report-data.json");
   EXPECT_EQ(data["reconstruction"], dir_ / "recon/brdf.binary");
-  EXPECT_EQ(data["title"], "my-measurement");
+  EXPECT_EQ(data["title"], "a");  // the session's name (synth names it after its folder)
+  std::ifstream index(out + "/report/index.html");
+  std::stringstream page;
+  page << index.rdbuf();
+  EXPECT_NE(page.str().find("<title>ibrdf report: a</title>"), std::string::npos);
   EXPECT_EQ(data["incidence_plane"].size(), 2u);
   EXPECT_FALSE(fs::exists(out + "/report/explorer.html"));
   const RunResult missing =

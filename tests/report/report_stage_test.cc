@@ -118,8 +118,9 @@ TEST_F(ReportTest, WritesEveryFigureAndTheHtmlShowsThemInHeadlessChromium) {
   // The title is the session's name here (no recipe; not a generator's default "synth...").
   EXPECT_EQ(data.at("title"), "s");
   for (const char* figure :
-       {"coverage.png", "incidence-plane.png", "reciprocity-curves.png", "timings.png", "truth-bands.png", "photo.png", "photo-render-reconstruction.png", "photo-render-truth.png",
-        "photo-difference.png", "sphere-reconstruction.png", "sphere-truth.png", "explorer.html"}) {
+       {"coverage.png", "incidence-plane.png", "reciprocity-curves.png", "timings.png", "truth-bands.png", "photo.png",
+        "photo-render-reconstruction.png", "photo-render-truth.png", "photo-difference.png",
+        "sphere-reconstruction.png", "sphere-truth.png", "explorer.html"}) {
     EXPECT_TRUE(fs::exists(folder + "/" + figure)) << figure;
   }
   // A consistency figure is drawn where it is valid, and said invalid where it is not.
@@ -210,6 +211,8 @@ TEST(ReportStage, OptionsCheckNamesTheRenderSize) {
 TEST_F(ReportTest, FindsTheReconstructionItIsGiven) {
   ASSERT_NO_FATAL_FAILURE(MakeRunFolder());
   fs::rename(dir_ / "run/reconstruction", dir_ / "elsewhere");
+  // A run of a recipe (run-input.json, written by `ibrdf run` before any stage) is titled by its name.
+  WriteJsonFile(dir_ / "run/run-input.json", {{"input", std::string(IBRDF_SAMPLES_DIR) + "/squash"}});
   ReportOptions options;
   options.reconstruction = dir_ / "elsewhere";
   options.explorer = false;
@@ -219,6 +222,7 @@ TEST_F(ReportTest, FindsTheReconstructionItIsGiven) {
   EXPECT_EQ(report.reconstruction_path, dir_ / "elsewhere/brdf.binary");
   const nlohmann::json data = ReadJsonFile(dir_ / "run/report/report-data.json");
   EXPECT_EQ(data.at("reconstruction"), dir_ / "elsewhere/brdf.binary");
+  EXPECT_EQ(data.at("title"), "squash");
   EXPECT_EQ(data.at("incidence_plane").size(), 2u);
   EXPECT_EQ(data.at("incidence_plane")[1].at("theta0_deg"), 40.0);
   options.reconstruction = dir_ / "nowhere";
