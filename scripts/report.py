@@ -419,8 +419,12 @@ def headline_rows(s, side, c, t, r, data, times):
     counts = side.get("counts", {})
     rows = [("samples accepted", f"{counts.get('accepted', s.size)} of {counts.get('pixels_examined', 'n/a')} pixels "
              f"in {counts.get('photos', 'n/a')} photos")]
+    zero = [reason for reason, n in counts.get("rejected", {}).items() if n == 0]
     for reason, n in counts.get("rejected", {}).items():
-        rows.append((f"rejected: {reason}", str(n)))
+        if n > 0:
+            rows.append((f"rejected: {reason}", str(n)))
+    if zero:
+        rows.append(("rejected: none for", ", ".join(zero)))
     for key, name in (("reciprocity", "reciprocity"), ("bilateral_symmetry", "bilateral symmetry")):
         figure = figure_of(c, key)
         if figure is None:
@@ -517,11 +521,11 @@ slice. Table: the reconstruction, interpolated smoothly; fits and truth as the r
 <input id="compare-file" type="file" accept=".binary"> <span id="compare-name" class="note">a MERL .binary
 (e.g. another run's reconstruction/brdf.binary)</span></fieldset></div>
 <div class="row"><canvas id="plot" width="580" height="400"></canvas>
-<div><canvas id="sphere" width="256" height="256"></canvas><br>
-<label>light elevation <input id="light-theta" type="range" min="0" max="85" value="30"></label><br>
-<label>light azimuth <input id="light-phi" type="range" min="0" max="359" value="180"></label><br>
+<div><canvas id="sphere" width="224" height="224"></canvas><br>
+<label>light elevation <input id="light-theta" type="range" min="0" max="85" value="30" style="width:110px"></label><br>
+<label>light azimuth <input id="light-phi" type="range" min="0" max="359" value="180" style="width:110px"></label><br>
 <label>sphere model <select id="sphere-model"></select></label></div>
-<div><canvas id="halfdiff" width="256" height="256"></canvas><br><span class="note">theta_h (right) x theta_d (up),
+<div><canvas id="halfdiff" width="224" height="224"></canvas><br><span class="note">theta_h (right) x theta_d (up),
 phi_d = 90 deg, log colour: <select id="halfdiff-model"></select></span></div></div>
 <pre id="ibrdf-test" style="display:none"></pre>
 <script>
@@ -663,13 +667,15 @@ function drawSphere() {
     const loc = w => [w[0] * t1[0] + w[1] * t1[1] + w[2] * t1[2], w[0] * t2[0] + w[1] * t2[1] + w[2] * t2[2],
                       w[0] * n[0] + w[1] * n[1] + w[2] * n[2]];
     const f = lookup(loc(L), loc([0, 0, 1]));
-    for (let c = 0; c < 3; ++c) vals[(y * S + x) * 3 + c] = f[c] < 0 ? -1 : f[c] * ci;
+    if (f[0] < 0 || f[1] < 0 || f[2] < 0) { vals[(y * S + x) * 3] = -2; continue; }  // no value: magenta
+    for (let c = 0; c < 3; ++c) vals[(y * S + x) * 3 + c] = f[c] * ci;
     lum.push(0.2126 * vals[(y * S + x) * 3] + 0.7152 * vals[(y * S + x) * 3 + 1] + 0.0722 * vals[(y * S + x) * 3 + 2]);
   }
   lum.sort((a, b) => a - b); const scale = lum.length ? 0.8 / Math.max(lum[Math.floor(0.99 * (lum.length - 1))], 1e-12) : 1;
   const srgb = v => 255 * (v <= 0.0031308 ? 12.92 * v : 1.055 * Math.pow(v, 1 / 2.4) - 0.055);
   for (let y = 0; y < S; ++y) for (let x = 0; x < S; ++x) { const at = ((y & ~1) * S + (x & ~1)) * 3, o = (y * S + x) * 4;
-    img.data[o + 3] = 255; if (vals[at] < 0) continue;
+    img.data[o + 3] = 255; if (vals[at] == -2) { img.data[o] = 255; img.data[o + 2] = 255; continue; }
+    if (vals[at] < 0) continue;
     for (let c = 0; c < 3; ++c) img.data[o + c] = srgb(Math.min(1, vals[at + c] * scale)); }
   g.putImageData(img, 0, 0);
 }
