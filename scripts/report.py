@@ -521,11 +521,11 @@ slice. Table: the reconstruction, interpolated smoothly; fits and truth as the r
 <input id="compare-file" type="file" accept=".binary"> <span id="compare-name" class="note">a MERL .binary
 (e.g. another run's reconstruction/brdf.binary)</span></fieldset></div>
 <div class="row"><canvas id="plot" width="580" height="400"></canvas>
-<div><canvas id="sphere" width="224" height="224"></canvas><br>
+<div style="width:240px"><canvas id="sphere" width="224" height="224"></canvas><br>
 <label>light elevation <input id="light-theta" type="range" min="0" max="85" value="30" style="width:110px"></label><br>
 <label>light azimuth <input id="light-phi" type="range" min="0" max="359" value="180" style="width:110px"></label><br>
 <label>sphere model <select id="sphere-model"></select></label></div>
-<div><canvas id="halfdiff" width="224" height="224"></canvas><br><span class="note">theta_h (right) x theta_d (up),
+<div style="width:230px"><canvas id="halfdiff" width="224" height="224"></canvas><br><span class="note">theta_h (right) x theta_d (up),
 phi_d = 90 deg, log colour: <select id="halfdiff-model"></select></span></div></div>
 <pre id="ibrdf-test" style="display:none"></pre>
 <script>
