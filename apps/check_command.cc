@@ -13,7 +13,9 @@ void AddCheckCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "check",
       "Check measured samples for reciprocity, f(ti, te, dphi) = f(te, ti, -dphi), and bilateral\n"
-      "symmetry, f(ti, te, dphi) = f(ti, te, -dphi), binned; writes the per-bin and overall figures as JSON.");
+      "symmetry, f(ti, te, dphi) = f(ti, te, -dphi): each sample against the measured samples around its\n"
+      "reciprocal (mirrored) point, binned; headline median and 95th percentile over bins, the worst bins\n"
+      "located; writes the figures as JSON (docs/cli.md).");
   struct Args {
     std::string samples, out;
     ConsistencyOptions options;
@@ -23,11 +25,18 @@ void AddCheckCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   command->add_option("samples", args->samples, "Sample file (.npy) from `ibrdf derender`")->required();
   command->add_option("--out", args->out, "Report to write (.json)")->required();
-  command->add_option("--theta-bin-deg", args->options.theta_bin_deg, "Bin width in theta_i and theta_e")
+  command->add_option("--theta-bin-deg", args->options.theta_bin_deg, "Bin width in theta_i and theta_e (5, 10 or 15)")
       ->capture_default_str();
-  command->add_option("--phi-bin-deg", args->options.phi_bin_deg, "Bin width in delta_phi (divides 360)")
+  command->add_option("--phi-bin-deg", args->options.phi_bin_deg, "Bin width in delta_phi (divides 360; 10, 20 or 30)")
       ->capture_default_str();
-  command->add_option("--min-samples", args->options.min_samples_per_bin, "Samples a bin needs to be compared")
+  command
+      ->add_option("--min-pairs,--min-samples", args->options.min_samples_per_bin,
+                   "Sample pairs a bin needs to be reported (--min-samples: the old name, for one release)")
+      ->capture_default_str();
+  command
+      ->add_option("--match-deg", args->options.match_deg,
+                   "Partners lie within this angle of the reciprocal (mirrored) point; 0: automatic, the first of\n"
+                   "0.5, 1, 2, 4 deg giving both figures 20 bins (the JSON's match_deg_used)")
       ->capture_default_str();
   command->add_option("--max-theta-deg", args->options.max_theta_deg, "Compare bins up to this theta")
       ->capture_default_str();

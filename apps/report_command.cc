@@ -1,4 +1,5 @@
 // ibrdf report: the consistency report of a run folder (report/report_stage.h) behind flags.
+#include <cstdio>
 #include <filesystem>
 
 #include "apps/commands.h"
@@ -13,37 +14,63 @@ void AddReportCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "report",
       "The consistency report of an `ibrdf run` folder: OUT/index.html (self-contained, figures embedded)\n"
-      "and the PNG figures beside it: sample coverage, incidence-plane plots per channel with the\n"
-      "reconstruction, reciprocity and bilateral symmetry, a rendered sphere beside a measured photo,\n"
-      "timings and rejected samples. Plots by matplotlib (scripts/report.py, Debian's python3).");
+      "with the measured photo beside the sample rendered from its camera by each model (and the signed\n"
+      "difference), spheres, sample coverage, incidence-plane plots per channel with every model evaluated\n"
+      "where the samples are, the paper's reciprocity figure, reciprocity and bilateral symmetry with the\n"
+      "worst bins located, timings; and OUT/explorer.html, an offline BRDF explorer. Plots by matplotlib\n"
+      "(scripts/report.py, Debian's python3).");
   struct Args {
     std::string run_dir, out;
     ReportOptions options;
   };
   auto args = std::make_shared<Args>();
+  ReportOptions& o = args->options;
   command
       ->add_option("run_dir", args->run_dir,
                    "Run folder of `ibrdf run` (samples.npy, consistency.json, reconstruction/ ...)")
       ->required();
   command->add_option("--out", args->out, "Report folder to write (default: RUN_DIR/report)");
-  command->add_option("--photo", args->options.photo,
-                      "Photo index shown beside the render (default: median phase angle)");
-  command->add_option("--render-size", args->options.render_size, "Rendered sphere size, pixels")
+  command->add_option("--reconstruction", o.reconstruction,
+                      "Reconstruction folder of `ibrdf reconstruct` (or its brdf.binary) to show, wherever it is\n"
+                      "(default: RUN_DIR/reconstruction); the fits beside it are shown too");
+  command->add_option("--photo", o.photo, "Photo index shown beside the renders (default: median phase angle)");
+  command
+      ->add_option("--angles-deg,--angles", o.angles_deg,
+                   "Incidence-plane angles theta_0, 1 to 8 in [0, 85] (--angles: the same, for one release)")
+      ->delimiter(',')
+      ->expected(1, 8)
       ->capture_default_str();
-  command->add_flag("--overwrite", args->options.overwrite, "Replace an existing report folder");
+  command->add_option("--title", o.title, "Report title (default: the recipe's or session's name)");
+  command
+      ->add_option("--render-size-px,--render-size", o.render_size_px,
+                   "Rendered sphere size, pixels (--render-size: the old name, for one release)")
+      ->capture_default_str();
+  command->add_flag_callback(
+      "--no-explorer", [args] { args->options.explorer = false; }, "Skip explorer.html");
+  command->add_flag("--overwrite", o.overwrite, "Replace an existing report folder");
   command->callback([args] {
     StageLog stage("report");
-    const int size = args->options.render_size;
-    if (size < 16 || size > 4096) ThrowError("ibrdf report", "--render-size must be in [16, 4096]");
+    std::string why;
+    if (!args->options.Check(&why)) ThrowError("ibrdf report", why);
     // The output guard: every file of the run folder is an input, except the default report's own.
     const std::filesystem::path own_report = std::filesystem::path(args->run_dir) / "report";
     std::vector<std::string> inputs = {args->run_dir};
+    if (!args->options.reconstruction.empty()) inputs.push_back(args->options.reconstruction);
     for (const std::string& file : FilesUnder(args->run_dir)) {
       if (std::filesystem::path(file).lexically_relative(own_report).string().rfind("..", 0) != 0) continue;
       inputs.push_back(file);
     }
     RequireWritableOutput(args->out.empty() ? own_report.string() : args->out, args->options.overwrite, inputs);
-    WriteReport(args->run_dir, args->options, args->out);
+    const ReportResult result = WriteReport(args->run_dir, args->options, args->out);
+    Log(1, result.BriefReport());
+    for (const BandAgreement& band : result.bands) {
+      char line[200];
+      std::snprintf(line, sizeof(line),
+                    "incidence plane %g deg: median sample / reconstruction R G B %.3f %.3f %.3f over %zu samples",
+                    band.theta0_deg, band.ratio[0], band.ratio[1], band.ratio[2], band.samples);
+      Log(1, line);
+    }
+    if (!result.explorer_html.empty()) Log(1, "explorer: " + result.explorer_html);
   });
 }
 

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/brdf_coords.h"
 #include "core/brdf_model.h"
 #include "core/error.h"
 #include "core/file_util.h"
@@ -17,13 +18,17 @@
 #include "core/json_reader.h"
 #include "core/linear_image.h"
 #include "core/logging.h"
+#include "core/npy.h"
 #include "core/sample_file.h"
 #include "core/session.h"
+#include "core/statistics.h"
 #include "reconstruct/merl_table.h"
 #include "reconstruct/truth_comparison.h"
+#include "report/photo_comparison.h"
 #include "report/photo_statistics.h"
 #include "report/report_script.h"
 #include "report/sphere_render.h"
+#include "report/table_interpolation.h"
 #include "report/tone_map.h"
 
 namespace fs = std::filesystem;
@@ -33,18 +38,57 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
+constexpr double kBandThetaDeg = 2.5;  // |theta - theta_0| for "fixed" incidence or exitance
+constexpr double kBandPhiDeg = 5.0;    // |delta_phi| or |180 - |delta_phi|| for "in the incidence plane"
+constexpr size_t kBandSamples = 3000;  // per band and kind, an even subset beyond that
 
-// The reconstruction and the truth, when the run has them.
-struct RunModels {
-  std::unique_ptr<MerlTable> table;
-  std::unique_ptr<BrdfModel> truth;
-  std::string truth_path;
+// A model the report evaluates: the reconstruction (smoothly interpolated table), the fits, the truth.
+struct NamedModel {
+  std::string name;
+  BrdfEvalFunction eval;
 };
 
-RunModels LoadRunModels(const fs::path& run_dir) {
+// The reconstruction, the fits beside it and the truth, when the run has them.
+struct RunModels {
+  std::unique_ptr<MerlTable> table;
+  std::string table_path;
+  std::vector<std::unique_ptr<BrdfModel>> fits;
+  std::vector<std::string> fit_names;
+  std::unique_ptr<BrdfModel> truth;
+  std::string truth_path;
+  std::vector<NamedModel> named;  // in drawing order
+};
+
+// The reconstruction folder or file asked for: a folder with brdf.binary, or the .binary itself.
+std::string ReconstructionTable(const fs::path& run_dir, const std::string& given) {
+  if (given.empty()) {
+    const fs::path path = run_dir / "reconstruction" / "brdf.binary";
+    return fs::exists(path) ? path.string() : "";
+  }
+  if (fs::is_directory(given)) {
+    const fs::path path = fs::path(given) / "brdf.binary";
+    if (!fs::is_regular_file(path))
+      ThrowError(given, "is a folder without brdf.binary (not an `ibrdf reconstruct` output)");
+    return path.string();
+  }
+  if (!fs::is_regular_file(given))
+    ThrowError(given, "does not exist (--reconstruction: a reconstruction folder or its brdf.binary)");
+  return given;
+}
+
+RunModels LoadRunModels(const fs::path& run_dir, const std::string& reconstruction) {
   RunModels models;
-  const std::string merl_path = (run_dir / "reconstruction" / "brdf.binary").string();
-  if (fs::exists(merl_path)) models.table = std::make_unique<MerlTable>(ReadMerl(merl_path));
+  models.table_path = ReconstructionTable(run_dir, reconstruction);
+  if (!models.table_path.empty()) {
+    models.table = std::make_unique<MerlTable>(ReadMerl(models.table_path));
+    const fs::path dir = fs::path(models.table_path).parent_path();
+    for (const char* fit : {"lafortune", "ggx"}) {
+      const fs::path path = dir / (std::string(fit) + ".json");
+      if (!fs::is_regular_file(path)) continue;
+      models.fits.push_back(LoadMaterial(path.string()));
+      models.fit_names.push_back(fit);
+    }
+  }
   const fs::path comparison = run_dir / "truth-comparison.json";
   if (fs::exists(comparison)) {
     const nlohmann::json json = ReadJsonFile(comparison.string());
@@ -53,35 +97,106 @@ RunModels LoadRunModels(const fs::path& run_dir) {
       models.truth = LoadTruthMaterial(models.truth_path);
     }
   }
+  if (models.table) {
+    const MerlTable* table = models.table.get();
+    models.named.push_back({"reconstruction", [table](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) {
+                              return InterpolateMerl(*table, wi, wo);
+                            }});
+  }
+  for (size_t i = 0; i < models.fits.size(); ++i) {
+    const BrdfModel* fit = models.fits[i].get();
+    models.named.push_back({models.fit_names[i],
+                            [fit](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) { return fit->Eval(wi, wo); }});
+  }
+  if (models.truth) {
+    const BrdfModel* truth = models.truth.get();
+    models.named.push_back(
+        {"truth", [truth](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) { return truth->Eval(wi, wo); }});
+  }
   return models;
 }
 
-// The measured photo, cropped to the samples' pixel box, linearized and tone-mapped into photo.png.
-// Errors reading the samples' session become a note in the data instead of failing the report.
-void WritePhoto(const std::string& samples_path, const PhotoStats& p, const ChosenPhoto& chosen, const fs::path& tmp,
-                nlohmann::json* data, ReportResult* result) {
+// The report's title: the option, else the recipe's name (the run's input, from run-input.json or
+// summary.json), else the session's name unless it is a generator's default ("synth..."), else the run
+// folder's name.
+std::string ReportTitle(const fs::path& run_dir, const std::string& samples_path, const std::string& given) {
+  if (!given.empty()) return given;
+  std::string session_name;
+  for (const char* name : {"run-input.json", "summary.json"}) {
+    const fs::path path = run_dir / name;
+    if (!fs::is_regular_file(path)) continue;
+    const nlohmann::json json = ReadJsonFile(path.string());
+    if (json.contains("input") && json["input"].is_string()) {
+      const fs::path recipe = fs::path(json["input"].get<std::string>()) / "recipe.json";
+      if (fs::is_regular_file(recipe)) {
+        const nlohmann::json r = ReadJsonFile(recipe.string());
+        if (r.contains("name") && r["name"].is_string()) return r["name"].get<std::string>();
+      }
+    }
+    if (json.contains("session_name") && json["session_name"].is_string()) session_name = json["session_name"];
+  }
   const fs::path sidecar(SidecarPath(samples_path));
-  if (!fs::exists(sidecar)) return;
+  if (session_name.empty() && fs::is_regular_file(sidecar)) {
+    const nlohmann::json side = ReadJsonFile(sidecar.string());
+    if (side.contains("session_name") && side["session_name"].is_string()) session_name = side["session_name"];
+  }
+  if (!session_name.empty() && session_name.rfind("synth", 0) != 0) return session_name;
+  return fs::absolute(run_dir).lexically_normal().filename().string();
+}
+
+Eigen::Vector3d Wi(const BrdfSample& s) { return Eigen::Vector3d(s.wi[0], s.wi[1], s.wi[2]).normalized(); }
+Eigen::Vector3d Wo(const BrdfSample& s) { return Eigen::Vector3d(s.wo[0], s.wo[1], s.wo[2]).normalized(); }
+
+// The measured photo at full resolution (cropped to the samples' box), and each model rendered at the
+// photo's own pixels with its signed difference. Errors reading the samples' session become a note in
+// the data instead of failing the report.
+void WritePhoto(const std::string& samples_path, const std::vector<BrdfSample>& samples, const PhotoStats& p,
+                const ChosenPhoto& chosen, const RunModels& models, const fs::path& tmp, nlohmann::json* data,
+                ReportResult* result) {
+  const fs::path sidecar(SidecarPath(samples_path));
+  if (!fs::exists(sidecar)) {
+    result->photo_note = sidecar.string() + " is missing, so the samples' session (and photos) are unknown";
+    (*data)["photo_note"] = result->photo_note;
+    return;
+  }
   const nlohmann::json side = ReadJsonFile(sidecar.string());
   try {
     const Session session = Session::Load(side.at("session").get<std::string>());
     if (chosen.photo >= session.photos.size())
       ThrowError(session.manifest_path, "has fewer photos than the samples name");
-    const int pad = std::max(4, (p.x1 - p.x0) / 8);
     Image photo = ReadImage(session.PhotoPath(chosen.photo));
     LinearizeImage(session, chosen.photo, &photo, /*divide_by_exposure=*/true);
-    const int x0 = std::max(0, p.x0 - pad), y0 = std::max(0, p.y0 - pad);
-    const int x1 = std::min(photo.width - 1, p.x1 + pad), y1 = std::min(photo.height - 1, p.y1 + pad);
-    Image crop(x1 - x0 + 1, y1 - y0 + 1, 3);
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) {
-        for (int c = 0; c < 3; ++c) crop.at(x - x0, y - y0, c) = photo.at(x, y, std::min(c, photo.channels - 1));
-      }
+    const int pad = std::max(4, (p.x1 - p.x0) / 16);
+    PixelBox box{std::max(0, p.x0 - pad), std::max(0, p.y0 - pad), std::min(photo.width - 1, p.x1 + pad),
+                 std::min(photo.height - 1, p.y1 + pad)};
+    std::vector<const BrdfSample*> own;
+    for (const BrdfSample& s : samples) {
+      if (s.image == chosen.photo) own.push_back(&s);
     }
-    WriteImage((tmp / "photo.png").string(), ToneMap(crop, nullptr), PixelFormat::kUint8);
-    (*data)["photo"] = {
-        {"file", "photo.png"},      {"source", session.PhotoPath(chosen.photo)}, {"index", chosen.photo},
-        {"crop", {x0, y0, x1, y1}}, {"phase_deg", chosen.phase / kDeg},          {"samples", p.count}};
+    const Image crop = CropPhoto(photo, box);
+    double scale = 1.0;
+    WriteImage((tmp / "photo.png").string(), ToneMap(crop, &scale), PixelFormat::kUint8);
+    nlohmann::json renders = nlohmann::json::array();
+    for (const NamedModel& model : models.named) {
+      const PhotoRender render = RenderPhotoPixels(photo, box, own, model.name, model.eval);
+      const std::string png = "photo-render-" + model.name + ".png", npy = "photo-diff-" + model.name + ".npy";
+      WriteImage((tmp / png).string(), ToneMapWithScale(render.linear, scale), PixelFormat::kUint8);
+      WriteNpyArray((tmp / npy).string(), render.difference.pixels,
+                    {size_t(render.difference.height), size_t(render.difference.width)});
+      renders.push_back({{"model", model.name},
+                         {"file", png},
+                         {"difference", npy},
+                         {"median_abs_difference", render.median_abs_difference}});
+    }
+    (*data)["photo"] = {{"file", "photo.png"},
+                        {"source", session.PhotoPath(chosen.photo)},
+                        {"index", chosen.photo},
+                        {"crop", {box.x0, box.y0, box.x1, box.y1}},
+                        {"full_resolution", true},
+                        {"stride", SampleStride(own)},
+                        {"phase_deg", chosen.phase / kDeg},
+                        {"samples", p.count},
+                        {"renders", renders}};
     result->photo_shown = true;
   } catch (const Error& e) {
     result->photo_note = e.what();
@@ -90,62 +205,200 @@ void WritePhoto(const std::string& samples_path, const PhotoStats& p, const Chos
   if (!result->photo_note.empty()) (*data)["photo_note"] = result->photo_note;
 }
 
-// Spheres of the reconstructed (and the true) material, lit at the chosen photo's phase angle.
-void WriteRenders(const RunModels& models, int size, double phase, const fs::path& tmp, nlohmann::json* data) {
-  if (models.table) {
-    const Image render = RenderSphere(size, phase, [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) {
-      return models.table->Lookup(wi, wo);
-    });
-    WriteImage((tmp / "render.png").string(), ToneMap(render, nullptr), PixelFormat::kUint8);
-    (*data)["render"] = {{"file", "render.png"}, {"phase_deg", phase / kDeg}};
+// Spheres of every model, lit at the chosen photo's phase angle.
+void WriteSpheres(const RunModels& models, int size, double phase, const fs::path& tmp, nlohmann::json* data) {
+  nlohmann::json spheres = nlohmann::json::array();
+  for (const NamedModel& model : models.named) {
+    const std::string file = "sphere-" + model.name + ".png";
+    WriteImage((tmp / file).string(), ToneMap(RenderSphere(size, phase, model.eval), nullptr), PixelFormat::kUint8);
+    spheres.push_back({{"model", model.name}, {"file", file}, {"phase_deg", phase / kDeg}});
   }
-  if (models.truth) {
-    const Image render = RenderSphere(
-        size, phase, [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) { return models.truth->Eval(wi, wo); });
-    WriteImage((tmp / "render-truth.png").string(), ToneMap(render, nullptr), PixelFormat::kUint8);
-    (*data)["render_truth"] = {{"file", "render-truth.png"}, {"phase_deg", phase / kDeg}};
-    (*data)["truth"] = models.truth_path;
-  }
+  (*data)["spheres"] = spheres;
+  if (models.truth) (*data)["truth"] = models.truth_path;
 }
 
-// The reconstruction and the truth along the incidence plane: theta_0 fixed, the other angle signed
-// (positive on the light's side, delta_phi = 0; negative on the mirror side, delta_phi = pi).
-nlohmann::json IncidencePlaneCurves(const RunModels& models) {
-  nlohmann::json curves = nlohmann::json::array();
-  for (const double theta0 : {15.0, 30.0, 45.0, 60.0}) {
-    nlohmann::json angles = nlohmann::json::array(), recon = nlohmann::json::array(),
-                   true_values = nlohmann::json::array();
-    for (double x = -88.0; x <= 88.0; x += 0.5) {
-      const Eigen::Vector3d wi(std::sin(theta0 * kDeg), 0.0, std::cos(theta0 * kDeg));
-      const Eigen::Vector3d wo(std::sin(x * kDeg), 0.0, std::cos(x * kDeg));
-      angles.push_back(x);
-      if (models.table) {
-        const Eigen::Vector3d f = models.table->Lookup(wi, wo);
-        recon.push_back({f[0], f[1], f[2]});
-      }
-      if (models.truth) {
-        const Eigen::Vector3d f = models.truth->Eval(wi, wo);
-        true_values.push_back({f[0], f[1], f[2]});
+// The models along the incidence plane, evaluated where the band's samples are: for each theta_0, the
+// fixed-incidence samples (|theta_i - theta_0| <= 2.5 deg, within 5 deg of the plane; abscissa the
+// signed theta_e, positive on the light's side) and the fixed-exitance ones (abscissa the signed
+// theta_i), each with every model at the sample's own directions, in incidence-plane-K.npy (columns:
+// kind (0 fixed incidence, 1 fixed exitance), abscissa deg, sample RGB, then RGB per model); and each
+// model in the exact plane (the band's centre) for the dotted curves.
+nlohmann::json IncidencePlanes(const std::vector<BrdfSample>& samples, const RunModels& models,
+                               const std::vector<double>& angles, const fs::path& tmp, ReportResult* result) {
+  nlohmann::json planes = nlohmann::json::array();
+  std::vector<std::string> columns = {"kind", "abscissa_deg", "sample_r", "sample_g", "sample_b"};
+  for (const NamedModel& m : models.named) {
+    for (const char* c : {"_r", "_g", "_b"}) columns.push_back(m.name + c);
+  }
+  for (size_t k = 0; k < angles.size(); ++k) {
+    const double t0 = angles[k];
+    std::vector<const BrdfSample*> band[2];
+    for (const BrdfSample& s : samples) {
+      const double ti = s.theta_i / kDeg, te = s.theta_e / kDeg, dp = std::abs(s.delta_phi / kDeg);
+      if (!(dp <= kBandPhiDeg || dp >= 180.0 - kBandPhiDeg)) continue;
+      if (std::abs(ti - t0) <= kBandThetaDeg) band[0].push_back(&s);
+      if (std::abs(te - t0) <= kBandThetaDeg) band[1].push_back(&s);
+    }
+    std::vector<float> rows;
+    size_t n_rows = 0;
+    std::vector<std::vector<double>> ratios(models.named.size() * 3);
+    for (int kind = 0; kind < 2; ++kind) {
+      const size_t step = std::max<size_t>(1, (band[kind].size() + kBandSamples - 1) / kBandSamples);
+      for (size_t i = 0; i < band[kind].size(); i += step) {
+        const BrdfSample& s = *band[kind][i];
+        const bool light_side = std::abs(s.delta_phi / kDeg) <= kBandPhiDeg;
+        const double other = (kind == 0 ? s.theta_e : s.theta_i) / kDeg;
+        rows.push_back(float(kind));
+        rows.push_back(float(light_side ? other : -other));
+        for (int c = 0; c < 3; ++c) rows.push_back(s.brdf[c]);
+        for (size_t m = 0; m < models.named.size(); ++m) {
+          const Eigen::Vector3d f = models.named[m].eval(Wi(s), Wo(s));
+          for (int c = 0; c < 3; ++c) {
+            rows.push_back(f[c] >= 0.0 ? float(f[c]) : NAN);
+            if (f[c] > 0.0 && s.brdf[c] > 0.0f) ratios[m * 3 + c].push_back(s.brdf[c] / f[c]);
+          }
+        }
+        ++n_rows;
       }
     }
-    curves.push_back(
-        {{"theta0_deg", theta0}, {"angle_deg", angles}, {"reconstruction", recon}, {"truth", true_values}});
+    const std::string file = "incidence-plane-" + std::to_string(k) + ".npy";
+    WriteNpyArray((tmp / file).string(), rows, {n_rows, columns.size()});
+    // Each model in the exact plane.
+    nlohmann::json centre = nlohmann::json::object();
+    std::vector<double> abscissa;
+    for (double x = -88.0; x <= 88.0; x += 0.5) abscissa.push_back(x);
+    for (const NamedModel& m : models.named) {
+      nlohmann::json values = nlohmann::json::array();
+      for (const double x : abscissa) {
+        const Eigen::Vector3d wi(std::sin(t0 * kDeg), 0.0, std::cos(t0 * kDeg));
+        const Eigen::Vector3d wo(std::sin(x * kDeg), 0.0, std::cos(x * kDeg));
+        const Eigen::Vector3d f = m.eval(wi, wo);
+        values.push_back({f[0], f[1], f[2]});
+      }
+      centre[m.name] = values;
+    }
+    nlohmann::json agreement = nlohmann::json::object();
+    for (size_t m = 0; m < models.named.size(); ++m) {
+      BandAgreement a;
+      a.theta0_deg = t0;
+      a.model = models.named[m].name;
+      a.samples = ratios[m * 3].size();
+      nlohmann::json rgb = nlohmann::json::array();
+      for (int c = 0; c < 3; ++c) {
+        a.ratio[c] = ratios[m * 3 + c].empty() ? NAN : Percentile(ratios[m * 3 + c], 0.5);
+        rgb.push_back(std::isfinite(a.ratio[c]) ? nlohmann::json(a.ratio[c]) : nlohmann::json());
+      }
+      agreement[a.model] = {{"samples", a.samples}, {"median_sample_over_model", rgb}};
+      if (a.model == "reconstruction") result->bands.push_back(a);
+    }
+    planes.push_back({{"theta0_deg", t0},
+                      {"band_theta_deg", kBandThetaDeg},
+                      {"band_phi_deg", kBandPhiDeg},
+                      {"file", file},
+                      {"columns", columns},
+                      {"fixed_incidence_samples", band[0].size()},
+                      {"fixed_exitance_samples", band[1].size()},
+                      {"centre_abscissa_deg", abscissa},
+                      {"centre", centre},
+                      {"agreement", agreement}});
   }
-  return curves;
+  return planes;
+}
+
+// The explorer's grids, per model (float32 .npy, -1 where a model has no value):
+//  explorer-curves-M.npy (theta_i 0..85 step 5, slice azimuth 0..180 step 15, signed theta_e -89..89
+//    step 1, RGB): wi = (theta_i, phi 0); x >= 0 is wo at (x, phi), x < 0 at (-x, phi + 180);
+//  explorer-halfdiff-M.npy (theta_h 0..89, theta_d 0..89 at 1 deg cell centres, phi_d 90 deg, RGB);
+//  explorer-table-M.npy (32 x 32 x 32 cells, MERL's axes: theta_h on the square-root axis, theta_d,
+//    phi_d over [0, 180), at cell centres, RGB) for the lit sphere.
+nlohmann::json ExplorerGrids(const std::vector<BrdfSample>& samples, const RunModels& models, const fs::path& tmp) {
+  nlohmann::json grids = {{"theta_i_deg", {0, 85, 5}},
+                          {"phi_deg", {0, 180, 15}},
+                          {"theta_e_deg", {-89, 89, 1}},
+                          {"table_cells", 32},
+                          {"models", nlohmann::json::array()}};
+  auto value = [](const Eigen::Vector3d& f, std::vector<float>* out) {
+    for (int c = 0; c < 3; ++c) out->push_back(std::isfinite(f[c]) && f[c] >= 0.0 ? float(f[c]) : -1.0f);
+  };
+  for (const NamedModel& m : models.named) {
+    std::vector<float> curves, halfdiff, table;
+    for (int ti = 0; ti <= 85; ti += 5) {
+      for (int phi = 0; phi <= 180; phi += 15) {
+        for (int x = -89; x <= 89; ++x) {
+          const Eigen::Vector3d wi = FromSpherical(ti * kDeg, 0.0);
+          const Eigen::Vector3d wo = FromSpherical(std::abs(x) * kDeg, (x >= 0 ? phi : phi + 180) * kDeg);
+          value(m.eval(wi, wo), &curves);
+        }
+      }
+    }
+    for (int h = 0; h < 90; ++h) {
+      for (int d = 0; d < 90; ++d) {
+        HalfDiffAngles a;
+        a.theta_h = (h + 0.5) * kDeg;
+        a.theta_d = (d + 0.5) * kDeg;
+        a.phi_d = 90.0 * kDeg;
+        Eigen::Vector3d wi, wo;
+        FromHalfDiff(a, &wi, &wo);
+        value(wi.z() > 0.0 && wo.z() > 0.0 ? m.eval(wi, wo) : Eigen::Vector3d(-1, -1, -1), &halfdiff);
+      }
+    }
+    constexpr int n = 32;
+    for (int h = 0; h < n; ++h) {
+      for (int d = 0; d < n; ++d) {
+        for (int p = 0; p < n; ++p) {
+          HalfDiffAngles a;
+          const double u = (h + 0.5) / n;
+          a.theta_h = u * u * kPi / 2.0;
+          a.theta_d = (d + 0.5) / n * kPi / 2.0;
+          a.phi_d = (p + 0.5) / n * kPi;
+          Eigen::Vector3d wi, wo;
+          FromHalfDiff(a, &wi, &wo);
+          value(wi.z() > 0.0 && wo.z() > 0.0 ? m.eval(wi, wo) : Eigen::Vector3d(-1, -1, -1), &table);
+        }
+      }
+    }
+    const std::string prefix = "explorer-";
+    WriteNpyArray((tmp / (prefix + "curves-" + m.name + ".npy")).string(), curves, {18, 13, 179, 3});
+    WriteNpyArray((tmp / (prefix + "halfdiff-" + m.name + ".npy")).string(), halfdiff, {90, 90, 3});
+    WriteNpyArray((tmp / (prefix + "table-" + m.name + ".npy")).string(), table, {n, n, n, 3});
+    grids["models"].push_back(m.name);
+  }
+  // A fixed-stride subset of the samples: theta_i, theta_e, delta_phi (deg), RGB.
+  std::vector<float> subset;
+  const size_t step = std::max<size_t>(1, samples.size() / 40000);
+  size_t rows = 0;
+  for (size_t i = 0; i < samples.size(); i += step, ++rows) {
+    const BrdfSample& s = samples[i];
+    for (const float v : {float(s.theta_i / kDeg), float(s.theta_e / kDeg), float(s.delta_phi / kDeg), s.brdf[0],
+                          s.brdf[1], s.brdf[2]}) {
+      subset.push_back(v);
+    }
+  }
+  WriteNpyArray((tmp / "explorer-samples.npy").string(), subset, {rows, 6});
+  grids["samples"] = rows;
+  return grids;
 }
 
 }  // namespace
 
 bool ReportOptions::Check(std::string* why) const {
-  IBRDF_CHECK_OPTION_RANGE(render_size, 16, 4096);
+  IBRDF_CHECK_OPTION_RANGE(render_size_px, 16, 4096);
+  IBRDF_CHECK_OPTION(!angles_deg.empty() && angles_deg.size() <= 8);
+  for (const double angle : angles_deg) {
+    if (!(angle >= 0.0 && angle <= 85.0)) {
+      *why = "angles_deg: every incidence-plane angle must be in [0, 85] degrees";
+      return false;
+    }
+  }
   return true;
 }
 
 std::string ReportResult::BriefReport() const {
   std::ostringstream out;
-  out << "report: " << (success ? index_html : "FAILED") << ", " << samples << " samples, photo " << photo << " ("
-      << phase_deg << " deg phase" << (photo_shown ? ", shown" : ", not shown") << ")"
+  out << "report \"" << title << "\": " << (success ? index_html : "FAILED") << ", " << samples << " samples, photo "
+      << photo << " (" << phase_deg << " deg phase" << (photo_shown ? ", shown" : ", not shown") << ")"
       << (reconstruction ? ", reconstruction" : "") << (truth ? ", truth" : "");
+  for (const std::string& fit : fits) out << ", " << fit << " fit";
   return out.str();
 }
 
@@ -163,30 +416,41 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   const std::string python = options.python.empty() ? ReportPython() : options.python;
   RequireFile(script, "the report's plotting script (IBRDF_REPORT_SCRIPT)");
   RequireFile(python, "python3 with matplotlib (Debian: python3-matplotlib)");
+  const RunModels models = LoadRunModels(run_dir, options.reconstruction);
 
   const std::vector<BrdfSample> samples = ReadSamples(samples_path);
   if (samples.empty()) ThrowError(samples_path, "holds no samples");
   ReportResult result;
   result.samples = samples.size();
-  nlohmann::json data = {{"format", "ibrdf-report-data"}, {"version", 1}};
+  result.title = ReportTitle(run_dir, samples_path, options.title);
+  nlohmann::json data = {{"format", "ibrdf-report-data"}, {"version", 2}, {"title", result.title}};
   // The photo: the one whose median angle between light and view is the median over photos.
   std::map<uint32_t, PhotoStats> photos = CollectPhotoStats(samples);
   const ChosenPhoto chosen = ChoosePhoto(photos, options.photo);
   result.photo = chosen.photo;
   result.phase_deg = chosen.phase / kDeg;
-  const RunModels models = LoadRunModels(run_dir);
   result.reconstruction = models.table != nullptr;
+  result.reconstruction_path = models.table_path;
+  result.fits = models.fit_names;
   result.truth = models.truth != nullptr;
+  if (models.table) data["reconstruction"] = models.table_path;
+  data["fits"] = models.fit_names;
+  nlohmann::json names = nlohmann::json::array();
+  for (const NamedModel& m : models.named) names.push_back(m.name);
+  data["models"] = names;
 
   AtomicDirectory directory(out, options.overwrite);
   const fs::path tmp(directory.temporary_path());
-  WritePhoto(samples_path, photos[chosen.photo], chosen, tmp, &data, &result);
-  WriteRenders(models, options.render_size, chosen.phase, tmp, &data);
-  data["incidence_plane"] = IncidencePlaneCurves(models);
+  WritePhoto(samples_path, samples, photos[chosen.photo], chosen, models, tmp, &data, &result);
+  WriteSpheres(models, options.render_size_px, chosen.phase, tmp, &data);
+  data["incidence_plane"] = IncidencePlanes(samples, models, options.angles_deg, tmp, &result);
+  if (options.explorer) data["explorer"] = ExplorerGrids(samples, models, tmp);
   WriteJsonFile((tmp / "report-data.json").string(), data);
   RunReportScript(python, script, run_dir.string(), tmp.string());
+  if (options.explorer) RequireFile((tmp / "explorer.html").string(), script + ": wrote no explorer.html");
   directory.Commit();
   result.index_html = (fs::path(out) / "index.html").string();
+  if (options.explorer) result.explorer_html = (fs::path(out) / "explorer.html").string();
   Log(1, "report written to " + result.index_html);
   result.success = true;
   return result;

@@ -20,6 +20,10 @@ Image ToneMap(const Image& linear, double* scale_out) {
   const double p99 = Percentile(luminance, 0.99);
   const double scale = p99 > 0.0 ? 0.8 / p99 : 1.0;
   if (scale_out) *scale_out = scale;
+  return ToneMapWithScale(linear, scale);
+}
+
+Image ToneMapWithScale(const Image& linear, double scale) {
   Image out(linear.width, linear.height, 3);
   for (int y = 0; y < linear.height; ++y) {
     for (int x = 0; x < linear.width; ++x) {

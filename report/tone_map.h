@@ -10,4 +10,7 @@ namespace ibrdf {
 // `scale_out` (optional) gets the scale applied to the linear values.
 Image ToneMap(const Image& linear, double* scale_out = nullptr);
 
+// As ToneMap with a given scale (e.g. ToneMap's of the photo, so renders of it compare by eye).
+Image ToneMapWithScale(const Image& linear, double scale);
+
 }  // namespace ibrdf

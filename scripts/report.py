@@ -4,33 +4,45 @@
 Usage: report.py RUN_DIR OUT_DIR
 
 Reads RUN_DIR's samples.npy (+ sidecar), consistency.json, truth-comparison.json, reconstruction/,
-stamps/*.json, and OUT_DIR/report-data.json (written by `ibrdf report`: the measured photo, rendered
-spheres, the reconstruction and the truth along the incidence plane). Writes the PNG figures and a
-self-contained OUT_DIR/index.html (figures embedded as data URIs, and the same PNGs beside it).
-Plots with matplotlib (Debian's python3-matplotlib), Agg backend: no display needed.
+stamps/*.json, and what `ibrdf report` wrote into OUT_DIR: report-data.json (title, models, the photo and
+its renders, spheres, incidence-plane bands with every model at the samples' own positions, the
+explorer's grids) and its .npy files. Writes the PNG figures, a self-contained OUT_DIR/index.html
+(figures embedded as data URIs, the same PNGs beside it) and OUT_DIR/explorer.html (the interactive
+explorer, its data embedded, no network at view time). Plots with matplotlib (Debian's
+python3-matplotlib), Agg backend: no display needed.
+
+Structure: one function per figure, each taking what it needs and returning the PNG's name (or None);
+main() gathers them into sections. A multi-light session adds one photo section per light the same way.
 """
 import base64
 import glob
 import html
 import json
-import math
 import os
 import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.colors  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 
 CHANNELS = (("R", "#d62728"), ("G", "#2ca02c"), ("B", "#1f77b4"))
-FIXED_INCIDENCE_COLOUR = "#ff7f0e"
-FIXED_EXITANCE_COLOUR = "#9467bd"
+MODEL_STYLE = {  # colour, line style
+    "reconstruction": ("k", "-"),
+    "lafortune": ("#ff7f0e", "-."),
+    "ggx": ("#9467bd", "--"),
+    "truth": ("0.5", ":"),
+}
+FIXED_INCIDENCE_COLOUR = "#e377c2"
+FIXED_EXITANCE_COLOUR = "#17becf"
 COVERAGE_THETAS = (0, 15, 30, 45, 60, 75)
-PLANE_TOLERANCE_DEG = 5.0   # |delta_phi| (or |pi - delta_phi|) for "in the incidence plane"
-THETA_TOLERANCE_DEG = 2.5   # |theta - theta_0| for "fixed" incidence or exitance
+THETA_TOLERANCE_DEG = 2.5   # |theta - theta_0| for the coverage plots
 MAX_POINTS = 4000           # per scatter panel, a fixed-seed subset beyond that
+ZOOM_TARGET_PX = 260        # small photo crops are shown enlarged (integer factor, up to 4) to about this width
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 
 
 def load_json(path):
@@ -48,9 +60,21 @@ def subset(mask, rng, limit=MAX_POINTS):
 
 
 def save(fig, out, name):
-    fig.savefig(os.path.join(out, name), dpi=100)
+    fig.savefig(os.path.join(out, name), dpi=90)
     plt.close(fig)
     return name
+
+
+def log_axis(ax, axis="y"):
+    """One scale convention: BRDF values on a log axis with a label at every decade and minor ticks."""
+    target = ax.yaxis if axis == "y" else ax.xaxis
+    (ax.set_yscale if axis == "y" else ax.set_xscale)("log")
+    target.set_major_locator(matplotlib.ticker.LogLocator(base=10, numticks=12))
+    target.set_minor_locator(matplotlib.ticker.LogLocator(base=10, subs=(2, 5), numticks=12))
+    # Plain "%g" labels (no mathtext, which is slow): every decade, and 2 and 5 within it.
+    plain = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}")
+    target.set_major_formatter(plain)
+    target.set_minor_formatter(plain)
 
 
 def coverage_figure(s, out):
@@ -58,108 +82,233 @@ def coverage_figure(s, out):
     ti = np.degrees(s["theta_i"])
     te = np.degrees(s["theta_e"])
     dphi = s["delta_phi"]
-    lum = s["brdf"] @ np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
+    lum = s["brdf"] @ LUMINANCE.astype(np.float32)
     rng = np.random.default_rng(0)
     fig, axes = plt.subplots(2, 3, figsize=(12, 8), subplot_kw={"projection": "polar"})
+    positive = lum[lum > 0]
+    norm = matplotlib.colors.LogNorm(vmin=max(np.percentile(positive, 1), 1e-6) if positive.size else 1e-3,
+                                     vmax=np.percentile(positive, 99.5) if positive.size else 1)
+    mappable = None
     for ax, theta in zip(axes.flat, COVERAGE_THETAS):
         mask = np.abs(ti - theta) <= THETA_TOLERANCE_DEG
         idx = subset(mask, rng, 8000)
         if idx.size:
-            ax.scatter(dphi[idx], te[idx], s=2, c=np.log10(np.maximum(lum[idx], 1e-6)), cmap="viridis",
-                       linewidths=0)
+            mappable = ax.scatter(dphi[idx], te[idx], s=2, c=np.maximum(lum[idx], 1e-6), cmap="viridis", norm=norm,
+                                  linewidths=0)
         ax.set_ylim(0, 90)
         ax.set_yticks([30, 60, 90])
         ax.set_title(f"theta_i = {theta} deg: {int(mask.sum())} samples", fontsize=10)
     fig.suptitle("Sample coverage: exitant direction (radius theta_e, angle delta_phi) for each incidence angle "
-                 f"(+-{THETA_TOLERANCE_DEG} deg); colour log10 luminance of f", fontsize=11)
-    fig.tight_layout()
+                 f"(+-{THETA_TOLERANCE_DEG} deg)", fontsize=11)
+    fig.tight_layout(rect=(0, 0, 0.92, 1))
+    if mappable is not None:
+        fig.colorbar(mappable, ax=list(axes.flat), fraction=0.025, pad=0.04, label="luminance of f, 1/sr (log)")
     return save(fig, out, "coverage.png")
 
 
-def incidence_plane_figure(s, data, out):
-    """Fixed-incidence and fixed-exitance samples in the incidence plane, per channel, with the
-    reconstruction (and the truth) as curves. Abscissa: the other angle, positive on the light's side."""
-    curves = data.get("incidence_plane", [])
-    ti = np.degrees(s["theta_i"])
-    te = np.degrees(s["theta_e"])
-    dphi = np.degrees(s["delta_phi"])
-    back = np.abs(dphi) <= PLANE_TOLERANCE_DEG
-    forward = np.abs(np.abs(dphi) - 180.0) <= PLANE_TOLERANCE_DEG
+def binned_median(x, y, width=1.0):
+    """Medians of y in bins of x `width` wide: the curve drawn through a band's samples."""
+    ok = np.isfinite(x) & np.isfinite(y)
+    x, y = x[ok], y[ok]
+    if x.size == 0:
+        return np.array([]), np.array([])
+    keys = np.floor(x / width).astype(int)
+    centres, values = [], []
+    for key in np.unique(keys):
+        sel = keys == key
+        centres.append((key + 0.5) * width)
+        values.append(np.median(y[sel]))
+    return np.array(centres), np.array(values)
+
+
+def load_plane(out, plane):
+    rows = np.load(os.path.join(out, plane["file"]))
+    return {name: rows[:, i] for i, name in enumerate(plane["columns"])}
+
+
+def incidence_plane_figure(data, models, out):
+    """Fixed-incidence and fixed-exitance samples in the incidence plane, per channel, with every model
+    evaluated at the samples' own directions (solid: median per degree of those values, so the curve is
+    where the samples are) and in the exact plane (thin dotted: the band's centre)."""
+    planes = data.get("incidence_plane", [])
+    if not planes:
+        return None
     rng = np.random.default_rng(1)
-    fig, axes = plt.subplots(3, len(curves), figsize=(4 * len(curves), 10), squeeze=False)
-    for col, curve in enumerate(curves):
-        t0 = curve["theta0_deg"]
-        fixed_i = (np.abs(ti - t0) <= THETA_TOLERANCE_DEG) & (back | forward)
-        fixed_e = (np.abs(te - t0) <= THETA_TOLERANCE_DEG) & (back | forward)
-        xi = np.where(back, te, -te)  # signed exitance angle
-        xe = np.where(back, ti, -ti)  # signed incidence angle (by reciprocity, the same curve)
-        ii, ie = subset(fixed_i, rng), subset(fixed_e, rng)
-        angles = np.array(curve["angle_deg"])
-        recon = np.array(curve["reconstruction"]) if curve["reconstruction"] else None
-        truth = np.array(curve["truth"]) if curve["truth"] else None
+    fig, axes = plt.subplots(3, len(planes), figsize=(4.2 * len(planes), 10), squeeze=False)
+    for col, plane in enumerate(planes):
+        t0 = plane["theta0_deg"]
+        cols = load_plane(out, plane)
+        kind = cols["kind"]
+        x = cols["abscissa_deg"]
+        centre_x = np.array(plane["centre_abscissa_deg"])
         for row, (name, colour) in enumerate(CHANNELS):
             ax = axes[row][col]
-            ax.scatter(xi[ii], s["brdf"][ii, row], s=3, color=FIXED_INCIDENCE_COLOUR, linewidths=0,
-                       label=f"fixed incidence, theta_i = {t0:g}")
-            ax.scatter(xe[ie], s["brdf"][ie, row], s=3, color=FIXED_EXITANCE_COLOUR, linewidths=0,
-                       label=f"fixed exitance, theta_e = {t0:g}")
-            if truth is not None:
-                ax.plot(angles, truth[:, row], color="0.4", linestyle="--", linewidth=1, label="truth")
-            if recon is not None:
-                values = np.where(recon[:, row] < 0, np.nan, recon[:, row])
-                ax.plot(angles, values, color=colour, linewidth=1.5, label="reconstruction")
-            shown = np.concatenate([s["brdf"][ii, row], s["brdf"][ie, row]])
-            shown = shown[shown > 0]
-            if shown.size and shown.max() > 10 * shown.min():  # a glossy lobe: log scale
-                ax.set_yscale("log")
+            key = "_" + name.lower()
+            y = cols["sample" + key]
+            for k, label, c in ((0, f"fixed incidence, theta_i = {t0:g}", FIXED_INCIDENCE_COLOUR),
+                                (1, f"fixed exitance, theta_e = {t0:g}", FIXED_EXITANCE_COLOUR)):
+                idx = subset(kind == k, rng)
+                ax.scatter(x[idx], y[idx], s=3, color=c, linewidths=0, label=label)
+            for model in models:
+                mc, ls = MODEL_STYLE.get(model, ("k", "-"))
+                bx, by = binned_median(x, cols[model + key])
+                if bx.size:
+                    ax.plot(bx, by, color=mc, linestyle=ls, linewidth=1.4, label=f"{model} at the samples")
+                centre = np.array(plane["centre"][model], dtype=float)[:, row]
+                centre = np.where(centre < 0, np.nan, centre)
+                ax.plot(centre_x, centre, color=mc, linestyle=":", linewidth=0.7, alpha=0.6)
+            positive = y[y > 0]
+            if positive.size:
+                log_axis(ax)
+                ax.set_ylim(np.percentile(positive, 0.5) / 2, positive.max() * 2)
             ax.set_xlim(-90, 90)
-            ax.grid(True, alpha=0.3)
+            ax.xaxis.set_major_locator(matplotlib.ticker.MultipleLocator(30))
+            ax.grid(True, which="major", alpha=0.3)
             if row == 0:
-                ax.set_title(f"theta_0 = {t0:g} deg ({len(ii)} + {len(ie)} samples)", fontsize=10)
+                agree = plane["agreement"].get("reconstruction")
+                ratio = ""
+                if agree and all(v is not None for v in agree["median_sample_over_model"]):
+                    ratio = "\nsamples/reconstruction " + " ".join(f"{v:.3f}" for v in agree["median_sample_over_model"])
+                ax.set_title(f"theta_0 = {t0:g} deg ({plane['fixed_incidence_samples']} + "
+                             f"{plane['fixed_exitance_samples']} samples){ratio}", fontsize=9)
             if row == 2:
                 ax.set_xlabel("other angle, deg (+ light side, - mirror side)")
             if col == 0:
                 ax.set_ylabel(f"{name}: f, 1/sr")
             if row == 0 and col == 0:
-                ax.legend(fontsize=7, markerscale=3)
-    fig.suptitle(f"Incidence plane (|delta_phi| or |180 - delta_phi| <= {PLANE_TOLERANCE_DEG:g} deg): "
-                 "fixed-incidence and fixed-exitance samples, reconstruction", fontsize=11)
+                ax.legend(fontsize=6, markerscale=3, loc="lower left")
+    b = planes[0]
+    fig.suptitle(f"Incidence plane (band: |theta - theta_0| <= {b['band_theta_deg']:g} deg, within "
+                 f"{b['band_phi_deg']:g} deg of the plane). Curves: each model at the samples' own directions "
+                 "(median per degree); dotted: the same model in the exact plane", fontsize=10)
     fig.tight_layout()
     return save(fig, out, "incidence-plane.png")
 
 
+def reciprocity_curves_figure(data, out):
+    """The paper's reciprocity figure: the fixed-incidence curve f(theta_0, x) against the fixed-exitance
+    curve f(x, theta_0), from the samples alone (medians per degree), and their ratio."""
+    planes = data.get("incidence_plane", [])
+    if not planes:
+        return None
+    fig, axes = plt.subplots(2, len(planes), figsize=(4.2 * len(planes), 6), squeeze=False,
+                             gridspec_kw={"height_ratios": (3, 1.3)})
+    for col, plane in enumerate(planes):
+        cols = load_plane(out, plane)
+        lum = np.stack([cols["sample_r"], cols["sample_g"], cols["sample_b"]], 1) @ LUMINANCE
+        curves = []
+        for k, label, c in ((0, "fixed incidence", FIXED_INCIDENCE_COLOUR),
+                            (1, "fixed exitance", FIXED_EXITANCE_COLOUR)):
+            sel = cols["kind"] == k
+            bx, by = binned_median(cols["abscissa_deg"][sel], lum[sel], 2.0)
+            curves.append(dict(zip(bx, by)))
+            axes[0][col].plot(bx, by, color=c, marker=".", markersize=3, linewidth=1, label=label)
+        common = sorted(set(curves[0]) & set(curves[1]))
+        if common:
+            ratio = np.array([curves[0][x] / curves[1][x] for x in common if curves[1][x] > 0])
+            xs = [x for x in common if curves[1][x] > 0]
+            axes[1][col].plot(xs, 100 * (ratio - 1), color="k", marker=".", markersize=3, linewidth=0.8)
+            med = np.median(np.abs(ratio - 1)) * 100 if ratio.size else float("nan")
+            axes[1][col].set_title(f"median |difference| {med:.2f} % over {len(xs)} degrees", fontsize=8)
+        axes[1][col].axhline(0, color="0.6", linewidth=0.8)
+        axes[1][col].set_ylabel("incidence / exitance - 1, %", fontsize=8)
+        axes[1][col].set_xlabel("other angle, deg")
+        if lum[lum > 0].size:
+            log_axis(axes[0][col])
+        axes[0][col].set_title(f"theta_0 = {plane['theta0_deg']:g} deg", fontsize=10)
+        for ax in axes[:, col]:
+            ax.set_xlim(-90, 90)
+            ax.grid(True, alpha=0.3)
+        if col == 0:
+            axes[0][col].set_ylabel("luminance of f, 1/sr")
+            axes[0][col].legend(fontsize=7)
+    fig.suptitle("Reciprocity as in the paper: the fixed-incidence curve against the fixed-exitance curve "
+                 "(sample medians per 2 deg, no model)", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out, "reciprocity-curves.png")
+
+
+def figure_of(c, key):
+    if not c:
+        return None
+    if key == "bilateral_symmetry" and key not in c:
+        key = "isotropy"  # a consistency.json of the previous release
+    return c.get(key)
+
+
 def consistency_figure(c, key, title, out):
-    figure = c.get(key) if c else None
+    figure = figure_of(c, key)
     if not figure or not figure.get("bins"):
         return None
     bins = figure["bins"]
     a = np.array([b["value_a"] for b in bins])
     b = np.array([b["value_b"] for b in bins])
     err = np.array([x["rel_error"] for x in bins])
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
     for i, (name, colour) in enumerate(CHANNELS):
         axes[0].scatter(a[:, i], b[:, i], s=6, color=colour, label=name, alpha=0.7)
     positive = np.concatenate([a[a > 0], b[b > 0]])
     if positive.size:
         lo, hi = positive.min(), positive.max()
         axes[0].plot([lo, hi], [lo, hi], color="k", linewidth=0.8)
-        axes[0].set_xscale("log")
-        axes[0].set_yscale("log")
-        for axis in (axes[0].xaxis, axes[0].yaxis):
-            axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    axes[0].set_xlabel("bin estimate")
-    axes[0].set_ylabel("its " + ("reciprocal" if key == "reciprocity" else "mirror") + " bin's estimate")
+        log_axis(axes[0], "x")
+        log_axis(axes[0], "y")
+    axes[0].set_xlabel("median of the bin's samples, 1/sr")
+    axes[0].set_ylabel("median of their " + ("reciprocal" if key == "reciprocity" else "mirrored") + " partners")
     axes[0].legend(fontsize=8)
-    axes[0].set_title(f"{len(bins)} bin pairs", fontsize=10)
+    axes[0].set_title(f"{len(bins)} bins, {figure.get('pairs', 0)} sample pairs", fontsize=10)
     axes[1].hist(100 * err, bins=40, color="0.5")
-    axes[1].set_xlabel("relative difference, % (mean over channels)")
-    axes[1].set_ylabel("bin pairs")
-    axes[1].set_title(f"weighted mean {100 * figure['overall_rel_error']:.2f} %, "
-                      f"median {100 * figure['median_rel_error']:.2f} %, p95 {100 * figure['p95_rel_error']:.2f} %",
-                      fontsize=10)
+    median = figure.get("median_rel_error") or 0.0
+    p95 = figure.get("p95_rel_error") or 0.0
+    axes[1].axvline(100 * median, color="k", label=f"median {100 * median:.2f} %")
+    axes[1].axvline(100 * p95, color="r", label=f"p95 {100 * p95:.2f} %")
+    axes[1].legend(fontsize=8)
+    axes[1].set_xlabel("|median signed difference| of a bin's pairs, %")
+    axes[1].set_ylabel("bins")
+    # Where: the worst bin over delta_phi at each (theta_i, theta_e).
+    ti = np.array([x["theta_i_deg"] for x in bins])
+    te = np.array([x["theta_e_deg"] for x in bins])
+    cells = {}
+    for i in range(len(bins)):
+        cells[(ti[i], te[i])] = max(cells.get((ti[i], te[i]), 0.0), err[i])
+    xs = np.array([k[0] for k in cells])
+    ys = np.array([k[1] for k in cells])
+    vs = np.array(list(cells.values())) * 100
+    sc = axes[2].scatter(xs, ys, c=vs, cmap="magma_r", s=120, marker="s",
+                         norm=matplotlib.colors.Normalize(0, max(vs.max(), 1.0)))
+    fig.colorbar(sc, ax=axes[2], label="worst bin over delta_phi, %")
+    for w in figure.get("worst_bins", [])[:3]:
+        axes[2].annotate(f"{100 * w['rel_error']:.1f} % at dphi {w['delta_phi_deg']:.0f}",
+                         (w["theta_i_deg"], w["theta_e_deg"]), fontsize=7, xytext=(4, 4), textcoords="offset points")
+    axes[2].set_xlabel("theta_i, deg")
+    axes[2].set_ylabel("theta_e, deg")
+    axes[2].set_xlim(0, 90)
+    axes[2].set_ylim(0, 90)
+    axes[2].set_title("where: the worst bins located", fontsize=10)
     fig.suptitle(title, fontsize=11)
     fig.tight_layout()
     return save(fig, out, f"{key}.png")
+
+
+def photo_difference_figure(data, out):
+    """The signed difference (render - photo) / photo of each model, one shared diverging scale."""
+    photo = data.get("photo")
+    if not photo or not photo.get("renders"):
+        return None
+    renders = photo["renders"]
+    fig, axes = plt.subplots(1, len(renders), figsize=(4 * len(renders) + 1, 4.2), squeeze=False)
+    limit = 0.1
+    image = None
+    for ax, r in zip(axes[0], renders):
+        d = np.load(os.path.join(out, r["difference"]))
+        image = ax.imshow(100 * d, cmap="RdBu_r", vmin=-100 * limit, vmax=100 * limit, interpolation="nearest")
+        med = r.get("median_abs_difference")
+        ax.set_title(f"{r['model']}: median |difference| {100 * med:.2f} %" if med is not None else r["model"],
+                     fontsize=9)
+        ax.set_xticks([])
+        ax.set_yticks([])
+    fig.colorbar(image, ax=list(axes[0]), fraction=0.03, label="(render - photo) / photo, % (clipped at +-10)")
+    return save(fig, out, "photo-difference.png")
 
 
 def stamps(run_dir):
@@ -184,7 +333,7 @@ def timings_figure(times, counts, out):
     if rejected:
         axes[1].barh(list(rejected), list(rejected.values()), color="#c44e52")
         axes[1].invert_yaxis()
-        axes[1].set_xscale("log")
+        log_axis(axes[1], "x")
     axes[1].set_xlabel("pixels")
     axes[1].set_title(f"Rejected pixels by reason ({(counts or {}).get('accepted', 0)} accepted)", fontsize=10)
     fig.tight_layout()
@@ -217,7 +366,7 @@ def pct(values):
         return "n/a"
     if isinstance(values, (int, float)):
         return f"{100 * values:.2f} %"
-    return " / ".join(f"{100 * v:.2f} %" for v in values)
+    return " / ".join("n/a" if v is None else f"{100 * v:.2f} %" for v in values)
 
 
 def embed(out, name):
@@ -225,45 +374,82 @@ def embed(out, name):
         return "data:image/png;base64," + base64.b64encode(f.read()).decode("ascii")
 
 
-def figure_html(out, name, caption, width=None):
+def figure_html(out, name, caption, width=None, zoom_width=None):
+    """An embedded figure; `zoom_width`: show a small image that many pixels wide, pixels kept sharp."""
     if not name:
         return ""
     style = f' style="max-width:{width}px"' if width else ""
+    if zoom_width:
+        style = f' style="width:{zoom_width}px; image-rendering: pixelated"'
     return (f'<figure><img src="{embed(out, name)}" alt="{html.escape(name)}"{style}>'
             f'<figcaption>{html.escape(caption)} ({html.escape(name)})</figcaption></figure>\n')
 
 
-def main():
-    if len(sys.argv) != 3:
-        sys.exit("usage: report.py RUN_DIR OUT_DIR")
-    run_dir, out = sys.argv[1], sys.argv[2]
-    s = np.load(os.path.join(run_dir, "samples.npy"))
-    side = load_json(os.path.join(run_dir, "samples.npy.json")) or {}
+def appearance_html(data, out, figures):
+    parts = []
+    photo = data.get("photo")
+    if photo:
+        x0, y0, x1, y1 = photo["crop"]
+        zoom = max(1, min(4, ZOOM_TARGET_PX // (x1 - x0 + 1)))
+        shown = (x1 - x0 + 1) * zoom if zoom > 1 else None
+        enlarged = f", shown {zoom}x enlarged" if zoom > 1 else ""
+        parts.append(figure_html(out, photo["file"], f"measured photo {photo['index']} (linearized, full resolution{enlarged}, "
+                                 f"pixels {x0}-{x1} x {y0}-{y1}, light {photo['phase_deg']:.0f} deg from the view)",
+                                 zoom_width=shown))
+        for r in photo.get("renders", []):
+            every = "every pixel" if photo["stride"] == 1 else \
+                f"every {photo['stride']}th pixel (the derender stride) shown as a block"
+            parts.append(figure_html(out, r["file"], f"{r['model']} rendered from the photo's camera ({every}; "
+                                     f"black: no sample; magenta: no model value; the photo's tone scale{enlarged})",
+                                     zoom_width=shown))
+        parts.append("<br>" + figure_html(out, figures.get("difference"), "signed difference of each render from "
+                                          "the photo at the samples' pixels"))
+    if "photo_note" in data:
+        parts.append(f"<p>No measured photo: {html.escape(data['photo_note'])}</p>")
+    spheres = data.get("spheres", [])
+    if spheres:
+        parts.append("<h3>On a sphere</h3>")
+        for sp in spheres:
+            parts.append(figure_html(out, sp["file"], f"{sp['model']} on a sphere, light {sp['phase_deg']:.0f} deg "
+                                     "from the view", 260))
+    return "\n".join(parts)
+
+
+def headline_rows(s, side, c, t, r, data, times):
     counts = side.get("counts", {})
-    c = load_json(os.path.join(run_dir, "consistency.json"))
-    t = load_json(os.path.join(run_dir, "truth-comparison.json"))
-    r = load_json(os.path.join(run_dir, "reconstruction", "summary.json"))
-    data = load_json(os.path.join(out, "report-data.json")) or {}
-    times = stamps(run_dir)
-
-    figures = {
-        "coverage": coverage_figure(s, out),
-        "plane": incidence_plane_figure(s, data, out),
-        "reciprocity": consistency_figure(c, "reciprocity", "Reciprocity: f(ti, te, dphi) against f(te, ti, -dphi), "
-                                          "binned (local linear fit at each bin centre)", out),
-        "isotropy": consistency_figure(c, "isotropy", "Bilateral symmetry: f(ti, te, dphi) against f(ti, te, -dphi)", out),
-        "timings": timings_figure(times, counts, out),
-        "bands": truth_bands_figure(t, out),
-    }
-
-    name = side.get("session_name", os.path.basename(os.path.abspath(run_dir)))
     rows = [("samples accepted", f"{counts.get('accepted', s.size)} of {counts.get('pixels_examined', 'n/a')} pixels "
              f"in {counts.get('photos', 'n/a')} photos")]
+    zero = [reason for reason, n in counts.get("rejected", {}).items() if n == 0]
     for reason, n in counts.get("rejected", {}).items():
-        rows.append((f"rejected: {reason}", str(n)))
-    if c:
-        rows.append(("reciprocity error (R / G / B)", pct(c["reciprocity"].get("per_channel_rel_error"))))
-        rows.append(("bilateral-symmetry error (R / G / B)", pct(c["isotropy"].get("per_channel_rel_error"))))
+        if n > 0:
+            rows.append((f"rejected: {reason}", str(n)))
+    if zero:
+        rows.append(("rejected: none for", ", ".join(zero)))
+    for key, name in (("reciprocity", "reciprocity"), ("bilateral_symmetry", "bilateral symmetry")):
+        figure = figure_of(c, key)
+        if figure is None:
+            continue
+        if "headline" in figure:
+            rows.append((f"{name}: |median pair difference| per bin, median and p95 over bins", figure["headline"]))
+        else:
+            rows.append((f"{name} error (R / G / B)", pct(figure.get("per_channel_rel_error"))))
+        for w in figure.get("worst_bins", [])[:3]:
+            rows.append((f"{name}: a worst bin", f"{100 * w['rel_error']:.2f} % at theta_i {w['theta_i_deg']:.0f}, "
+                         f"theta_e {w['theta_e_deg']:.0f}, delta_phi {w['delta_phi_deg']:.0f} deg "
+                         f"({w['pairs']} pairs)"))
+    if c and "regression" in c:
+        reg = c["regression"]
+        for key in ("reciprocity", "bilateral"):
+            f = reg.get(key, {})
+            value = "invalid (no pair had two estimates)" if not f.get("valid", f.get("pairs", 0)) else \
+                f"median {pct(f.get('median'))}, p95 {pct(f.get('p95'))} over {f.get('pairs')} pairs"
+            rows.append((f"regression check: {key}", value))
+    for plane in data.get("incidence_plane", []):
+        agree = plane["agreement"].get("reconstruction")
+        if agree:
+            rows.append((f"incidence plane {plane['theta0_deg']:g} deg: median sample / reconstruction (R / G / B)",
+                         " / ".join("n/a" if v is None else f"{v:.3f}" for v in agree["median_sample_over_model"]) +
+                         f" over {agree['samples']} samples"))
     if t:
         rows.append(("samples vs truth: median |rel. error| (R / G / B)", pct(t["overall"]["median_rel_error"])))
         rows.append(("samples vs truth: p95 |rel. error| (R / G / B)", pct(t["overall"]["p95_rel_error"])))
@@ -274,46 +460,330 @@ def main():
     if r and "fits" in r:
         for model, fit in r["fits"].items():
             rows.append((f"{model} fit: relative RMS against the samples", pct(fit["rel_rms_vs_samples"])))
+    photo = data.get("photo")
+    if photo:
+        for rd in photo.get("renders", []):
+            if rd.get("median_abs_difference") is not None:
+                rows.append((f"photo {photo['index']}: median |render - photo| / photo, {rd['model']}",
+                             pct(rd["median_abs_difference"])))
     for stage in [n for n in STAGE_ORDER if n in times]:
         rows.append((f"time: {stage}", f"{times[stage]:.2f} s"))
-    table = "\n".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>" for k, v in rows)
+    return rows
 
-    appearance = ""
-    for key, caption in (("photo", "measured photo (linearized, cropped)"),
-                         ("render", "reconstructed material on a sphere"),
-                         ("render_truth", "true material on a sphere")):
-        if key in data:
-            extra = f", light {data[key].get('phase_deg', 0):.0f} deg from the view"
-            if key == "photo":
-                extra = f", photo {data[key]['index']}" + extra
-            appearance += figure_html(out, data[key]["file"], caption + extra, 320)
-    if "photo_note" in data:
-        appearance += f"<p>No measured photo: {html.escape(data['photo_note'])}</p>"
+
+def b64_array(path):
+    return base64.b64encode(np.load(path).astype("<f4").tobytes()).decode("ascii")
+
+
+def write_explorer(data, out, title):
+    grids = data.get("explorer")
+    if not grids:
+        return None
+    payload = {"title": title, "theta_i": grids["theta_i_deg"], "phi": grids["phi_deg"],
+               "theta_e": grids["theta_e_deg"], "table_cells": grids["table_cells"], "models": {}}
+    for model in grids["models"]:
+        payload["models"][model] = {
+            "curves": b64_array(os.path.join(out, f"explorer-curves-{model}.npy")),
+            "halfdiff": b64_array(os.path.join(out, f"explorer-halfdiff-{model}.npy")),
+            "table": b64_array(os.path.join(out, f"explorer-table-{model}.npy")),
+        }
+    payload["samples"] = b64_array(os.path.join(out, "explorer-samples.npy"))
+    page = EXPLORER_HTML.replace("__TITLE__", html.escape(title)).replace("__DATA__", json.dumps(payload))
+    with open(os.path.join(out, "explorer.html"), "w") as f:
+        f.write(page)
+    for path in glob.glob(os.path.join(out, "explorer-*.npy")):
+        os.remove(path)  # embedded in explorer.html
+    return "explorer.html"
+
+
+EXPLORER_HTML = r"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>ibrdf explorer: __TITLE__</title>
+<style>
+body { font-family: sans-serif; margin: 1em; } .row { display: flex; flex-wrap: wrap; gap: 1em; }
+fieldset { border: 1px solid #ccc; } label { margin-right: 0.8em; white-space: nowrap; }
+canvas { border: 1px solid #ddd; } .note { color: #555; font-size: 0.85em; max-width: 60em; }
+</style></head><body>
+<h1>BRDF explorer: __TITLE__</h1>
+<p class="note">Everything is embedded in this file: it works offline. Curves: f(theta_i, phi_i = 0; theta_e, phi_e)
+in the slice at azimuth phi (the right half of the plot; the left half is the opposite azimuth phi + 180, so phi = 0
+is the incidence plane with the light's side on the right). Samples: those within 2.5 deg of theta_i and 5 deg of the
+slice. Table: the reconstruction, interpolated smoothly; fits and truth as the run has them.</p>
+<div class="row"><fieldset><legend>Incidence and slice</legend>
+<label>theta_i <input id="theta" type="range"> <span id="theta-value"></span> deg</label>
+<label>slice azimuth phi <input id="phi" type="range"> <span id="phi-value"></span> deg</label><br>
+<label><input id="log" type="checkbox" checked> log scale</label>
+<label><input id="polar" type="checkbox"> polar plot</label>
+<label>channel <select id="channel"><option value="3">luminance</option><option value="0">R</option>
+<option value="1">G</option><option value="2">B</option></select></label>
+<label><input id="show-samples" type="checkbox" checked> samples</label>
+<span id="model-boxes"></span></fieldset>
+<fieldset><legend>Compare with a second BRDF</legend>
+<input id="compare-file" type="file" accept=".binary"> <span id="compare-name" class="note">a MERL .binary
+(e.g. another run's reconstruction/brdf.binary)</span></fieldset></div>
+<div class="row"><canvas id="plot" width="580" height="400"></canvas>
+<div style="width:240px"><canvas id="sphere" width="224" height="224"></canvas><br>
+<label>light elevation <input id="light-theta" type="range" min="0" max="85" value="30" style="width:110px"></label><br>
+<label>light azimuth <input id="light-phi" type="range" min="0" max="359" value="180" style="width:110px"></label><br>
+<label>sphere model <select id="sphere-model"></select></label></div>
+<div style="width:230px"><canvas id="halfdiff" width="224" height="224"></canvas><br><span class="note">theta_h (right) x theta_d (up),
+phi_d = 90 deg, log colour: <select id="halfdiff-model"></select></span></div></div>
+<pre id="ibrdf-test" style="display:none"></pre>
+<script>
+const DATA = __DATA__;
+const COLOURS = {reconstruction: "#000000", lafortune: "#ff7f0e", ggx: "#9467bd", truth: "#888888", compare: "#17becf"};
+function f32(b64) { const s = atob(b64); const b = new Uint8Array(s.length);
+  for (let i = 0; i < s.length; ++i) b[i] = s.charCodeAt(i); return new Float32Array(b.buffer); }
+const MODELS = {};
+for (const name in DATA.models) { const m = DATA.models[name];
+  MODELS[name] = {curves: f32(m.curves), halfdiff: f32(m.halfdiff), table: f32(m.table)}; }
+const SAMPLES = f32(DATA.samples);
+const TI = DATA.theta_i, PH = DATA.phi, TE = DATA.theta_e, NC = DATA.table_cells;
+const nTI = Math.round((TI[1] - TI[0]) / TI[2]) + 1, nPH = Math.round((PH[1] - PH[0]) / PH[2]) + 1,
+      nTE = Math.round((TE[1] - TE[0]) / TE[2]) + 1;
+const $ = id => document.getElementById(id);
+$("theta").min = TI[0]; $("theta").max = TI[1]; $("theta").step = TI[2]; $("theta").value = 30;
+$("phi").min = PH[0]; $("phi").max = PH[1]; $("phi").step = PH[2]; $("phi").value = 0;
+const shown = {};
+for (const name in MODELS) { shown[name] = true;
+  $("model-boxes").insertAdjacentHTML("beforeend", `<label style="color:${COLOURS[name] || "#000"}">` +
+    `<input type="checkbox" id="show-${name}" checked> ${name}</label>`);
+  for (const sel of ["sphere-model", "halfdiff-model"]) $(sel).insertAdjacentHTML("beforeend",
+    `<option value="${name}">${name}</option>`); }
+let compare = null;  // {name, lookup(wi, wo)}
+function value(rgb, ch) { if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) return NaN;
+  return ch == 3 ? 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] : rgb[ch]; }
+function dir(theta, phi) { const t = theta * Math.PI / 180, p = phi * Math.PI / 180;
+  return [Math.sin(t) * Math.cos(p), Math.sin(t) * Math.sin(p), Math.cos(t)]; }
+// The curve of a model at the slider's grid point: values at theta_e = TE[0] .. TE[1].
+function curve(name, theta, phi, ch) {
+  const it = Math.round((theta - TI[0]) / TI[2]), ip = Math.round((phi - PH[0]) / PH[2]);
+  const out = [];
+  if (name == "compare") { for (let k = 0; k < nTE; ++k) { const x = TE[0] + k * TE[2];
+      out.push(value(compare.lookup(dir(theta, 0), dir(Math.abs(x), x >= 0 ? phi : phi + 180)), ch)); }
+    return out; }
+  const c = MODELS[name].curves;
+  for (let k = 0; k < nTE; ++k) { const at = ((it * nPH + ip) * nTE + k) * 3;
+    out.push(value([c[at], c[at + 1], c[at + 2]], ch)); }
+  return out;
+}
+function slabSamples(theta, phi, ch) {
+  const pts = [];
+  for (let i = 0; i + 5 < SAMPLES.length; i += 6) {
+    if (Math.abs(SAMPLES[i] - theta) > 2.5) continue;
+    const dp = SAMPLES[i + 2], te = SAMPLES[i + 1];
+    const d1 = Math.abs(((dp - phi) % 360 + 540) % 360 - 180), d2 = Math.abs(((dp - phi - 180) % 360 + 540) % 360 - 180);
+    let x = null;
+    if (Math.min(d1, Math.abs(((-dp - phi) % 360 + 540) % 360 - 180)) <= 5) x = te;
+    else if (Math.min(d2, Math.abs(((-dp - phi - 180) % 360 + 540) % 360 - 180)) <= 5) x = -te;
+    if (x === null) continue;
+    const v = value([SAMPLES[i + 3], SAMPLES[i + 4], SAMPLES[i + 5]], ch);
+    if (v > 0) pts.push([x, v]);
+  }
+  return pts;
+}
+function draw() {
+  const theta = +$("theta").value, phi = +$("phi").value, ch = +$("channel").value;
+  const log = $("log").checked, polar = $("polar").checked;
+  $("theta-value").textContent = theta; $("phi-value").textContent = phi;
+  const cv = $("plot"), g = cv.getContext("2d"); g.clearRect(0, 0, cv.width, cv.height);
+  const series = {};
+  for (const name in MODELS) if ($("show-" + name).checked) series[name] = curve(name, theta, phi, ch);
+  if (compare) series.compare = curve("compare", theta, phi, ch);
+  const pts = $("show-samples").checked ? slabSamples(theta, phi, ch) : [];
+  let vals = pts.map(p => p[1]);
+  for (const n in series) vals = vals.concat(series[n].filter(v => v > 0));
+  vals = vals.filter(v => isFinite(v) && v > 0).sort((a, b) => a - b);
+  const hi = vals.length ? vals[vals.length - 1] * 1.2 : 1, lo = log ? (vals.length ? Math.max(vals[0] / 1.5, hi * 1e-4) : 1e-3) : 0;
+  const W = cv.width, H = cv.height, L = 70, R = 20, T = 20, B = 40;
+  const fy = v => log ? (Math.log10(Math.max(v, lo)) - Math.log10(lo)) / (Math.log10(hi) - Math.log10(lo)) : v / hi;
+  let px, py;
+  if (!polar) { px = (x, v) => L + (x + 90) / 180 * (W - L - R); py = (x, v) => H - B - fy(v) * (H - T - B); }
+  else { const cx = W / 2, cy = H - B, r = Math.min(W / 2 - R, H - T - B);
+    px = (x, v) => cx + Math.sin(x * Math.PI / 180) * fy(v) * r; py = (x, v) => cy - Math.cos(x * Math.PI / 180) * fy(v) * r; }
+  // Axes and ticks.
+  g.strokeStyle = "#bbb"; g.fillStyle = "#333"; g.font = "11px sans-serif"; g.lineWidth = 1;
+  if (!polar) { g.strokeRect(L, T, W - L - R, H - T - B);
+    for (let x = -90; x <= 90; x += 30) { g.fillText(x, px(x, lo) - 8, H - B + 14); }
+    g.fillText("theta_e, deg (right: azimuth phi, left: phi + 180)", L + 150, H - 8);
+    const ticks = [];
+    if (log) { for (let e = Math.floor(Math.log10(lo)); e <= Math.ceil(Math.log10(hi)); ++e)
+        for (const m of [1, 2, 5]) { const v = m * Math.pow(10, e); if (v >= lo && v <= hi) ticks.push(v); } }
+    else { const step = Math.pow(10, Math.floor(Math.log10(hi / 5))); for (let v = 0; v <= hi; v += step * (hi / step > 20 ? 5 : hi / step > 10 ? 2 : 1)) ticks.push(v); }
+    for (const v of ticks) { const y = py(0, v); g.beginPath(); g.moveTo(L, y); g.lineTo(W - R, y); g.stroke();
+      g.fillText(v.toPrecision(2), 5, y + 4); }
+  } else { for (const v of [0.25, 0.5, 0.75, 1]) { g.beginPath();
+      g.arc(W / 2, H - B, v * Math.min(W / 2 - R, H - T - B), Math.PI, 2 * Math.PI); g.stroke(); }
+    g.fillText(log ? "radius: log f" : "radius: f", 5, 14); }
+  for (const p of pts) { g.fillStyle = "rgba(220,60,160,0.5)"; g.fillRect(px(p[0], p[1]) - 1, py(p[0], p[1]) - 1, 2.5, 2.5); }
+  const drawn = {};
+  for (const name in series) { g.strokeStyle = COLOURS[name] || "#000"; g.lineWidth = 1.6; g.beginPath();
+    let pen = false; const ys = [];
+    series[name].forEach((v, k) => { const x = TE[0] + k * TE[2];
+      if (!(v > 0) && !(v == 0 && !log)) { pen = false; ys.push(null); return; }
+      const X = px(x, v), Y = py(x, v); ys.push(Y);
+      if (pen) g.lineTo(X, Y); else g.moveTo(X, Y); pen = true; });
+    g.stroke(); drawn[name] = {values: series[name].map(v => isFinite(v) ? v : null), y_px: ys}; }
+  $("ibrdf-test").textContent = JSON.stringify({theta_i: theta, phi: phi, channel: ch, log: log, polar: polar,
+    theta_e: TE, samples: pts.length, curves: drawn});
+  drawSphere(); drawHalfDiff();
+}
+// Trilinear lookup in a model's 32^3 table (MERL's axes, phi_d over [0, 180)).
+function halfDiff(wi, wo) {
+  const h = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]; const n = Math.hypot(h[0], h[1], h[2]);
+  if (n < 1e-9) return null; h[0] /= n; h[1] /= n; h[2] /= n;
+  const th = Math.acos(Math.min(1, h[2])), ph = Math.atan2(h[1], h[0]);
+  const rot = (v, axis, a) => { const c = Math.cos(a), s = Math.sin(a);
+    if (axis == "z") return [c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]];
+    return [c * v[0] + s * v[2], v[1], -s * v[0] + c * v[2]]; };
+  const d = rot(rot(wi, "z", -ph), "y", -th);
+  let pd = Math.atan2(d[1], d[0]); if (pd < 0) pd += Math.PI;
+  return [th, Math.acos(Math.max(-1, Math.min(1, d[2]))), pd];
+}
+function tableLookup(name, wi, wo) {
+  const a = halfDiff(wi, wo); if (!a) return [-1, -1, -1];
+  const t = MODELS[name].table;
+  const u = Math.sqrt(a[0] / (Math.PI / 2)) * NC - 0.5, v = a[1] / (Math.PI / 2) * NC - 0.5, w = a[2] / Math.PI * NC - 0.5;
+  const fu = Math.floor(u), fv = Math.floor(v), fw = Math.floor(w); const out = [0, 0, 0]; let ws = 0;
+  for (let du = 0; du < 2; ++du) for (let dv = 0; dv < 2; ++dv) for (let dw = 0; dw < 2; ++dw) {
+    const i = Math.min(NC - 1, Math.max(0, fu + du)), j = Math.min(NC - 1, Math.max(0, fv + dv)), k = ((fw + dw) % NC + NC) % NC;
+    const wt = (du ? u - fu : 1 - u + fu) * (dv ? v - fv : 1 - v + fv) * (dw ? w - fw : 1 - w + fw);
+    const at = ((i * NC + j) * NC + k) * 3; if (wt <= 0 || t[at] < 0) continue;
+    for (let c = 0; c < 3; ++c) out[c] += wt * t[at + c]; ws += wt; }
+  return ws > 1e-9 ? out.map(x => x / ws) : [-1, -1, -1];
+}
+function drawSphere() {
+  const cv = $("sphere"), g = cv.getContext("2d"), S = cv.width, img = g.createImageData(S, S);
+  const name = $("sphere-model").value; const L = dir(+$("light-theta").value, +$("light-phi").value);
+  const lookup = name == "compare" && compare ? compare.lookup : (wi, wo) => tableLookup(name, wi, wo);
+  const vals = new Float32Array(S * S * 3).fill(-1); const lum = [];
+  for (let y = 0; y < S; y += 2) for (let x = 0; x < S; x += 2) {
+    const u = 2 * (x + 1) / S - 1, v = 1 - 2 * (y + 1) / S, r2 = u * u + v * v; if (r2 >= 1) continue;
+    const n = [u, v, Math.sqrt(1 - r2)]; const ci = n[0] * L[0] + n[1] * L[1] + n[2] * L[2]; if (ci <= 0) continue;
+    // Local frame around n: t1, t2, n.
+    const a = Math.abs(n[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0];
+    let t1 = [a[1] * n[2] - a[2] * n[1], a[2] * n[0] - a[0] * n[2], a[0] * n[1] - a[1] * n[0]];
+    const tn = Math.hypot(...t1); t1 = t1.map(c => c / tn);
+    const t2 = [n[1] * t1[2] - n[2] * t1[1], n[2] * t1[0] - n[0] * t1[2], n[0] * t1[1] - n[1] * t1[0]];
+    const loc = w => [w[0] * t1[0] + w[1] * t1[1] + w[2] * t1[2], w[0] * t2[0] + w[1] * t2[1] + w[2] * t2[2],
+                      w[0] * n[0] + w[1] * n[1] + w[2] * n[2]];
+    const f = lookup(loc(L), loc([0, 0, 1]));
+    if (f[0] < 0 || f[1] < 0 || f[2] < 0) { vals[(y * S + x) * 3] = -2; continue; }  // no value: magenta
+    for (let c = 0; c < 3; ++c) vals[(y * S + x) * 3 + c] = f[c] * ci;
+    lum.push(0.2126 * vals[(y * S + x) * 3] + 0.7152 * vals[(y * S + x) * 3 + 1] + 0.0722 * vals[(y * S + x) * 3 + 2]);
+  }
+  lum.sort((a, b) => a - b); const scale = lum.length ? 0.8 / Math.max(lum[Math.floor(0.99 * (lum.length - 1))], 1e-12) : 1;
+  const srgb = v => 255 * (v <= 0.0031308 ? 12.92 * v : 1.055 * Math.pow(v, 1 / 2.4) - 0.055);
+  for (let y = 0; y < S; ++y) for (let x = 0; x < S; ++x) { const at = ((y & ~1) * S + (x & ~1)) * 3, o = (y * S + x) * 4;
+    img.data[o + 3] = 255; if (vals[at] == -2) { img.data[o] = 255; img.data[o + 2] = 255; continue; }
+    if (vals[at] < 0) continue;
+    for (let c = 0; c < 3; ++c) img.data[o + c] = srgb(Math.min(1, vals[at + c] * scale)); }
+  g.putImageData(img, 0, 0);
+}
+function drawHalfDiff() {
+  const cv = $("halfdiff"), g = cv.getContext("2d"), name = $("halfdiff-model").value;
+  if (!MODELS[name]) return; const t = MODELS[name].halfdiff, ch = +$("channel").value;
+  const img = g.createImageData(90, 90); const vs = [];
+  for (let i = 0; i < 90 * 90; ++i) { const v = value([t[3 * i], t[3 * i + 1], t[3 * i + 2]], ch); if (v > 0) vs.push(Math.log10(v)); }
+  vs.sort((a, b) => a - b); const lo = vs.length ? vs[0] : 0, hi = vs.length ? vs[vs.length - 1] : 1;
+  for (let h = 0; h < 90; ++h) for (let d = 0; d < 90; ++d) { const i = h * 90 + d, o = ((89 - d) * 90 + h) * 4;
+    const v = value([t[3 * i], t[3 * i + 1], t[3 * i + 2]], ch); img.data[o + 3] = 255;
+    if (!(v > 0)) { img.data[o] = 255; img.data[o + 2] = 255; continue; }
+    const s = (Math.log10(v) - lo) / Math.max(hi - lo, 1e-9);
+    img.data[o] = 255 * Math.min(1, 1.5 * s); img.data[o + 1] = 255 * Math.max(0, Math.min(1, 1.5 * s - 0.5)); img.data[o + 2] = 255 * Math.max(0, s - 0.66) * 3; }
+  const tmp = document.createElement("canvas"); tmp.width = 90; tmp.height = 90; tmp.getContext("2d").putImageData(img, 0, 0);
+  g.imageSmoothingEnabled = false; g.drawImage(tmp, 0, 0, cv.width, cv.height);
+}
+// A second BRDF: a MERL .binary read in the browser (FileReader; nothing leaves the machine).
+$("compare-file").addEventListener("change", ev => { const file = ev.target.files[0]; if (!file) return;
+  const reader = new FileReader();
+  reader.onload = () => { const buf = reader.result, dims = new Int32Array(buf, 0, 3);
+    if (dims[0] != 90 || dims[1] != 90 || dims[2] != 180) { $("compare-name").textContent = file.name + ": not a MERL table"; return; }
+    const d = new Float64Array(buf.slice(12)), N = 90 * 90 * 180, scale = [1 / 1500, 1.15 / 1500, 1.66 / 1500];
+    compare = {name: file.name, lookup: (wi, wo) => { const a = halfDiff(wi, wo); if (!a) return [-1, -1, -1];
+      const i = Math.min(89, Math.max(0, Math.floor(Math.sqrt(a[0] / (Math.PI / 2) * 90 * 90)))),
+            j = Math.min(89, Math.max(0, Math.floor(a[1] / (Math.PI / 2) * 90))),
+            k = Math.min(179, Math.max(0, Math.floor(a[2] / Math.PI * 180))), at = k + 180 * (j + 90 * i);
+      return [0, 1, 2].map(c => d[at + c * N] < 0 ? -1 : d[at + c * N] * scale[c]); }};
+    $("compare-name").textContent = "compared: " + file.name;
+    if (!$("sphere-model").querySelector('option[value="compare"]'))
+      $("sphere-model").insertAdjacentHTML("beforeend", '<option value="compare">compare</option>');
+    draw(); };
+  reader.readAsArrayBuffer(file); });
+for (const id of ["theta", "phi", "log", "polar", "channel", "show-samples", "light-theta", "light-phi", "sphere-model", "halfdiff-model"])
+  $(id).addEventListener("input", draw);
+for (const name in MODELS) $("show-" + name).addEventListener("input", draw);
+// Test hook: #theta_i=30&phi=0&channel=1&log=0&polar=1 sets the controls before the first drawing.
+for (const kv of location.hash.replace(/^#/, "").split("&")) { const [k, v] = kv.split("=");
+  if (k == "theta_i") $("theta").value = v; else if (k == "phi") $("phi").value = v;
+  else if (k == "channel") $("channel").value = v; else if (k == "log") $("log").checked = v == "1";
+  else if (k == "polar") $("polar").checked = v == "1"; }
+draw();
+</script></body></html>
+"""
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit("usage: report.py RUN_DIR OUT_DIR")
+    run_dir, out = sys.argv[1], sys.argv[2]
+    s = np.load(os.path.join(run_dir, "samples.npy"))
+    side = load_json(os.path.join(run_dir, "samples.npy.json")) or {}
+    c = load_json(os.path.join(run_dir, "consistency.json"))
+    t = load_json(os.path.join(run_dir, "truth-comparison.json"))
+    data = load_json(os.path.join(out, "report-data.json")) or {}
+    recon = data.get("reconstruction")
+    r = load_json(os.path.join(os.path.dirname(recon), "summary.json")) if recon else None
+    times = stamps(run_dir)
+    models = data.get("models", [])
+    title = data.get("title") or os.path.basename(os.path.abspath(run_dir))
+
+    figures = {
+        "coverage": coverage_figure(s, out),
+        "plane": incidence_plane_figure(data, models, out),
+        "reciprocity_curves": reciprocity_curves_figure(data, out),
+        "reciprocity": consistency_figure(c, "reciprocity", "Reciprocity: each sample against the measured sample "
+                                          "nearest its reciprocal point f(te, ti, -dphi)", out),
+        "bilateral": consistency_figure(c, "bilateral_symmetry", "Bilateral symmetry: each sample against the "
+                                        "measured sample nearest f(ti, te, -dphi)", out),
+        "difference": photo_difference_figure(data, out),
+        "timings": timings_figure(times, side.get("counts", {}), out),
+        "bands": truth_bands_figure(t, out),
+    }
+    explorer = write_explorer(data, out, title)
+    rows = headline_rows(s, side, c, t, r, data, times)
+    table = "\n".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>" for k, v in rows)
+    explorer_link = (f'<p><a href="{explorer}">Open the BRDF explorer</a> (explorer.html beside this file: '
+                     'sliders for the incidence angle and slice azimuth, polar and Cartesian plots, linear/log, '
+                     'samples, table and fits overlaid, a theta_h x theta_d slice, a lit sphere under a movable '
+                     'light, a second BRDF file to compare against; offline).</p>') if explorer else ""
 
     page = f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>ibrdf report: {html.escape(name)}</title>
+<html lang="en"><head><meta charset="utf-8"><title>ibrdf report: {html.escape(title)}</title>
 <style>
-body {{ font-family: sans-serif; margin: 2em; max-width: 1300px; }}
+body {{ font-family: sans-serif; margin: 2em; max-width: 1500px; }}
 table {{ border-collapse: collapse; }} th, td {{ border: 1px solid #ccc; padding: 3px 8px; text-align: left; }}
 th {{ font-weight: normal; color: #444; }} figure {{ display: inline-block; margin: 0.5em; vertical-align: top; }}
-figure img {{ max-width: 100%; }} figcaption {{ font-size: 0.85em; color: #555; }}
+figure img {{ max-width: 100%; }} figcaption {{ font-size: 0.85em; color: #555; max-width: 24em; }}
 </style></head><body>
-<h1>ibrdf consistency report: {html.escape(name)}</h1>
+<h1>ibrdf consistency report: {html.escape(title)}</h1>
 <p>Run folder: <code>{html.escape(os.path.abspath(run_dir))}</code>. Figures after Marschner et al. 1999, Image-Based
 BRDF Measurement. Every figure is embedded in this file; the same PNGs lie beside it.</p>
+{explorer_link}
 <h2>Headline figures</h2>
 <table>{table}</table>
-<h2>Appearance</h2>
-<p>The sphere is lit by a distant light at the measured photo's median angle between light and view; each image is
-scaled so its 99th-percentile luminance is 0.8 (sRGB). Magenta: no reconstructed value there.</p>
-{appearance}
+<h2>The sample itself</h2>
+<p>The measured photo at full resolution beside each model rendered from the same camera, geometry and light: at every
+pixel that gave a sample, f_model(wi, wo) times the irradiance term E cos(theta_i) the derenderer divided by
+(so sphere, cylinder or scanned mesh alike, shadows included), on the photo's tone scale; and the signed difference.</p>
+{appearance_html(data, out, figures)}
 <h2>Sample coverage</h2>
 {figure_html(out, figures['coverage'], 'exitant directions sampled at each incidence angle')}
 <h2>Incidence plane, three colour channels</h2>
-{figure_html(out, figures['plane'], 'fixed-incidence (orange) and fixed-exitance (purple) samples; reconstruction as the channel-coloured curve, truth dashed')}
+{figure_html(out, figures['plane'], 'fixed-incidence and fixed-exitance samples; each model evaluated at the samples themselves (solid) and in the exact plane (dotted)')}
 <h2>Reciprocity and bilateral symmetry</h2>
-{figure_html(out, figures['reciprocity'], 'reciprocal bin pairs')}
-{figure_html(out, figures['isotropy'], 'mirrored bin pairs')}
+{figure_html(out, figures['reciprocity_curves'], 'the paper figure: fixed-incidence against fixed-exitance curves')}
+{figure_html(out, figures['reciprocity'], 'reciprocal sample pairs, binned')}
+{figure_html(out, figures['bilateral'], 'mirrored sample pairs, binned')}
 {('<h2>Against the truth</h2>' + figure_html(out, figures['bands'], 'median relative error by band')) if figures['bands'] else ''}
 <h2>Timings and rejected samples</h2>
 {figure_html(out, figures['timings'], 'stage wall-clock times and pixels rejected by reason')}

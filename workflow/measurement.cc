@@ -139,6 +139,7 @@ void Planner::Derender() {
   if (session) {
     for (const std::string& file : session->InputFiles()) derender.inputs.push_back(file);
   }
+  derender.arguments.insert(derender.arguments.end(), options_.derender_args.begin(), options_.derender_args.end());
   Execute(derender);
 }
 
@@ -147,6 +148,7 @@ void Planner::SampleStages() {
   Stage check = MakeStage("check", {"check", At("samples.npy"), "--out", At("consistency.json"), "--overwrite"},
                           samples_in, {At("consistency.json")});
   if (options_.check_regression) check.arguments.push_back("--regression");
+  check.arguments.insert(check.arguments.end(), options_.check_args.begin(), options_.check_args.end());
   Execute(check);
 
   Stage compare = MakeStage("compare", {}, samples_in, {At("truth-comparison.json")});
@@ -176,10 +178,13 @@ void Planner::SampleStages() {
   pass("--radius-h-deg", options_.radius_h_deg, -1.0);
   pass("--radius-d-deg", options_.radius_d_deg, -1.0);
   if (!options_.fits) reconstruct.arguments.push_back("--no-fits");
+  reconstruct.arguments.insert(reconstruct.arguments.end(), options_.reconstruct_args.begin(),
+                               options_.reconstruct_args.end());
   Execute(reconstruct);
 
   Stage report = MakeStage("report", {"report", run_->run_dir(), "--out", At("report"), "--overwrite"}, {},
                            {At("report/index.html")});
+  report.arguments.insert(report.arguments.end(), options_.report_args.begin(), options_.report_args.end());
   if (!options_.report) {
     report.not_applicable = "--no-report";
   } else {

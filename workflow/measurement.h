@@ -29,6 +29,9 @@ struct MeasurementOptions {
   bool report = true;             // the HTML report (--no-report)
   bool force = false;             // re-run every stage (--force)
   std::string stop_after;         // the last stage to run ("": all of them) (--stop-after)
+  // Extra arguments appended to a stage's command line as given (--derender-args, --check-args,
+  // --reconstruct-args, --report-args, and run's named pass-through options); part of the stage's stamp.
+  std::vector<std::string> derender_args, check_args, reconstruct_args, report_args;
 
   // The messages name the flag: "--stride must be at least 1".
   bool Check(std::string* why) const;

@@ -11,10 +11,13 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "core/brdf_coords.h"
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
@@ -22,8 +25,10 @@
 #include "core/session.h"
 #include "derender/derenderer.h"
 #include "reconstruct/consistency.h"
+#include "reconstruct/merl_table.h"
 #include "reconstruct/reconstruction_stage.h"
 #include "reconstruct/truth_comparison.h"
+#include "report/table_interpolation.h"
 #include "tests/scratch_dir.h"
 #include "tests/test_util.h"
 
@@ -108,10 +113,39 @@ TEST_F(ReportTest, WritesEveryFigureAndTheHtmlShowsThemInHeadlessChromium) {
   const nlohmann::json data = ReadJsonFile(folder + "/report-data.json");
   EXPECT_EQ(data.at("photo").at("index"), report.photo);
   EXPECT_EQ(data.at("incidence_plane").size(), 4u);
-  EXPECT_EQ(data.at("incidence_plane")[0].at("angle_deg").size(), data.at("incidence_plane")[0].at("truth").size());
-  for (const char* figure : {"coverage.png", "incidence-plane.png", "reciprocity.png", "isotropy.png", "timings.png",
-                             "truth-bands.png", "photo.png", "render.png", "render-truth.png"}) {
+  EXPECT_EQ(data.at("incidence_plane")[0].at("centre_abscissa_deg").size(),
+            data.at("incidence_plane")[0].at("centre").at("truth").size());
+  // The title is the session's name here (no recipe; not a generator's default "synth...").
+  EXPECT_EQ(data.at("title"), "s");
+  for (const char* figure :
+       {"coverage.png", "incidence-plane.png", "reciprocity-curves.png", "timings.png", "truth-bands.png", "photo.png",
+        "photo-render-reconstruction.png", "photo-render-truth.png", "photo-difference.png",
+        "sphere-reconstruction.png", "sphere-truth.png", "explorer.html"}) {
     EXPECT_TRUE(fs::exists(folder + "/" + figure)) << figure;
+  }
+  // A consistency figure is drawn where it is valid, and said invalid where it is not.
+  const nlohmann::json consistency = ReadJsonFile(dir_ / "run/consistency.json");
+  for (const char* figure : {"reciprocity", "bilateral_symmetry"}) {
+    const bool valid = consistency.at(figure).at("valid");
+    EXPECT_EQ(fs::exists(folder + "/" + figure + ".png"), valid) << figure;
+    if (!valid) {
+      EXPECT_NE(Slurp(folder + "/index.html").find("invalid: no bin had"), std::string::npos);
+    }
+  }
+  // The reconstruction rendered at the photo's own pixels matches the photo (the truth exactly, up to
+  // the camera noise of the samples).
+  for (const nlohmann::json& render : data.at("photo").at("renders")) {
+    const double limit = render.at("model") == "truth" ? 0.03 : 0.05;
+    EXPECT_LT(render.at("median_abs_difference").get<double>(), limit) << render.dump();
+  }
+  // The incidence-plane curves pass through the samples' band: the median of sample / reconstruction
+  // at the samples' own directions is within 2 %.
+  ASSERT_EQ(report.bands.size(), 4u);
+  for (const BandAgreement& band : report.bands) {
+    for (int c = 0; c < 3; ++c) {
+      if (band.samples < 50) continue;
+      EXPECT_NEAR(band.ratio[c], 1.0, 0.02) << band.theta0_deg << " deg, channel " << c;
+    }
   }
   const std::string html = Slurp(folder + "/index.html");
   // Self-contained: every image is embedded, none is fetched from a path.
@@ -164,9 +198,104 @@ TEST(ReportStage, OptionsCheckNamesTheRenderSize) {
   std::string why;
   EXPECT_TRUE(ReportOptions().Check(&why)) << why;
   ReportOptions options;
-  options.render_size = 8;
+  options.render_size_px = 8;
   EXPECT_FALSE(options.Check(&why));
-  EXPECT_NE(why.find("render_size"), std::string::npos) << why;
+  EXPECT_NE(why.find("render_size_px"), std::string::npos) << why;
+  ReportOptions angles;
+  angles.angles_deg = {30, 89};
+  EXPECT_FALSE(angles.Check(&why));
+  EXPECT_NE(why.find("angles_deg"), std::string::npos) << why;
+}
+
+// `report` finds the reconstruction it is given, wherever it is, and says so when it is missing.
+TEST_F(ReportTest, FindsTheReconstructionItIsGiven) {
+  ASSERT_NO_FATAL_FAILURE(MakeRunFolder());
+  fs::rename(dir_ / "run/reconstruction", dir_ / "elsewhere");
+  // A run of a recipe (run-input.json, written by `ibrdf run` before any stage) is titled by its name.
+  WriteJsonFile(dir_ / "run/run-input.json", {{"input", std::string(IBRDF_SAMPLES_DIR) + "/squash"}});
+  ReportOptions options;
+  options.reconstruction = dir_ / "elsewhere";
+  options.explorer = false;
+  options.angles_deg = {20, 40};
+  const ReportResult report = WriteReport(dir_ / "run", options);
+  EXPECT_TRUE(report.reconstruction);
+  EXPECT_EQ(report.reconstruction_path, dir_ / "elsewhere/brdf.binary");
+  const nlohmann::json data = ReadJsonFile(dir_ / "run/report/report-data.json");
+  EXPECT_EQ(data.at("reconstruction"), dir_ / "elsewhere/brdf.binary");
+  EXPECT_EQ(data.at("title"), "squash");
+  EXPECT_EQ(data.at("incidence_plane").size(), 2u);
+  EXPECT_EQ(data.at("incidence_plane")[1].at("theta0_deg"), 40.0);
+  options.reconstruction = dir_ / "nowhere";
+  options.overwrite = true;
+  std::string message;
+  try {
+    WriteReport(dir_ / "run", options);
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find(dir_ / "nowhere"), std::string::npos) << message;
+}
+
+// The explorer driven in headless Chromium: the incidence slider (set from the URL fragment, the page's
+// test hook) changes the plotted curve, and the curve drawn matches the table at both angles.
+TEST_F(ReportTest, ExplorerSliderChangesTheCurveAsTheTableSays) {
+  ASSERT_NO_FATAL_FAILURE(MakeRunFolder());
+  ReportOptions options;
+  const ReportResult report = WriteReport(dir_ / "run", options);
+  ASSERT_TRUE(report.success);
+  const std::string html = Slurp(report.explorer_html);
+  EXPECT_EQ(html.find("http://"), std::string::npos);  // offline: nothing fetched
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  const std::string chromium = Chromium();
+  if (chromium.empty())
+    GTEST_SKIP() << "chromium is not installed (scripts/install-deps installs it): explorer check skipped";
+  const MerlTable table = ReadMerl(dir_ / "run/reconstruction/brdf.binary");
+  std::vector<double> first;
+  for (const int theta : {15, 45}) {
+    const std::string dom = Capture(chromium +
+                                    " --headless --disable-gpu --no-sandbox --virtual-time-budget=10000 "
+                                    "--user-data-dir=" +
+                                    dir_ / "chromium" + " --dump-dom 'file://" + report.explorer_html +
+                                    "#theta_i=" + std::to_string(theta) + "&phi=0&channel=1' 2>/dev/null");
+    std::smatch match;
+    ASSERT_TRUE(std::regex_search(dom, match, std::regex("<pre id=\"ibrdf-test\"[^>]*>([^<]*)</pre>")))
+        << "no test output; DOM (first 500 characters): " << dom.substr(0, 500);
+    std::string text = match[1];
+    for (const auto& [from, to] : {std::pair<std::string, std::string>{"&quot;", "\""}, {"&amp;", "&"}}) {
+      for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at))
+        text.replace(at, from.size(), to);
+    }
+    const nlohmann::json drawn = nlohmann::json::parse(text);
+    EXPECT_EQ(drawn.at("theta_i"), theta);
+    const nlohmann::json& values = drawn.at("curves").at("reconstruction").at("values");
+    ASSERT_EQ(values.size(), 179u);
+    std::vector<double> curve;
+    int compared = 0;
+    for (int k = 0; k < 179; ++k) {
+      const int x = -89 + k;
+      const Eigen::Vector3d wi = FromSpherical(theta * M_PI / 180.0, 0.0);
+      const Eigen::Vector3d wo = FromSpherical(std::abs(x) * M_PI / 180.0, x >= 0 ? 0.0 : M_PI);
+      const Eigen::Vector3d expected = InterpolateMerl(table, wi, wo);
+      curve.push_back(values[k].is_null() ? -1.0 : values[k].get<double>());
+      if (expected[1] < 0.0) {
+        EXPECT_TRUE(values[k].is_null()) << x;
+        continue;
+      }
+      ASSERT_FALSE(values[k].is_null()) << x;
+      EXPECT_NEAR(values[k].get<double>(), expected[1], 1e-5 * expected[1] + 1e-7)
+          << "theta_i " << theta << ", x " << x;
+      ++compared;
+    }
+    EXPECT_GT(compared, 100) << theta;
+    EXPECT_GT(drawn.at("samples").get<int>(), 0) << theta;
+    if (first.empty()) {
+      first = curve;
+    } else {
+      double change = 0.0;
+      for (size_t k = 0; k < curve.size(); ++k) change = std::max(change, std::abs(curve[k] - first[k]));
+      EXPECT_GT(change, 0.01) << "moving the slider from 15 to 45 deg did not change the curve";
+    }
+  }
 }
 
 }  // namespace

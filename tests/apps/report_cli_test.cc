@@ -1,0 +1,191 @@
+// The command-line rough edges of `check`, `report` and `run` (issue 16, part 4), each through the tool
+// as a user types it: check's regression line says "invalid" rather than "0.00 % over 0 pairs"; help
+// texts without CLI11's "{false}"; unit-suffixed option names with the old names as aliases; `report`
+// finds the reconstruction it is given; a report titled from the run rather than "synth"; `run`
+// refuses a folder holding another input's run unless --overwrite; `run` passes stage options through.
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/sample_file.h"
+#include "reconstruct/consistency.h"
+#include "reconstruct/prediction_check.h"
+#include "tests/run_ibrdf.h"
+#include "tests/scratch_dir.h"
+
+namespace fs = std::filesystem;
+
+namespace ibrdf {
+namespace {
+
+using testing::RunIbrdf;
+using testing::RunResult;
+using testing::ScratchDir;
+
+const std::string kSynth = std::string("synth --material ") + IBRDF_SAMPLES_DIR +
+                           "/materials/bluepaint.json --width 160 --height 120 --photos 6 --out ";
+
+nlohmann::json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return nlohmann::json::parse(text.str());
+}
+
+TEST(ReportCli, RegressionLineSaysInvalidNotZeroPercent) {
+  const PredictionReport empty;  // no pairs, no held-out photos: every figure invalid
+  const std::string line = RegressionSummary(empty);
+  EXPECT_NE(line.find("reciprocity near the incidence plane invalid"), std::string::npos) << line;
+  EXPECT_NE(line.find("bilateral symmetry invalid"), std::string::npos) << line;
+  EXPECT_EQ(line.find("0.00 %"), std::string::npos) << line;
+  EXPECT_EQ(line.find("over 0 pairs"), std::string::npos) << line;
+}
+
+TEST(ReportCli, HelpTextsHaveNoDefaultBracesOnFlags) {
+  for (const char* command : {"check", "report", "run"}) {
+    const RunResult help = RunIbrdf(std::string(command) + " --help");
+    EXPECT_EQ(help.exit_code, 0) << command;
+    EXPECT_EQ(help.output.find("{false}"), std::string::npos) << command << ":\n" << help.output;
+    EXPECT_EQ(help.output.find("{true}"), std::string::npos) << command << ":\n" << help.output;
+  }
+  const RunResult report = RunIbrdf("report --help");
+  for (const char* name : {"--render-size-px", "--angles-deg", "--reconstruction", "--title"}) {
+    EXPECT_NE(report.output.find(name), std::string::npos) << name;
+  }
+  const RunResult check = RunIbrdf("check --help");
+  EXPECT_NE(check.output.find("--min-pairs"), std::string::npos);
+  EXPECT_EQ(check.output.find("isotropy"), std::string::npos) << "one name: bilateral symmetry";
+}
+
+class RunFolderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_EQ(RunIbrdf(kSynth + dir_ / "a").exit_code, 0);
+    ASSERT_EQ(RunIbrdf(kSynth + dir_ / "b" + " --seed 2").exit_code, 0);
+  }
+  ScratchDir dir_;
+};
+
+// A run folder holding another input's run is refused (its results would mix), unless --overwrite.
+TEST_F(RunFolderTest, RunRefusesAnotherInputsFolderUnlessOverwrite) {
+  const std::string out = dir_ / "run";
+  ASSERT_EQ(RunIbrdf("run " + dir_ / "a" + " --out " + out + " --stop-after derender").exit_code, 0);
+  const RunResult refused = RunIbrdf("run " + dir_ / "b" + " --out " + out + " --stop-after derender");
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.output.find(out), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find(dir_ / "a"), std::string::npos) << refused.output;  // names the other input
+  EXPECT_EQ(ReadJson(out + "/run-input.json")["input"], dir_ / "a");                // nothing changed
+  // The same input resumes.
+  EXPECT_EQ(RunIbrdf("run " + dir_ / "a" + " --out " + out + " --stop-after derender").exit_code, 0);
+  const RunResult overwritten = RunIbrdf("run " + dir_ / "b" + " --out " + out + " --stop-after derender --overwrite");
+  ASSERT_EQ(overwritten.exit_code, 0) << overwritten.output;
+  EXPECT_EQ(ReadJson(out + "/run-input.json")["input"], dir_ / "b");
+  EXPECT_EQ(ReadJson(out + "/summary.json")["input"], dir_ / "b");
+  const nlohmann::json sidecar = ReadJson(out + "/samples.npy.json");
+  EXPECT_NE(sidecar["session"].get<std::string>().find(dir_ / "b"), std::string::npos) << sidecar["session"];
+}
+
+// Stage options pass through `run`, named (--lobes, --min-signal ...) or as --STAGE-args strings, into
+// the stage's command line (its stamp).
+TEST_F(RunFolderTest, RunPassesStageOptionsThrough) {
+  const std::string out = dir_ / "run";
+  const RunResult run = RunIbrdf("run " + dir_ / "a" + " --out " + out +
+                                 " --no-report --lobes 1 --min-signal 0.001 --reconstruct-args '--degree 1' "
+                                 "--check-args '--match-deg 0.4'");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  auto has = [](const nlohmann::json& args, const std::string& flag, const std::string& value) {
+    for (size_t i = 0; i + 1 < args.size(); ++i) {
+      if (args[i] == flag && args[i + 1] == value) return true;
+    }
+    return false;
+  };
+  const nlohmann::json reconstruct = ReadJson(out + "/stamps/reconstruct.json")["args"];
+  EXPECT_TRUE(has(reconstruct, "--lobes", "1")) << reconstruct;
+  EXPECT_TRUE(has(reconstruct, "--degree", "1")) << reconstruct;
+  EXPECT_TRUE(has(ReadJson(out + "/stamps/derender.json")["args"], "--min-signal", "0.001"));
+  EXPECT_TRUE(has(ReadJson(out + "/stamps/check.json")["args"], "--match-deg", "0.4"));
+  EXPECT_EQ(ReadJson(out + "/consistency.json")["options"]["match_deg"], 0.4);
+  // A bad pass-through value fails in its stage, naming the flag.
+  const RunResult bad = RunIbrdf("run " + dir_ / "a" + " --out " + out + " --no-report --lobes 7");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("lobes"), std::string::npos) << bad.output;
+}
+
+// `report` on a run whose reconstruction lies elsewhere, with the old option names still accepted, and a
+// title from the session's name (not the generator's "synth").
+TEST_F(RunFolderTest, ReportFindsTheGivenReconstructionAndAcceptsOldNames) {
+  const std::string out = dir_ / "my-measurement";
+  ASSERT_EQ(RunIbrdf("run " + dir_ / "a" + " --out " + out + " --no-report --no-fits").exit_code, 0);
+  fs::rename(out + "/reconstruction", dir_ / "recon");
+  const RunResult report = RunIbrdf("report " + out + " --reconstruction " + dir_ / "recon" +
+                                    " --render-size 32 --angles 20,50 --no-explorer");
+  ASSERT_EQ(report.exit_code, 0) << report.output;
+  const nlohmann::json data = ReadJson(out + "/report/report-data.json");
+  EXPECT_EQ(data["reconstruction"], dir_ / "recon/brdf.binary");
+  EXPECT_EQ(data["title"], "a");  // the session's name (synth names it after its folder)
+  std::ifstream index(out + "/report/index.html");
+  std::stringstream page;
+  page << index.rdbuf();
+  EXPECT_NE(page.str().find("<title>ibrdf report: a</title>"), std::string::npos);
+  EXPECT_EQ(data["incidence_plane"].size(), 2u);
+  EXPECT_FALSE(fs::exists(out + "/report/explorer.html"));
+  const RunResult missing =
+      RunIbrdf("report " + out + " --out " + dir_ / "r2" + " --reconstruction " + dir_ / "nowhere");
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.output.find(dir_ / "nowhere"), std::string::npos) << missing.output;
+  EXPECT_FALSE(fs::exists(dir_ / "r2"));
+  // check: the old --min-samples and the new --min-pairs are the same option.
+  const RunResult check = RunIbrdf("check " + out + "/samples.npy --out " + dir_ / "c.json" + " --min-samples 7");
+  ASSERT_EQ(check.exit_code, 0) << check.output;
+  EXPECT_EQ(ReadJson(dir_ / "c.json")["options"]["min_samples_per_bin"], 7);
+  EXPECT_TRUE(ReadJson(dir_ / "c.json").contains("bilateral_symmetry"));
+}
+
+}  // namespace
+}  // namespace ibrdf
+
+namespace ibrdf {
+namespace {
+
+// The README's demo figures come from a run's summary.json through scripts/readme_figures.py, not typed.
+TEST(ReportCli, ReadmeFiguresAreRegeneratedFromTheRun) {
+  ScratchDir dir;
+  const nlohmann::json summary = {{"samples", {{"accepted", 1234}}},
+                                  {"timings_s", {{"stages_total", 26.04}}},
+                                  {"truth",
+                                   {{"samples_median_rel_error", {0.01, 0.02, 0.03}},
+                                    {"brdf_rel_rmse", {0.004, 0.005, 0.006}},
+                                    {"brdf_cells_scored", 777}}},
+                                  {"consistency", {{"reciprocity", 0.0012}, {"isotropy", 0.0034}}},
+                                  {"report", "/x/report/index.html"}};
+  { std::ofstream(dir / "summary.json") << summary.dump(); }
+  {
+    std::ofstream(dir / "README.md") << "intro\n<!-- readme-figures -->\n```\n1117060 samples; stages took 146.8 "
+                                        "s\n```\n<!-- /readme-figures -->\nrest\n";
+  }
+  const std::string script = std::string(IBRDF_SAMPLES_DIR) + "/../scripts/readme_figures.py";
+  ASSERT_EQ(
+      std::system(
+          ("/usr/bin/python3 " + script + " " + dir.str() + " --update " + dir / "README.md" + " > /dev/null").c_str()),
+      0);
+  std::ifstream in(dir / "README.md");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string readme = text.str();
+  EXPECT_EQ(readme.find("146.8"), std::string::npos) << readme;
+  EXPECT_NE(readme.find("1234 samples; stages took 26.0 s"), std::string::npos) << readme;
+  EXPECT_NE(readme.find("Reciprocity error 0.12 %, bilateral-symmetry error 0.34 %"), std::string::npos) << readme;
+  EXPECT_NE(readme.find("over 777 MERL cells"), std::string::npos) << readme;
+  EXPECT_EQ(readme.rfind("intro\n", 0), 0u);
+  EXPECT_NE(readme.find("-->\nrest\n"), std::string::npos) << readme;
+  // No summary: an error naming it, the README untouched.
+  EXPECT_NE(std::system(("/usr/bin/python3 " + script + " " + dir / "nowhere" + " 2> /dev/null").c_str()), 0);
+}
+
+}  // namespace
+}  // namespace ibrdf
