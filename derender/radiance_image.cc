@@ -166,6 +166,7 @@ RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, doub
   const RadiometrySpec& radiometry = impl.radiometry;
   const size_t m = exposures.size();
   std::vector<Image> images(m);
+  std::vector<double> saturation(m);  // per exposure: float files have none unless the session states one
   std::vector<double> scale(m);  // exposure_s * gain
   for (size_t e = 0; e < m; ++e) {
     const std::string path = ResolvePath(impl.directory, exposures[e].file);
@@ -180,6 +181,7 @@ RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, doub
       ThrowError(path, "expected 1 (grey) or 3+ (RGB) channels, got " + std::to_string(images[e].channels));
     }
     scale[e] = exposures[e].exposure_s * exposures[e].gain;
+    saturation[e] = SaturationLevel(radiometry, images[e]);
   }
   RadianceImage out;
   out.width = impl.width;
@@ -216,7 +218,7 @@ RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, doub
             const double v = values[image.channels == 1 ? 0 : c];
             encoded[3 * e + c] = v;
             finite = finite && std::isfinite(v);
-            saturated = saturated || v >= radiometry.saturation_level;
+            saturated = saturated || v >= saturation[e];
             const double linear = impl.ToLinear(v) - radiometry.black_level;
             darkest = std::min(darkest, linear);
             radiance[3 * e + c] = linear / scale[e] * inverse[c];
