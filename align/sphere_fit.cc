@@ -17,18 +17,26 @@ namespace ibrdf {
 namespace {
 
 // The lit limb along a radial profile (samples `step` pixels apart, outwards): the sharpest drop over
-// one pixel from a lit limb to a dark background, located where the profile crosses the mid level
+// one pixel from a lit limb to a dark background (the outermost such step), located where the profile crosses the mid level
 // between the limb pixel and the first background pixel. Position along the profile in pixels, or -1.
 double LitLimbEdge(const std::vector<double>& profile, double step) {
   const int span = static_cast<int>(1.0 / step);
-  int best = -1;
+  const int windows = static_cast<int>(profile.size()) - span;
+  if (windows < 3) return -1.0;
+  std::vector<double> drops(windows);
   double best_drop = 0.0;
-  for (size_t i = 0; i + span < profile.size(); ++i) {
-    const double drop = profile[i] - profile[i + span];
-    if (drop > best_drop) {
-      best_drop = drop;
-      best = static_cast<int>(i);
-    }
+  for (int i = 0; i < windows; ++i) {
+    drops[i] = profile[i] - profile[i + span];
+    best_drop = std::max(best_drop, drops[i]);
+  }
+  if (!(best_drop > 0.0)) return -1.0;
+  // The outermost local maximum of the drop that is at least a third of the largest: on a limb lit at a
+  // grazing angle the shading falls steeply just inside the edge, and the largest drop over a pixel can
+  // be that fall, a pixel inside the limb (an inward bias on the dim side of the lit limb, which moved
+  // the centre away from the light); the limb's own step to the background is the last one.
+  int best = -1;
+  for (int i = 1; i + 1 < windows; ++i) {
+    if (drops[i] >= drops[i - 1] && drops[i] >= drops[i + 1] && drops[i] >= best_drop / 3.0) best = i;
   }
   const int guard = static_cast<int>(2.0 / step);
   if (best < guard || best + span + guard >= static_cast<int>(profile.size())) return -1.0;
@@ -43,7 +51,7 @@ double LitLimbEdge(const std::vector<double>& profile, double step) {
   // Sub-pixel: the crossing of the mid level between the two ends of the steepest drop (the limb
   // pixel and the first background pixel); the level further inside may differ from the limb's.
   const double mid = 0.5 * (profile[best] + profile[best + span]);
-  for (int i = best - guard; i < best + span + guard; ++i) {
+  for (int i = best; i < best + span + guard; ++i) {
     if (profile[i] >= mid && profile[i + 1] < mid)
       return step * (i + (profile[i] - mid) / (profile[i] - profile[i + 1]));
   }
@@ -125,15 +133,16 @@ void DescribeUncertainty(const std::vector<TangentRay>& rays, const std::vector<
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(fit->covariance.topLeftCorner<3, 3>());
   fit->drift_direction = eigen.eigenvectors().col(2);
   if (fit->drift_direction.dot(mean) > 0.0) fit->drift_direction = -fit->drift_direction;
-  fit->one_sided = !fit->radius_fixed && !(fit->radius_amplification <= options.max_radius_amplification);
+  fit->one_sided = !fit->radius_fixed && (!(fit->limb_balance <= options.max_limb_balance) ||
+                                          !(fit->radius_amplification <= options.max_radius_amplification));
   if (fit->one_sided) {
     char buffer[512];
     std::snprintf(buffer, sizeof(buffer),
-                  "one-sided limb evidence: the silhouette points cover one side of the sphere (balance %.2f), "
-                  "so its centre and radius trade off (radius %.1fx worse determined than from both limbs, "
-                  "sigma %.3f mm; centre sigma %.3f mm along (%.2f, %.2f, %.2f)); state the known radius "
-                  "(sample.radius with \"radius_known\": true) or show the unlit limb against a brighter "
-                  "background",
+                  "one-sided limb evidence: the silhouette points cover one side of the sphere (balance %.2f; "
+                  "0 is all round), so a bias of the lit limb moves its centre and radius together, unseen "
+                  "by the noise figures (radius %.1fx worse determined than from both limbs, sigma %.3f mm; "
+                  "centre sigma %.3f mm along (%.2f, %.2f, %.2f)); state the known radius (sample.radius with "
+                  "\"radius_known\": true) or show the unlit limb against a brighter background",
                   fit->limb_balance, fit->radius_amplification, 1e3 * std::sqrt(fit->covariance(3, 3)),
                   1e3 * std::sqrt(eigen.eigenvalues()(2)), fit->drift_direction.x(), fit->drift_direction.y(),
                   fit->drift_direction.z());
@@ -152,6 +161,7 @@ bool SphereFitOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GT(outlier_rms_factor, 0.0);
   IBRDF_CHECK_OPTION_GE(min_points, 4);
   IBRDF_CHECK_OPTION_GT(tolerance, 0.0);
+  IBRDF_CHECK_OPTION_GT(max_limb_balance, 0.0);
   IBRDF_CHECK_OPTION_GE(max_radius_amplification, 1.0);
   return true;
 }

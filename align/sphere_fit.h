@@ -35,9 +35,13 @@ struct SphereFitOptions {
   int min_points = 8;                 // fewer tangent rays: no fit (the sphere stays as given)
   double tolerance = 1e-15;           // Ceres function and parameter tolerance
   bool fix_radius = false;            // keep the start radius (a known radius): fit only the centre
-  // Warn (SphereFit::warning) when the radius is fitted and its amplification exceeds this: limb points
-  // all around the sphere give 1, a uniformly covered hemisphere 2; beyond 3 the centre and radius
-  // trade off so much that a small bias of the lit limb moves both by many times the noise.
+  // Warn (SphereFit::warning) when the radius is fitted from one-sided limb evidence: a limb balance
+  // over max_limb_balance (0 all around, 0.5 a uniformly covered hemisphere: the lit limb alone on a
+  // black background), where a bias of the lit limb that varies with its brightness (blur, the soft
+  // terminator) moves the centre towards the light with nothing on the other side to hold it; or a
+  // radius amplification over max_radius_amplification (1 all around, 2 a uniform hemisphere), where
+  // the noise alone trades centre against radius.
+  double max_limb_balance = 0.3;
   double max_radius_amplification = 3.0;
   bool Check(std::string* why) const;
 };

@@ -202,10 +202,13 @@ bool TargetSheetsOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GE(dpi, 72.0);
   IBRDF_CHECK_OPTION_LE(dpi, 2400.0);
   IBRDF_CHECK_OPTION_GT(scale_bar, 0.0);
-  // The cards on the ring must not overlap, and the ring's cards must lie on the platform.
+  // Neighbouring cards on the ring must not overlap (centres further apart than a card's side), and
+  // every card must lie on the platform.
   const double card = marker_size * (1.0 + 2.0 * card_margin);
-  IBRDF_CHECK_OPTION_GT(2.0 * ring_radius * std::sin(M_PI / ring_count), card * std::sqrt(2.0));
-  IBRDF_CHECK_OPTION_GE(platform_radius, ring_radius + card / std::sqrt(2.0));
+  const double card_spacing = 2.0 * ring_radius * std::sin(M_PI / ring_count);
+  const double card_reach = ring_radius + card / std::sqrt(2.0);
+  IBRDF_CHECK_OPTION_GT(card_spacing, card);
+  IBRDF_CHECK_OPTION_GE(platform_radius, card_reach);
   return true;
 }
 

@@ -8,10 +8,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <memory>
 
 #include <OpenImageIO/imageio.h>
-#include <OpenImageIO/tiffutils.h>
 
 #include "core/error.h"
 #include "core/file_util.h"
@@ -50,7 +50,11 @@ std::unique_ptr<OIIO::ImageInput> Open(const std::string& path) {
 std::optional<double> Number(const OIIO::ImageSpec& spec, const char* name) {
   const OIIO::ParamValue* p = spec.find_attribute(name);
   if (!p || p->type().basetype == OIIO::TypeDesc::STRING) return std::nullopt;
-  const double value = p->get_float();
+  // OpenImageIO 2.4 converts integers only through get_int_attribute (get_float_attribute and
+  // ParamValue::get_float miss an EXR header's int).
+  const double value = p->type().is_floating_point()
+                           ? double(spec.get_float_attribute(name, std::numeric_limits<float>::quiet_NaN()))
+                           : double(spec.get_int_attribute(name, -1));
   if (!std::isfinite(value) || value <= 0.0) return std::nullopt;
   return value;
 }
@@ -97,15 +101,101 @@ void AppendBigEndian(uint32_t value, std::string* out) {
   for (int shift = 24; shift >= 0; shift -= 8) out->push_back(static_cast<char>((value >> shift) & 0xff));
 }
 
+// The best rational approximation of `value` > 0 with numerator and denominator below 2^31
+// (continued fractions): 1/125 stays 1/125, as a camera writes it.
+std::pair<uint32_t, uint32_t> Rational(double value) {
+  const double limit = 2147483647.0;
+  double h0 = 0, h1 = 1, k0 = 1, k1 = 0, x = value;
+  for (int i = 0; i < 40; ++i) {
+    const double a = std::floor(x);
+    const double h2 = a * h1 + h0, k2 = a * k1 + k0;
+    if (h2 > limit || k2 > limit) break;
+    h0 = h1;
+    h1 = h2;
+    k0 = k1;
+    k1 = k2;
+    if (std::abs(h1 / k1 - value) <= 1e-15 * value || x - a < 1e-12) break;
+    x = 1.0 / (x - a);
+  }
+  if (k1 == 0) return {static_cast<uint32_t>(limit), 1};
+  return {static_cast<uint32_t>(h1), static_cast<uint32_t>(k1)};
+}
+
+// A little-endian TIFF structure holding the EXIF fields of `metadata` (IFD0: Make, Model, DateTime and
+// the Exif IFD pointer; the Exif IFD: exposure, f-number, ISO, original time, focal length and the focal
+// plane resolution). OpenImageIO 2.4's own encoder turns some exposure times into infinity (0.5 s) and
+// others into approximations (0.01 s as 0.009999), so ibrdf writes the rationals itself.
+std::string EncodeExif(const PhotoMetadata& m) {
+  struct Entry {
+    uint16_t tag, type;
+    uint32_t count;
+    std::string data;  // the value's bytes, little-endian
+  };
+  auto u16 = [](uint32_t v) { return std::string{char(v & 0xff), char((v >> 8) & 0xff)}; };
+  auto u32 = [](uint32_t v) {
+    return std::string{char(v & 0xff), char((v >> 8) & 0xff), char((v >> 16) & 0xff), char((v >> 24) & 0xff)};
+  };
+  auto ascii = [](uint16_t tag, const std::string& text) { return Entry{tag, 2, uint32_t(text.size() + 1), text + '\0'}; };
+  auto rational = [&](uint16_t tag, double value) {
+    const auto [num, den] = Rational(value);
+    return Entry{tag, 5, 1, u32(num) + u32(den)};
+  };
+  auto short_value = [&](uint16_t tag, double value) {
+    return Entry{tag, 3, 1, u16(static_cast<uint32_t>(std::clamp(std::lround(value), 0L, 65535L)))};
+  };
+  std::vector<Entry> ifd0, exif;
+  if (!m.make.empty()) ifd0.push_back(ascii(0x010F, m.make));
+  if (!m.model.empty()) ifd0.push_back(ascii(0x0110, m.model));
+  if (!m.date_time.empty()) ifd0.push_back(ascii(0x0132, m.date_time));
+  if (m.exposure_s) exif.push_back(rational(0x829A, *m.exposure_s));
+  if (m.f_number) exif.push_back(rational(0x829D, *m.f_number));
+  if (m.iso) exif.push_back(short_value(0x8827, *m.iso));
+  exif.push_back(Entry{0x9000, 7, 4, "0230"});  // ExifVersion
+  if (!m.date_time.empty()) exif.push_back(ascii(0x9003, m.date_time));
+  if (m.focal_length_mm) exif.push_back(rational(0x920A, *m.focal_length_mm));
+  if (m.pixels_per_mm) {
+    exif.push_back(rational(0xA20E, 10.0 * *m.pixels_per_mm));  // per centimetre (unit 3)
+    exif.push_back(rational(0xA20F, 10.0 * *m.pixels_per_mm));
+    exif.push_back(short_value(0xA210, 3));
+  }
+  if (m.focal_length_35mm) exif.push_back(short_value(0xA405, *m.focal_length_35mm));
+  // Layout: header (8), IFD0, its values, the Exif IFD, its values. The pointer's value is known once
+  // IFD0's size is.
+  auto ifd_size = [](const std::vector<Entry>& entries) {
+    size_t size = 2 + 12 * entries.size() + 4;
+    for (const Entry& e : entries) size += e.data.size() > 4 ? e.data.size() + (e.data.size() & 1) : 0;
+    return size;
+  };
+  ifd0.push_back(Entry{0x8769, 4, 1, u32(0)});
+  const uint32_t exif_offset = static_cast<uint32_t>(8 + ifd_size(ifd0));
+  ifd0.back().data = u32(exif_offset);
+  auto write_ifd = [&](const std::vector<Entry>& entries, uint32_t offset, std::string* out) {
+    uint32_t values = offset + 2 + 12 * static_cast<uint32_t>(entries.size()) + 4;
+    std::string table = u16(static_cast<uint32_t>(entries.size())), blobs;
+    for (const Entry& e : entries) {
+      table += u16(e.tag) + u16(e.type) + u32(e.count);
+      if (e.data.size() <= 4) {
+        table += e.data + std::string(4 - e.data.size(), '\0');
+      } else {
+        table += u32(values);
+        std::string data = e.data;
+        if (data.size() & 1) data.push_back('\0');
+        blobs += data;
+        values += static_cast<uint32_t>(data.size());
+      }
+    }
+    *out += table + u32(0) + blobs;
+  };
+  std::string tiff = std::string("II*\0", 4) + u32(8);
+  write_ifd(ifd0, 8, &tiff);
+  write_ifd(exif, exif_offset, &tiff);
+  return tiff;
+}
+
 // OpenImageIO 2.4 writes no EXIF into PNG files but reads the eXIf chunk (PNG 1.5): insert one, with
-// the EXIF block OpenImageIO encodes, after the IHDR chunk of the PNG file `path`.
+// EncodeExif's block, after the IHDR chunk of the PNG file `path`.
 void InsertPngExif(const std::string& path, const PhotoMetadata& metadata) {
-  OIIO::ImageSpec spec;
-  SetMetadata(metadata, &spec);
-  std::vector<char> exif;
-  OIIO::encode_exif(spec, exif);
-  // encode_exif may prefix JPEG's "Exif\0\0"; the PNG chunk holds the TIFF structure only.
-  if (exif.size() >= 6 && std::string(exif.data(), 4) == "Exif") exif.erase(exif.begin(), exif.begin() + 6);
+  const std::string exif = EncodeExif(metadata);
   std::string png;
   {
     std::ifstream in(path, std::ios::binary);
