@@ -17,26 +17,18 @@ namespace ibrdf {
 namespace {
 
 // The lit limb along a radial profile (samples `step` pixels apart, outwards): the sharpest drop over
-// one pixel from a lit limb to a dark background (the outermost such step), located where the profile crosses the mid level
+// one pixel from a lit limb to a dark background, located where the profile crosses the mid level
 // between the limb pixel and the first background pixel. Position along the profile in pixels, or -1.
 double LitLimbEdge(const std::vector<double>& profile, double step) {
   const int span = static_cast<int>(1.0 / step);
-  const int windows = static_cast<int>(profile.size()) - span;
-  if (windows < 3) return -1.0;
-  std::vector<double> drops(windows);
-  double best_drop = 0.0;
-  for (int i = 0; i < windows; ++i) {
-    drops[i] = profile[i] - profile[i + span];
-    best_drop = std::max(best_drop, drops[i]);
-  }
-  if (!(best_drop > 0.0)) return -1.0;
-  // The outermost local maximum of the drop that is at least a third of the largest: on a limb lit at a
-  // grazing angle the shading falls steeply just inside the edge, and the largest drop over a pixel can
-  // be that fall, a pixel inside the limb (an inward bias on the dim side of the lit limb, which moved
-  // the centre away from the light); the limb's own step to the background is the last one.
   int best = -1;
-  for (int i = 1; i + 1 < windows; ++i) {
-    if (drops[i] >= drops[i - 1] && drops[i] >= drops[i + 1] && drops[i] >= best_drop / 3.0) best = i;
+  double best_drop = 0.0;
+  for (size_t i = 0; i + span < profile.size(); ++i) {
+    const double drop = profile[i] - profile[i + span];
+    if (drop > best_drop) {
+      best_drop = drop;
+      best = static_cast<int>(i);
+    }
   }
   const int guard = static_cast<int>(2.0 / step);
   if (best < guard || best + span + guard >= static_cast<int>(profile.size())) return -1.0;
@@ -51,7 +43,7 @@ double LitLimbEdge(const std::vector<double>& profile, double step) {
   // Sub-pixel: the crossing of the mid level between the two ends of the steepest drop (the limb
   // pixel and the first background pixel); the level further inside may differ from the limb's.
   const double mid = 0.5 * (profile[best] + profile[best + span]);
-  for (int i = best; i < best + span + guard; ++i) {
+  for (int i = best - guard; i < best + span + guard; ++i) {
     if (profile[i] >= mid && profile[i + 1] < mid)
       return step * (i + (profile[i] - mid) / (profile[i] - profile[i + 1]));
   }

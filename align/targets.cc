@@ -77,7 +77,12 @@ void DrawMarker(const MarkerDictionary& dictionary, int id, double cx, double cy
       col = end;
     }
   }
-  sheet->Text(cx - 0.5 * card, cy + 0.5 * card + 4.0, 3.0, "id " + std::to_string(id));
+  // The id in the card's bottom margin (black on white, whatever the card lies on).
+  const double margin_mm = 0.5 * (card - side_mm);
+  if (margin_mm >= 2.0) {
+    sheet->Text(cx - 0.5 * side_mm, cy + 0.5 * side_mm + 0.8 * margin_mm, std::min(3.0, 0.6 * margin_mm),
+                "id " + std::to_string(id));
+  }
 }
 
 // A scale bar of `length_mm` with 10 mm ticks, its left end at (x, y), labelled.
@@ -309,7 +314,7 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
     Sheet sheet;
     sheet.name = "platform";
     sheet.width_mm = std::max(2.0 * r_mm + 20.0, 150.0);
-    sheet.height_mm = 2.0 * r_mm + 55.0;
+    sheet.height_mm = 2.0 * r_mm + 60.0;
     const double cx = 0.5 * sheet.width_mm, cy = 10.0 + r_mm;
     sheet.Disc(cx, cy, r_mm, true);
     for (const TargetSpec& target : result.targets.reference) {
@@ -323,10 +328,9 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
     DrawScaleBar(10.0, text_y, 1e3 * options.scale_bar, &sheet);
     sheet.Text(10.0, text_y + 14.0, 3.5,
                options.dictionary + " markers " + Mm(1e3 * options.marker_size) + " (border included), centres " +
-                   Mm(1e3 * options.ring_radius) + " from the cross; platform " + Mm(2e3 * options.platform_radius) +
-                   " across");
-    sheet.Text(10.0, text_y + 20.0, 3.5,
-               "world frame: origin at the cross, x right, y up this sheet, z up from the paper; sample on the cross");
+                   Mm(1e3 * options.ring_radius) + " from the cross");
+    sheet.Text(10.0, text_y + 20.0, 3.5, "platform " + Mm(2e3 * options.platform_radius) + " across; sample on the cross");
+    sheet.Text(10.0, text_y + 26.0, 3.5, "world frame: origin at the cross, x right, y up this sheet, z up");
     emit(sheet);
     readme << "platform.svg/.png: lay it flat under the sample, the sample on the white cross at its centre. The\n"
            << "  black disc keeps the sphere's silhouette against black; keep it matte and free of dust.\n"

@@ -45,6 +45,7 @@ class LightSideSphere : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new std::string(
         (std::filesystem::temp_directory_path() / ("ibrdf-LightSideSphere-" + std::to_string(::getpid()))).string());
+    std::filesystem::create_directories(*dir_);
     const LambertianBrdf material(Eigen::Vector3d(0.6, 0.5, 0.4));
     truth_ = new Session(Session::Load(MakeSession(*dir_ + "/s", LightSideOptions(), material)));
   }
