@@ -329,7 +329,8 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
     sheet.Text(10.0, text_y + 14.0, 3.5,
                options.dictionary + " markers " + Mm(1e3 * options.marker_size) + " (border included), centres " +
                    Mm(1e3 * options.ring_radius) + " from the cross");
-    sheet.Text(10.0, text_y + 20.0, 3.5, "platform " + Mm(2e3 * options.platform_radius) + " across; sample on the cross");
+    sheet.Text(10.0, text_y + 20.0, 3.5,
+               "platform " + Mm(2e3 * options.platform_radius) + " across; sample on the cross");
     sheet.Text(10.0, text_y + 26.0, 3.5, "world frame: origin at the cross, x right, y up this sheet, z up");
     emit(sheet);
     readme << "platform.svg/.png: lay it flat under the sample, the sample on the white cross at its centre. The\n"

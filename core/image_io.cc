@@ -135,7 +135,9 @@ std::string EncodeExif(const PhotoMetadata& m) {
   auto u32 = [](uint32_t v) {
     return std::string{char(v & 0xff), char((v >> 8) & 0xff), char((v >> 16) & 0xff), char((v >> 24) & 0xff)};
   };
-  auto ascii = [](uint16_t tag, const std::string& text) { return Entry{tag, 2, uint32_t(text.size() + 1), text + '\0'}; };
+  auto ascii = [](uint16_t tag, const std::string& text) {
+    return Entry{tag, 2, uint32_t(text.size() + 1), text + '\0'};
+  };
   auto rational = [&](uint16_t tag, double value) {
     const auto [num, den] = Rational(value);
     return Entry{tag, 5, 1, u32(num) + u32(den)};
@@ -224,7 +226,8 @@ PhotoMetadata ReadPhotoMetadata(const std::string& path) {
   metadata.channels = spec.nchannels;
   metadata.raw = IsRawExtension(path);
   metadata.floating_point = spec.format.is_floating_point() && !metadata.raw;
-  metadata.bits = metadata.floating_point ? 0 : spec.get_int_attribute("oiio:BitsPerSample", int(spec.format.size() * 8));
+  metadata.bits =
+      metadata.floating_point ? 0 : spec.get_int_attribute("oiio:BitsPerSample", int(spec.format.size() * 8));
   metadata.exposure_s = Number(spec, "ExposureTime");
   metadata.f_number = Number(spec, "FNumber");
   metadata.iso = Number(spec, "Exif:PhotographicSensitivity");

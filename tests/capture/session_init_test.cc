@@ -48,8 +48,8 @@ std::string TargetsFile(const ScratchDir& dir) {
   nlohmann::json reference = nlohmann::json::array();
   for (int id = 0; id < 4; ++id) {
     const double x = 0.1 * (id % 2 ? 1 : -1), y = 0.1 * (id / 2 ? 1 : -1), h = 0.014;
-    reference.push_back({{"id", id},
-                         {"corners", {{x - h, y + h, 0}, {x + h, y + h, 0}, {x + h, y - h, 0}, {x - h, y - h, 0}}}});
+    reference.push_back(
+        {{"id", id}, {"corners", {{x - h, y + h, 0}, {x + h, y + h, 0}, {x + h, y - h, 0}, {x - h, y - h, 0}}}});
   }
   const nlohmann::json targets = {
       {"targets",
@@ -78,8 +78,8 @@ TEST(SessionInit, GroupsBurstsIntoBrackets) {
   int second = 0;
   for (int pose = 0; pose < 3; ++pose) {
     for (int k = 0; k < 3; ++k) {
-      options.photos.push_back(Photo(dir, "b" + std::to_string(pose) + std::to_string(k) + ".png",
-                                     0.1 / (1 << (2 * k)), 100, second));
+      options.photos.push_back(
+          Photo(dir, "b" + std::to_string(pose) + std::to_string(k) + ".png", 0.1 / (1 << (2 * k)), 100, second));
       second += 1;
     }
     second += 9;
