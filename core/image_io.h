@@ -46,18 +46,18 @@ ImageSpec ReadImageSpec(const std::string& path);
 // What a camera writes into a photo's metadata (EXIF), as OpenImageIO reads it. Absent fields are
 // those the file does not carry.
 struct PhotoMetadata {
-  std::optional<double> exposure_s;         // EXIF ExposureTime, seconds
-  std::optional<double> iso;                // EXIF PhotographicSensitivity (ISOSpeedRatings)
-  std::optional<double> f_number;           // EXIF FNumber
-  std::optional<double> focal_length_mm;    // EXIF FocalLength
-  std::optional<double> focal_length_35mm;  // EXIF FocalLengthIn35mmFilm, millimetres
-  std::optional<double> pixels_per_mm;      // EXIF FocalPlaneXResolution in its unit, as pixels per mm
-  std::string make, model;                  // EXIF Make, Model (empty when absent)
-  std::string date_time;                    // EXIF DateTimeOriginal or DateTime, "YYYY:MM:DD HH:MM:SS"
-  int width = 0, height = 0, channels = 0;  // the decoded image's size
-  bool floating_point = false;              // float or half pixels (EXR, float TIFF)
-  int bits = 0;                             // bits per stored sample (0 when floating point)
-  bool raw = false;                         // a camera RAW file (decoded through LibRaw)
+  std::optional<double> exposure_s;          // EXIF ExposureTime, seconds
+  std::optional<double> iso;                 // EXIF PhotographicSensitivity (ISOSpeedRatings)
+  std::optional<double> f_number;            // EXIF FNumber
+  std::optional<double> focal_length_mm;     // EXIF FocalLength
+  std::optional<double> focal_length_35mm;   // EXIF FocalLengthIn35mmFilm, millimetres
+  std::optional<double> pixels_per_mm;       // EXIF FocalPlaneXResolution in its unit, as pixels per mm
+  std::string make, model;                   // EXIF Make, Model (empty when absent)
+  std::string date_time;                     // EXIF DateTimeOriginal or DateTime, "YYYY:MM:DD HH:MM:SS"
+  int width = 0, height = 0, channels = 0;   // the decoded image's size
+  bool floating_point = false;               // float or half pixels (EXR, float TIFF)
+  int bits = 0;                              // bits per stored sample (0 when floating point)
+  bool raw = false;                          // a camera RAW file (decoded through LibRaw)
 };
 
 // Reads the header and metadata without decoding the pixels. Throws Error naming the file.
