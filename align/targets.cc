@@ -200,7 +200,7 @@ bool TargetSheetsOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GT(ring_radius, 0.0);
   IBRDF_CHECK_OPTION_GE(card_margin, 0.0);
   IBRDF_CHECK_OPTION_GE(light_marker_count, 0);
-  IBRDF_CHECK_OPTION_GE(light_marker_first_id, ring_count);
+  IBRDF_CHECK_OPTION(light_marker_count == 0 || light_marker_first_id >= ring_count);
   IBRDF_CHECK_OPTION_GT(light_marker_size, 0.0);
   IBRDF_CHECK_OPTION_GT(light_drop, 0.5 * light_marker_size * (1.0 + 2.0 * card_margin));
   IBRDF_CHECK_OPTION_GE(light_offset, 0.0);

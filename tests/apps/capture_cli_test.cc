@@ -89,10 +89,13 @@ TEST(CaptureCli, SessionInitFromSyntheticPhotos) {
   EXPECT_NE(draft.output.find("missing: the light's position"), std::string::npos) << draft.output;
   EXPECT_TRUE(fs::exists(dir / "init/session.draft.json"));
   EXPECT_FALSE(fs::exists(dir / "init/session.json"));
-  // Given the scene: the session, with the synthetic exposures and brackets read from EXIF.
-  const RunResult done = RunIbrdf("session init" + photos + " --out " + dir / "init" +
-                                  " --light-position 1.2 0 0 --light-intensity 1 1 1 --sample-radius 0.04"
-                                  " --sample-center 0 0 0 --overwrite");
+  // Given the scene (and a targets block, from which align would pose the photos): the session, with
+  // the synthetic exposures and brackets read from EXIF.
+  ASSERT_EQ(RunIbrdf("targets --out " + dir / "targets" + " --no-charuco --dpi 72").exit_code, 0);
+  const RunResult done =
+      RunIbrdf("session init" + photos + " --out " + dir / "init" + " --targets " + dir / "targets/targets.json" +
+               " --light-position 1.2 0 0 --light-intensity 1 1 1 --sample-radius 0.04"
+               " --sample-center 0 0 0 --overwrite");
   ASSERT_EQ(done.exit_code, 0) << done.output;
   const Session session = Session::Load(dir / "init/session.json");
   ASSERT_EQ(session.photos.size(), truth.photos.size());
