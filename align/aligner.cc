@@ -369,8 +369,11 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
       if (!result.images[i].used || session.photos[i].role == PhotoRole::kTargets) continue;
       photos.push_back({&images[i], result.images[i].camera_from_world});
     }
+    SphereFitOptions sphere_options = options.sphere;
+    sphere_options.fix_radius = sphere_options.fix_radius || session.sample.radius_known;
     result.sphere =
-        FitSphereToSilhouettes(session.camera, photos, session.sample.center, session.sample.radius, options.sphere);
+        FitSphereToSilhouettes(session.camera, photos, session.sample.center, session.sample.radius, sphere_options);
+    if (!result.sphere.warning.empty()) Log(1, "warning: sphere fit: " + result.sphere.warning);
     if (result.sphere.fitted) {
       result.session.sample.center = result.sphere.center;
       result.session.sample.radius = result.sphere.radius;
@@ -462,7 +465,26 @@ nlohmann::json ToJson(const AlignResult& result) {
                       {"radius", result.sphere.radius},
                       {"silhouette_points", result.sphere.silhouette_points},
                       {"rejected_points", result.sphere.rejected_points},
-                      {"rms_m", result.sphere.rms_m}};
+                      {"rms_m", result.sphere.rms_m},
+                      {"radius_known", result.sphere.radius_fixed},
+                      {"limb_balance", result.sphere.limb_balance},
+                      {"radius_amplification", result.sphere.radius_amplification},
+                      {"one_sided", result.sphere.one_sided}};
+    nlohmann::json covariance = nlohmann::json::array();
+    for (int i = 0; i < 4; ++i) {
+      nlohmann::json row = nlohmann::json::array();
+      for (int j = 0; j < 4; ++j) row.push_back(result.sphere.covariance(i, j));
+      covariance.push_back(row);
+    }
+    json["sphere"]["covariance_m2"] = covariance;
+    json["sphere"]["center_sigma_m"] = {std::sqrt(result.sphere.covariance(0, 0)),
+                                        std::sqrt(result.sphere.covariance(1, 1)),
+                                        std::sqrt(result.sphere.covariance(2, 2))};
+    json["sphere"]["radius_sigma_m"] = std::sqrt(result.sphere.covariance(3, 3));
+    if (!result.sphere.warning.empty()) {
+      json["sphere"]["warning"] = result.sphere.warning;
+      json["warnings"].push_back("sphere fit: " + result.sphere.warning);
+    }
   }
   if (result.light.fitted || !result.light.reason.empty()) {
     nlohmann::json light_markers = nlohmann::json::array();

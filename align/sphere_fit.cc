@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+
+#include <Eigen/Eigenvalues>
 
 #include <ceres/ceres.h>
 
@@ -10,6 +13,136 @@
 #include "core/error.h"
 
 namespace ibrdf {
+
+namespace {
+
+// The lit limb along a radial profile (samples `step` pixels apart, outwards): the sharpest drop over
+// one pixel from a lit limb to a dark background, located where the profile crosses the mid level
+// between the limb pixel and the first background pixel. Position along the profile in pixels, or -1.
+double LitLimbEdge(const std::vector<double>& profile, double step) {
+  const int span = static_cast<int>(1.0 / step);
+  int best = -1;
+  double best_drop = 0.0;
+  for (size_t i = 0; i + span < profile.size(); ++i) {
+    const double drop = profile[i] - profile[i + span];
+    if (drop > best_drop) {
+      best_drop = drop;
+      best = static_cast<int>(i);
+    }
+  }
+  const int guard = static_cast<int>(2.0 / step);
+  if (best < guard || best + span + guard >= static_cast<int>(profile.size())) return -1.0;
+  const double inside = profile[best - guard + span / 2];
+  const double outside = profile[best + span + guard];
+  if (!(inside > 0.03) || !(outside < 0.1 * inside)) return -1.0;
+  // A rise before the edge means something brighter than the limb lies just beyond it (a white card
+  // behind the sphere): the drop found is that thing's edge, not the limb. Skip the line.
+  for (int i = 0; i + span <= best; ++i) {
+    if (profile[i + span] - profile[i] > 0.25 * inside) return -1.0;
+  }
+  // Sub-pixel: the crossing of the mid level between the two ends of the steepest drop (the limb
+  // pixel and the first background pixel); the level further inside may differ from the limb's.
+  const double mid = 0.5 * (profile[best] + profile[best + span]);
+  for (int i = best - guard; i < best + span + guard; ++i) {
+    if (profile[i] >= mid && profile[i + 1] < mid)
+      return step * (i + (profile[i] - mid) / (profile[i] - profile[i + 1]));
+  }
+  return -1.0;
+}
+
+// The unlit limb against a brighter background: the sharpest rise over one pixel from a dark limb
+// (below a tenth of the background over the whole inner part of the profile, so the dark side of a
+// lit sphere and not a shadowed edge of something else) to a background that stays bright (no second
+// edge: a card's edge is not a background). Position in pixels, or -1.
+double UnlitLimbEdge(const std::vector<double>& profile, double step) {
+  const int span = static_cast<int>(1.0 / step);
+  int best = -1;
+  double best_rise = 0.0;
+  for (size_t i = 0; i + span < profile.size(); ++i) {
+    const double rise = profile[i + span] - profile[i];
+    if (rise > best_rise) {
+      best_rise = rise;
+      best = static_cast<int>(i);
+    }
+  }
+  const int guard = static_cast<int>(2.0 / step);
+  if (best < guard || best + span + guard >= static_cast<int>(profile.size())) return -1.0;
+  const double outside = profile[best + span + guard];
+  if (!(outside > 0.03)) return -1.0;
+  for (int i = 0; i <= best - guard / 2; ++i) {
+    if (!(profile[i] < 0.1 * outside)) return -1.0;
+  }
+  for (size_t i = best + span + guard; i < profile.size(); ++i) {
+    if (std::abs(profile[i] - outside) > 0.25 * outside) return -1.0;
+  }
+  const double mid = 0.5 * (profile[best] + profile[best + span]);
+  for (int i = best - guard; i < best + span + guard; ++i) {
+    if (profile[i] < mid && profile[i + 1] >= mid)
+      return step * (i + (mid - profile[i]) / (profile[i + 1] - profile[i]));
+  }
+  return -1.0;
+}
+
+// The unit vector from the closest point of `ray` to `center`: the derivative of the ray's distance to
+// the centre with respect to the centre (minus the limb's outward normal at the tangent point).
+Eigen::Vector3d TowardsCenter(const TangentRay& ray, const Eigen::Vector3d& center) {
+  const Eigen::Vector3d v = center - ray.origin;
+  const Eigen::Vector3d perp = v - v.dot(ray.direction) * ray.direction;
+  const double norm = perp.norm();
+  return norm > 0.0 ? Eigen::Vector3d(perp / norm) : Eigen::Vector3d::Zero();
+}
+
+// Covariance, limb balance, amplification and the one-sided warning of a fit over the kept rays.
+void DescribeUncertainty(const std::vector<TangentRay>& rays, const std::vector<bool>& keep,
+                         const SphereFitOptions& options, SphereFit* fit) {
+  Eigen::Matrix4d information = Eigen::Matrix4d::Zero();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (size_t k = 0; k < rays.size(); ++k) {
+    if (!keep[k]) continue;
+    const Eigen::Vector3d u = TowardsCenter(rays[k], fit->center);
+    Eigen::Vector4d row;
+    row << u, -1.0;
+    information += row * row.transpose();
+    mean += u;
+    ++count;
+  }
+  if (count == 0) return;
+  mean /= count;
+  fit->limb_balance = mean.norm();
+  const int parameters = fit->radius_fixed ? 3 : 4;
+  const double variance = fit->rms_m * fit->rms_m * count / std::max(count - parameters, 1);
+  fit->covariance.setZero();
+  if (fit->radius_fixed) {
+    fit->covariance.topLeftCorner<3, 3>() = variance * information.topLeftCorner<3, 3>().inverse();
+  } else {
+    fit->covariance = variance * information.inverse();
+  }
+  // The free radius's variance per ray, in units of the residual variance (1: all around).
+  const Eigen::Matrix3d s = information.topLeftCorner<3, 3>() / count;
+  const double schur = 1.0 - mean.dot(s.ldlt().solve(mean));
+  fit->radius_amplification = schur > 1e-12 ? 1.0 / std::sqrt(schur) : std::numeric_limits<double>::infinity();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(fit->covariance.topLeftCorner<3, 3>());
+  fit->drift_direction = eigen.eigenvectors().col(2);
+  if (fit->drift_direction.dot(mean) > 0.0) fit->drift_direction = -fit->drift_direction;
+  fit->one_sided = !fit->radius_fixed && (!(fit->limb_balance <= options.max_limb_balance) ||
+                                          !(fit->radius_amplification <= options.max_radius_amplification));
+  if (fit->one_sided) {
+    char buffer[512];
+    std::snprintf(buffer, sizeof(buffer),
+                  "one-sided limb evidence: the silhouette points cover one side of the sphere (balance %.2f; "
+                  "0 is all round), so a bias of the lit limb moves its centre and radius together, unseen "
+                  "by the noise figures (radius %.1fx worse determined than from both limbs, sigma %.3f mm; "
+                  "centre sigma %.3f mm along (%.2f, %.2f, %.2f)); state the known radius (sample.radius with "
+                  "\"radius_known\": true) or show the unlit limb against a brighter background",
+                  fit->limb_balance, fit->radius_amplification, 1e3 * std::sqrt(fit->covariance(3, 3)),
+                  1e3 * std::sqrt(eigen.eigenvalues()(2)), fit->drift_direction.x(), fit->drift_direction.y(),
+                  fit->drift_direction.z());
+    fit->warning = buffer;
+  }
+}
+
+}  // namespace
 
 bool SphereFitOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GE(silhouette_lines, 8);
@@ -20,6 +153,8 @@ bool SphereFitOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GT(outlier_rms_factor, 0.0);
   IBRDF_CHECK_OPTION_GE(min_points, 4);
   IBRDF_CHECK_OPTION_GT(tolerance, 0.0);
+  IBRDF_CHECK_OPTION_GT(max_limb_balance, 0.0);
+  IBRDF_CHECK_OPTION_GE(max_radius_amplification, 1.0);
   return true;
 }
 
@@ -30,7 +165,13 @@ std::string SphereFit::BriefReport() const {
       buffer, sizeof(buffer),
       "sphere centre (%.5f, %.5f, %.5f) m, radius %.5f m from %d silhouette points (RMS %.3f mm, %d rejected)",
       center.x(), center.y(), center.z(), radius, silhouette_points, 1e3 * rms_m, rejected_points);
-  return buffer;
+  std::string report = buffer;
+  if (radius_fixed) report += ", radius known";
+  std::snprintf(buffer, sizeof(buffer), ", centre sigma %.3f mm",
+                1e3 * std::sqrt(std::max(covariance.topLeftCorner<3, 3>().trace(), 0.0)));
+  report += buffer;
+  if (one_sided) report += "; WARNING: one-sided limb evidence";
+  return report;
 }
 
 std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& camera,
@@ -51,38 +192,10 @@ std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& 
     for (double s = s0; s <= s1; s += step)
       profile.push_back(BilinearLuminance(image, center_px.x() + s * direction.x(), center_px.y() + s * direction.y()));
     if (std::any_of(profile.begin(), profile.end(), [](double v) { return !std::isfinite(v); })) continue;
-    // The sharpest drop over one pixel.
-    const int span = static_cast<int>(1.0 / step);
-    int best = -1;
-    double best_drop = 0.0;
-    for (size_t i = 0; i + span < profile.size(); ++i) {
-      const double drop = profile[i] - profile[i + span];
-      if (drop > best_drop) {
-        best_drop = drop;
-        best = static_cast<int>(i);
-      }
-    }
-    const int guard = static_cast<int>(2.0 / step);
-    if (best < guard || best + span + guard >= static_cast<int>(profile.size())) continue;
-    const double inside = profile[best - guard + span / 2];
-    const double outside = profile[best + span + guard];
-    if (!(inside > 0.03) || !(outside < 0.1 * inside)) continue;
-    // A rise before the edge means something brighter than the limb lies just beyond it (a white card
-    // behind the sphere): the drop found is that thing's edge, not the limb. Skip the line.
-    bool rises = false;
-    for (int i = 0; i + span <= best && !rises; ++i) rises = profile[i + span] - profile[i] > 0.25 * inside;
-    if (rises) continue;
-    // Sub-pixel: the crossing of the mid level between the two ends of the steepest drop (the limb
-    // pixel and the first background pixel); the level further inside may differ from the limb's.
-    const double mid = 0.5 * (profile[best] + profile[best + span]);
-    double edge = -1.0;
-    for (int i = best - guard; i < best + span + guard; ++i) {
-      if (profile[i] >= mid && profile[i + 1] < mid) {
-        edge = s0 + step * (i + (profile[i] - mid) / (profile[i] - profile[i + 1]));
-        break;
-      }
-    }
+    double edge = LitLimbEdge(profile, step);
+    if (edge < 0.0) edge = UnlitLimbEdge(profile, step);
     if (edge < 0.0) continue;
+    edge += s0;
     points.push_back(center_px + edge * direction);
   }
   return points;
@@ -116,6 +229,7 @@ SphereFit FitSphereToTangentRays(const std::vector<TangentRay>& rays, const Eige
                                new ceres::CauchyLoss(options.cauchy_m), center, &radius);
     }
     problem.SetParameterLowerBound(&radius, 0, 1e-6);
+    if (options.fix_radius) problem.SetParameterBlockConstant(&radius);
     ceres::Solver::Options solver_options;
     solver_options.linear_solver_type = ceres::DENSE_QR;
     solver_options.max_num_iterations = 100;
@@ -144,7 +258,9 @@ SphereFit FitSphereToTangentRays(const std::vector<TangentRay>& rays, const Eige
   }
   fit.center = Eigen::Vector3d(center[0], center[1], center[2]);
   fit.radius = radius;
+  fit.radius_fixed = options.fix_radius;
   fit.fitted = fit.silhouette_points >= options.min_points;
+  if (fit.fitted) DescribeUncertainty(rays, keep, options, &fit);
   if (!fit.fitted) {
     fit.reason = "only " + std::to_string(fit.silhouette_points) + " silhouette points left after rejecting " +
                  std::to_string(fit.rejected_points) + " outliers (need " + std::to_string(options.min_points) + ")";

@@ -3,6 +3,14 @@
 // extracting limb points in a band around the current estimate's silhouette (wide, then narrow) and
 // fitting with a Cauchy loss, so edges of other things (a card behind the limb) do not pull the fit;
 // the last round drops points beyond a multiple of the RMS and refits.
+//
+// Limb points come from both limbs where they can: the lit limb drops to a dark background, an unlit
+// limb rises to a brighter one. On a black background only the lit side of the limb is seen, and from
+// one side the centre and the radius trade off (moving the centre towards the light and shrinking the
+// radius keeps every lit tangent ray tangent). The fit measures that: its covariance (from the
+// tangent rays' geometry at the residual RMS) and the radius amplification (how much worse the radius
+// is determined than by limb points all around the sphere), and warns when the evidence is one-sided.
+// A known radius (SampleSpec::radius_known) removes the trade-off: only the centre is fitted.
 #pragma once
 
 #include <string>
@@ -26,6 +34,15 @@ struct SphereFitOptions {
   double outlier_rms_factor = 3.0;    // the last round drops rays farther than this x RMS and refits
   int min_points = 8;                 // fewer tangent rays: no fit (the sphere stays as given)
   double tolerance = 1e-15;           // Ceres function and parameter tolerance
+  bool fix_radius = false;            // keep the start radius (a known radius): fit only the centre
+  // Warn (SphereFit::warning) when the radius is fitted from one-sided limb evidence: a limb balance
+  // over max_limb_balance (0 all around, 0.5 a uniformly covered hemisphere: the lit limb alone on a
+  // black background), where a bias of the lit limb that varies with its brightness (blur, the soft
+  // terminator) moves the centre towards the light with nothing on the other side to hold it; or a
+  // radius amplification over max_radius_amplification (1 all around, 2 a uniform hemisphere), where
+  // the noise alone trades centre against radius.
+  double max_limb_balance = 0.3;
+  double max_radius_amplification = 3.0;
   bool Check(std::string* why) const;
 };
 
@@ -50,6 +67,18 @@ struct SphereFit {
   int silhouette_points = 0;  // tangent rays used
   int rejected_points = 0;    // outliers removed after the first solve
   double rms_m = 0.0;         // RMS of ray-to-sphere distances, metres
+  bool radius_fixed = false;  // the radius was kept (known), only the centre fitted
+  // Covariance of (centre x, y, z, radius), metres squared: the Gauss-Newton covariance of the inlier
+  // tangent rays scaled by their residual variance. Radius row and column zero when radius_fixed.
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
+  // Limb coverage: the length of the mean of the unit vectors from the centre to the tangent points
+  // (0: all around, 0.5: a uniformly covered hemisphere, 1: one point), and the radius amplification
+  // sqrt(N var(radius)) / RMS the geometry gives a free radius (1: all around; large: one-sided).
+  double limb_balance = 0.0;
+  double radius_amplification = 0.0;
+  Eigen::Vector3d drift_direction = Eigen::Vector3d::Zero();  // the centre's direction of largest variance
+  bool one_sided = false;                                     // amplification over the option's bound
+  std::string warning;  // non-empty when the radius was fitted from one-sided limb evidence
   // "sphere centre (0.00001, 0.00002, 0.05000) m, radius 0.05000 m from 1234 silhouette points (RMS ...)"
   std::string BriefReport() const;
 };

@@ -1,9 +1,11 @@
 // Image I/O through OpenImageIO (and libpng for plain PNGs): every format it reads (8/16-bit PNG and TIFF, EXR, camera
 // RAW ...) into float pixels, file values normalized to [0, 1] for integer formats. Linearization is the session's
-// business (core/radiometry.h), except for camera RAW, which is decoded to a linear colour space here, since
-// OpenImageIO's RAW reader would otherwise apply an sRGB curve.
+// business (core/radiometry.h), except for camera RAW, which LibRaw decodes here to linear camera RGB: the file's
+// black level subtracted and its white level scaled to 1.0, demosaiced, with no white balance and no colour matrix
+// (docs/radiometry.md).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,9 @@ struct Image {
   int height = 0;
   int channels = 0;
   std::vector<float> pixels;  // interleaved, row-major: pixels[(y * width + x) * channels + c]
+  // The file stores floating-point values (EXR, float or half TIFF): no full scale, so no saturation
+  // unless the session states one. Set by ReadImage.
+  bool floating_point = false;
 
   Image() = default;
   Image(int w, int h, int c) : width(w), height(h), channels(c), pixels(size_t(w) * h * c, 0.0f) {}
@@ -48,9 +53,31 @@ struct ImageSpec {
 };
 ImageSpec ReadImageSpec(const std::string& path);
 
+// What a camera writes into a photo's metadata (EXIF), as OpenImageIO reads it. Absent fields are
+// those the file does not carry.
+struct PhotoMetadata {
+  std::optional<double> exposure_s;          // EXIF ExposureTime, seconds
+  std::optional<double> iso;                 // EXIF PhotographicSensitivity (ISOSpeedRatings)
+  std::optional<double> f_number;            // EXIF FNumber
+  std::optional<double> focal_length_mm;     // EXIF FocalLength
+  std::optional<double> focal_length_35mm;   // EXIF FocalLengthIn35mmFilm, millimetres
+  std::optional<double> pixels_per_mm;       // EXIF FocalPlaneXResolution in its unit, as pixels per mm
+  std::string make, model;                   // EXIF Make, Model (empty when absent)
+  std::string date_time;                     // EXIF DateTimeOriginal or DateTime, "YYYY:MM:DD HH:MM:SS"
+  int width = 0, height = 0, channels = 0;   // the decoded image's size
+  bool floating_point = false;               // float or half pixels (EXR, float TIFF)
+  int bits = 0;                              // bits per stored sample (0 when floating point)
+  bool raw = false;                          // a camera RAW file (decoded through LibRaw)
+};
+
+// Reads the header and metadata without decoding the pixels. Throws Error naming the file.
+PhotoMetadata ReadPhotoMetadata(const std::string& path);
+
 // Writes an image atomically; the format follows the extension (.png, .tif, .exr ...). Integer formats
-// take values in [0, 1], clamped and rounded.
-void WriteImage(const std::string& path, const Image& image, PixelFormat format);
+// take values in [0, 1], clamped and rounded. With `metadata`, its set fields are written as EXIF (PNG:
+// an eXIf chunk; TIFF, JPEG: EXIF tags; EXR: header attributes), so ReadPhotoMetadata reads them back.
+void WriteImage(const std::string& path, const Image& image, PixelFormat format,
+                const PhotoMetadata* metadata = nullptr);
 
 // True for file extensions OpenImageIO's RAW reader handles (.cr2, .nef, .arw, .dng ...).
 bool IsRawExtension(const std::string& path);

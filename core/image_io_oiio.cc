@@ -6,7 +6,10 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <cmath>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <OpenImageIO/imageio.h>
@@ -24,14 +27,57 @@ std::string LowerExtension(const std::string& path) {
 std::unique_ptr<OIIO::ImageInput> Open(const std::string& path, bool raw, std::string* error) {
   OIIO::ImageSpec config;
   if (raw) {
-    // Linear output: without this the RAW reader applies an sRGB curve.
-    config.attribute("raw:ColorSpace", "sRGB-linear");
+    // Linear camera RGB (docs/radiometry.md): LibRaw subtracts the file's black level and scales its
+    // white (saturation) level to full scale, then demosaics (AHD); no colour matrix ("raw"), no white
+    // balance (unit multipliers, neither the camera's nor the daylight pre-multipliers), no automatic
+    // brightening and no lowering of the white level to the brightest pixel (adjust_maximum_thr 0).
+    config.attribute("raw:ColorSpace", "raw");
+    config.attribute("raw:use_camera_wb", 0);
+    const float unit_multipliers[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+    config.attribute("raw:user_mul", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 4), unit_multipliers);
     config.attribute("raw:auto_bright", 0);
-    config.attribute("raw:use_camera_wb", 1);
+    config.attribute("raw:adjust_maximum_thr", 0.0f);
+    config.attribute("raw:Demosaic", "AHD");
   }
   auto input = OIIO::ImageInput::open(path, &config);
   if (!input) *error = "cannot read image: " + OIIO::geterror();
   return input;
+}
+
+// A numeric attribute of `spec` (any numeric type, the first element of an array), if present.
+std::optional<double> Number(const OIIO::ImageSpec& spec, const char* name) {
+  const OIIO::ParamValue* p = spec.find_attribute(name);
+  if (!p || p->type().basetype == OIIO::TypeDesc::STRING) return std::nullopt;
+  // OpenImageIO 2.4 converts integers only through get_int_attribute (get_float_attribute and
+  // ParamValue::get_float miss an EXR header's int).
+  const double value = p->type().is_floating_point()
+                           ? double(spec.get_float_attribute(name, std::numeric_limits<float>::quiet_NaN()))
+                           : double(spec.get_int_attribute(name, -1));
+  if (!std::isfinite(value) || value <= 0.0) return std::nullopt;
+  return value;
+}
+
+// The EXIF fields of `metadata` as OpenImageIO attributes.
+void SetMetadata(const ibrdf::PhotoMetadata& metadata, OIIO::ImageSpec* spec) {
+  if (metadata.exposure_s) spec->attribute("ExposureTime", static_cast<float>(*metadata.exposure_s));
+  if (metadata.f_number) spec->attribute("FNumber", static_cast<float>(*metadata.f_number));
+  if (metadata.iso) spec->attribute("Exif:PhotographicSensitivity", static_cast<int>(std::lround(*metadata.iso)));
+  if (metadata.focal_length_mm) spec->attribute("Exif:FocalLength", static_cast<float>(*metadata.focal_length_mm));
+  if (metadata.focal_length_35mm) {
+    spec->attribute("Exif:FocalLengthIn35mmFilm", static_cast<int>(std::lround(*metadata.focal_length_35mm)));
+  }
+  if (metadata.pixels_per_mm) {
+    // Unit 3: centimetres.
+    spec->attribute("Exif:FocalPlaneXResolution", static_cast<float>(10.0 * *metadata.pixels_per_mm));
+    spec->attribute("Exif:FocalPlaneYResolution", static_cast<float>(10.0 * *metadata.pixels_per_mm));
+    spec->attribute("Exif:FocalPlaneResolutionUnit", 3);
+  }
+  if (!metadata.make.empty()) spec->attribute("Make", metadata.make);
+  if (!metadata.model.empty()) spec->attribute("Model", metadata.model);
+  if (!metadata.date_time.empty()) {
+    spec->attribute("DateTime", metadata.date_time);
+    spec->attribute("Exif:DateTimeOriginal", metadata.date_time);
+  }
 }
 
 }  // namespace
@@ -44,6 +90,38 @@ __attribute__((visibility("default"))) bool IbrdfOiioReadSpec(const std::string&
   auto input = Open(path, raw, error);
   if (!input) return false;
   *spec = {input->spec().width, input->spec().height, input->spec().nchannels};
+  return true;
+}
+
+// The header and EXIF fields of `path` (a camera RAW file when `raw`); false with `error` set on failure.
+__attribute__((visibility("default"))) bool IbrdfOiioReadMetadata(const std::string& path, bool raw,
+                                                                  ibrdf::PhotoMetadata* metadata, std::string* error) {
+  auto input = Open(path, raw, error);
+  if (!input) return false;
+  const OIIO::ImageSpec& spec = input->spec();
+  metadata->width = spec.width;
+  metadata->height = spec.height;
+  metadata->channels = spec.nchannels;
+  metadata->raw = raw;
+  metadata->floating_point = spec.format.is_floating_point() && !metadata->raw;
+  metadata->bits =
+      metadata->floating_point ? 0 : spec.get_int_attribute("oiio:BitsPerSample", int(spec.format.size() * 8));
+  metadata->exposure_s = Number(spec, "ExposureTime");
+  metadata->f_number = Number(spec, "FNumber");
+  metadata->iso = Number(spec, "Exif:PhotographicSensitivity");
+  if (!metadata->iso) metadata->iso = Number(spec, "Exif:ISOSpeedRatings");
+  metadata->focal_length_mm = Number(spec, "Exif:FocalLength");
+  metadata->focal_length_35mm = Number(spec, "Exif:FocalLengthIn35mmFilm");
+  if (const std::optional<double> resolution = Number(spec, "Exif:FocalPlaneXResolution")) {
+    // FocalPlaneResolutionUnit: 2 inch (the default), 3 centimetre, 4 millimetre.
+    const int unit = spec.get_int_attribute("Exif:FocalPlaneResolutionUnit", 2);
+    const double mm_per_unit = unit == 3 ? 10.0 : unit == 4 ? 1.0 : 25.4;
+    metadata->pixels_per_mm = *resolution / mm_per_unit;
+  }
+  metadata->make = spec.get_string_attribute("Make");
+  metadata->model = spec.get_string_attribute("Model");
+  metadata->date_time = spec.get_string_attribute("Exif:DateTimeOriginal", spec.get_string_attribute("DateTime"));
+  input->close();
   return true;
 }
 
@@ -61,6 +139,7 @@ __attribute__((visibility("default"))) bool IbrdfOiioRead(const std::string& pat
   image->width = spec.width;
   image->height = spec.height;
   image->channels = spec.nchannels;
+  image->floating_point = spec.format.is_floating_point() && !raw;
   image->pixels.resize(size_t(spec.width) * spec.height * spec.nchannels);  // every value is overwritten
   if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image->pixels.data())) {
     *error = "cannot decode image: " + input->geterror();
@@ -71,9 +150,11 @@ __attribute__((visibility("default"))) bool IbrdfOiioRead(const std::string& pat
 }
 
 // Writes `image` to `path` (the writer chosen by the extension) with `format` as the stored pixel type
-// (an ibrdf::PixelFormat). False with `error` set on failure.
+// (an ibrdf::PixelFormat) and, for formats whose EXIF OpenImageIO writes (not PNG), `metadata` when not
+// null. False with `error` set on failure.
 __attribute__((visibility("default"))) bool IbrdfOiioWrite(const std::string& path, const ibrdf::Image& image,
-                                                           int format, std::string* error) {
+                                                           int format, const ibrdf::PhotoMetadata* metadata,
+                                                           std::string* error) {
   auto output = OIIO::ImageOutput::create(path);
   if (!output) {
     *error = "no image writer for this extension: " + OIIO::geterror();
@@ -98,6 +179,7 @@ __attribute__((visibility("default"))) bool IbrdfOiioWrite(const std::string& pa
   if (LowerExtension(path) == ".exr") spec.attribute("compression", "zip");
   // Fast deflate: noisy 16-bit photos barely compress, and level 6 costs 5x the time.
   if (LowerExtension(path) == ".png") spec.attribute("png:compressionLevel", 1);
+  if (metadata && LowerExtension(path) != ".png") SetMetadata(*metadata, &spec);
   if (!output->open(path, spec) || !output->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data()) ||
       !output->close()) {
     *error = "cannot write image: " + output->geterror();

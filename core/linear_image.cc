@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <string>
@@ -96,6 +97,11 @@ void LinearizeImage(const Session& session, size_t photo, Image* image, bool div
       v = static_cast<float>(linear);
     }
   }
+}
+
+double SaturationLevel(const RadiometrySpec& radiometry, const Image& image) {
+  if (radiometry.saturation_stated) return radiometry.saturation_level;
+  return image.floating_point ? std::numeric_limits<double>::infinity() : 1.0;
 }
 
 }  // namespace ibrdf

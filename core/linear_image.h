@@ -24,6 +24,12 @@ struct FlatField {
 // Throws Error naming the image and the manifest's field.
 std::shared_ptr<const FlatField> LoadFlatField(const Session& session);
 
+// The file value at which a channel of `image` counts as clipped: the session's saturation_level when
+// its manifest states one; otherwise 1.0 (full scale) for integer files and +infinity for
+// floating-point files (an HDR render or merged EXR has no full scale: clipping it at 1.0 would throw
+// away every highlight).
+double SaturationLevel(const RadiometrySpec& radiometry, const Image& image);
+
 // Linearizes `image` (photo `photo` of the session, as ReadImage decoded it) in place by the chain
 // above. Grey images use the mean of the flat field's channels; channels past the third (alpha) are
 // left as they are. Throws Error naming the photo if its size is not the camera's while a flat field

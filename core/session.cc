@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -73,6 +74,12 @@ Light ParseLight(JsonObject object) {
   } else {
     ThrowError(object.Where("kind"), "unknown light kind \"" + kind + "\" (expected point or directional)");
   }
+  // Optional when a white reference measures it (checked in Session::Load): NaN until then.
+  if (!object.Has("intensity")) {
+    light.intensity = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    object.Finish();
+    return light;
+  }
   light.intensity = object.Vector3("intensity");
   if ((light.intensity.array() < 0.0).any() || !(light.intensity.maxCoeff() > 0.0)) {
     ThrowError(object.Where("intensity"), "must be non-negative and not all zero");
@@ -141,6 +148,7 @@ SampleSpec ParseSample(JsonObject object) {
     sample.center = object.Vector3("center");
     sample.radius = object.Number("radius");
     RequirePositive(object, "radius", sample.radius);
+    sample.radius_known = object.Boolean("radius_known", false);
   } else if (kind == "cylinder") {
     sample.kind = SampleSpec::Kind::kCylinder;
     sample.center = object.Vector3("center");
@@ -198,6 +206,7 @@ RadiometrySpec ParseRadiometry(JsonObject object, const std::string& directory) 
   RadiometrySpec radiometry;
   if (object.Has("response")) radiometry.response = ParseResponse(object);
   radiometry.black_level = object.Number("black_level", 0.0);
+  radiometry.saturation_stated = object.Has("saturation_level");
   radiometry.saturation_level = object.Number("saturation_level", 1.0);
   if (radiometry.black_level < 0.0) ThrowError(object.Where("black_level"), "must not be negative");
   if (!(radiometry.saturation_level > radiometry.black_level)) {
@@ -454,6 +463,14 @@ Session Session::Load(const std::string& path) {
     session.photos.push_back(ParsePhoto(photo, session.directory));
   }
   if (session.photos.empty()) ThrowError(root.Where("photos"), "a session needs at least one photo");
+  if (session.light.intensity.hasNaN()) {
+    if (!session.calibration || !session.calibration->white_reference) {
+      ThrowError(session.manifest_path + ": /light/intensity",
+                 "missing: state the light's RGB intensity, or give a calibration.white_reference that measures it");
+    }
+    // A placeholder: the white reference's calibration (derender/light_calibration.h) replaces it.
+    session.light.intensity = Eigen::Vector3d::Ones();
+  }
   root.Finish();
   return session;
 }
@@ -503,6 +520,7 @@ nlohmann::json Session::ToJson() const {
   } else {
     s["center"] = ibrdf::ToJson(sample.center);
     s["radius"] = sample.radius;
+    if (sample.radius_known) s["radius_known"] = true;
     if (sample.kind == SampleSpec::Kind::kCylinder) {
       s["axis"] = ibrdf::ToJson(sample.axis);
       s["length"] = sample.length;
@@ -524,7 +542,7 @@ nlohmann::json Session::ToJson() const {
       break;
   }
   r["black_level"] = radiometry.black_level;
-  r["saturation_level"] = radiometry.saturation_level;
+  if (radiometry.saturation_stated) r["saturation_level"] = radiometry.saturation_level;
   if (radiometry.noise) {
     r["noise"] = {{"full_well_e", radiometry.noise->full_well_e},
                   {"read_noise_e", radiometry.noise->read_noise_e},

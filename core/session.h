@@ -30,6 +30,9 @@ struct RadiometrySpec {
   Response response;              // file value -> linear signal
   double black_level = 0.0;       // linear signal of a dark pixel, subtracted (normalized file units)
   double saturation_level = 1.0;  // file value at which a channel is clipped (normalized file units)
+  // The manifest states saturation_level. When it does not, integer photos clip at 1.0 (full scale)
+  // and floating-point photos (EXR, float TIFF) have no saturation (SaturationLevel, linear_image.h).
+  bool saturation_stated = false;
   std::optional<CameraNoise> noise;
   // Optional flat-field image (relative to the session folder): the camera's relative sensitivity per
   // pixel (vignetting x pixel response), linear, 1 where exposure and gain alone are right (normally
@@ -63,6 +66,9 @@ struct SampleSpec {
   Kind kind = Kind::kSphere;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // sphere centre; cylinder axis midpoint
   double radius = 0.0;                               // sphere and cylinder, metres
+  // Sphere: the radius is known (a ball bearing's gauge, measured with callipers); the align stage's
+  // sphere fit keeps it and fits only the centre (JSON "radius_known", default false).
+  bool radius_known = false;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   // cylinder axis, unit
   double length = 0.0;                               // cylinder length along the axis, metres
   // Mesh samples. The file need not exist when the session is read (the scan stage may write it).

@@ -176,6 +176,7 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
   const size_t m = exposures.size();
   std::vector<Image>& images = *decoded;
   if (images.size() < m) images.resize(m);
+  std::vector<double> saturation(m);  // per exposure: float files have none unless the session states one
   std::vector<double> scale(m);  // exposure_s * gain
   for (size_t e = 0; e < m; ++e) {
     const std::string path = ResolvePath(impl.directory, exposures[e].file);
@@ -190,6 +191,7 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
       ThrowError(path, "expected 1 (grey) or 3+ (RGB) channels, got " + std::to_string(images[e].channels));
     }
     scale[e] = exposures[e].exposure_s * exposures[e].gain;
+    saturation[e] = SaturationLevel(radiometry, images[e]);
   }
   RadianceImage& out = *radiance_image;
   out.width = impl.width;
@@ -232,7 +234,7 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
             const double v = values[image.channels == 1 ? 0 : c];
             encoded[3 * e + c] = v;
             finite = finite && std::isfinite(v);
-            saturated = saturated || v >= radiometry.saturation_level;
+            saturated = saturated || v >= saturation[e];
             const double linear = impl.ToLinear(v) - radiometry.black_level;
             darkest = std::min(darkest, linear);
             radiance[3 * e + c] = linear / scale[e] * inverse[c];

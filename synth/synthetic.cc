@@ -22,6 +22,7 @@
 #include "core/statistics.h"
 #include "derender/analytic_sample.h"
 #include "scan/ply_io.h"
+#include "synth/synthetic_exif.h"
 #include "synth/synthetic_radiometry.h"
 #include "synth/synthetic_targets.h"
 
@@ -130,8 +131,9 @@ Session BuildSession(const SynthOptions& options) {
   const CameraEffects& effects = options.effects;
   session.radiometry.response.kind = effects.srgb ? Response::Kind::kSrgb : Response::Kind::kLinear;
   session.radiometry.black_level = effects.black_level;
-  // Unclipped float files have no saturation level; the largest float stands for "none".
-  session.radiometry.saturation_level = effects.clip ? 1.0 : double(std::numeric_limits<float>::max());
+  // Unclipped files state no saturation level (float files then have none; core/linear_image.h).
+  session.radiometry.saturation_stated = effects.clip;
+  session.radiometry.saturation_level = 1.0;
   if (effects.shot_noise || effects.read_noise || effects.bits > 0) {
     CameraNoise noise;
     noise.full_well_e = effects.full_well_e;
@@ -615,7 +617,8 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
     const PixelFormat format = effects.bits == 0   ? PixelFormat::kFloat
                                : effects.bits <= 8 ? PixelFormat::kUint8
                                                    : PixelFormat::kUint16;
-    WriteImage((fs::path(directory.temporary_path()) / photo.file).string(), image, format);
+    const PhotoMetadata exif = SyntheticPhotoMetadata(session, photo, i);
+    WriteImage((fs::path(directory.temporary_path()) / photo.file).string(), image, format, &exif);
     progress.Add(1);
   }
   progress.Finish();

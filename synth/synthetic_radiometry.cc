@@ -12,6 +12,7 @@
 #include "core/light.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
+#include "synth/synthetic_exif.h"
 
 namespace fs = std::filesystem;
 
@@ -198,7 +199,8 @@ void WriteSynthCalibration(const SynthOptions& options, const std::string& direc
     const PixelFormat format = effects.bits == 0   ? PixelFormat::kFloat
                                : effects.bits <= 8 ? PixelFormat::kUint8
                                                    : PixelFormat::kUint16;
-    WriteImage((fs::path(directory) / photo.file).string(), image, format);
+    const PhotoMetadata exif = SyntheticPhotoMetadata(*session, photo, session->photos.size());
+    WriteImage((fs::path(directory) / photo.file).string(), image, format, &exif);
     white.photos.push_back(photo);
     CalibrationSpec calibration;
     calibration.white_reference = white;

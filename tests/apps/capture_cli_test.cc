@@ -1,0 +1,113 @@
+// The capture kit through the command line (issue 13): `ibrdf targets` writes the sheets and a targets
+// block equal to `ibrdf synth --targets`'s layout (in the platform's frame); `ibrdf session init` on a
+// synthetic capture's photos alone (their EXIF) drafts a session whose exposures are the synthetic ones,
+// says what is missing with exit status 2, and validates once it is given.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/image_io.h"
+#include "core/json_reader.h"
+#include "core/session.h"
+#include "tests/run_ibrdf.h"
+#include "tests/test_util.h"
+
+namespace ibrdf {
+namespace {
+
+using testing::MaterialPath;
+using testing::RunIbrdf;
+using testing::RunResult;
+using testing::ScratchDir;
+namespace fs = std::filesystem;
+
+TEST(CaptureCli, TargetsMatchTheSyntheticLayout) {
+  ScratchDir dir;
+  const RunResult targets = RunIbrdf("targets --out " + dir / "targets" + " --dpi 100");
+  ASSERT_EQ(targets.exit_code, 0) << targets.output;
+  for (const char* file : {"platform.svg", "platform.png", "light-card.svg", "light-card.png", "charuco.svg",
+                           "charuco.png", "board.json", "targets.json", "README.txt"}) {
+    EXPECT_TRUE(fs::is_regular_file(dir / ("targets/" + std::string(file)))) << file;
+  }
+  // The SVG states its printed size in millimetres; the PNG is that size at the DPI.
+  std::ifstream svg(dir / "targets/platform.svg");
+  const std::string text((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("width=\"290.000000mm\""), std::string::npos);
+  EXPECT_NE(text.find("scale bar: 100.0 mm"), std::string::npos);
+  const ImageSpec png = ReadImageSpec(dir / "targets/platform.png");
+  EXPECT_EQ(png.width, static_cast<int>(std::ceil(290.0 / 25.4 * 100.0)));
+  // A synthetic session with targets: the same markers, shifted by the platform's height.
+  const RunResult synth = RunIbrdf("synth --out " + dir / "s" + " --material " + MaterialPath("lambertian50") +
+                                   " --photos 1 --width 96 --height 72 --targets --light-photos 1");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const Session session = Session::Load(dir / "s");
+  const nlohmann::json block = ReadJsonFile(dir / "targets/targets.json")["targets"];
+  ASSERT_EQ(block["reference"].size(), session.targets->reference.size());
+  for (size_t i = 0; i < session.targets->reference.size(); ++i) {
+    const TargetSpec& expected = session.targets->reference[i];
+    EXPECT_EQ(block["reference"][i]["id"].get<int>(), expected.id);
+    for (int k = 0; k < 4; ++k) {
+      for (int a = 0; a < 3; ++a) {
+        const double shift = a == 2 ? session.sample.radius : 0.0;  // synth's world origin: the sphere's centre
+        EXPECT_NEAR(block["reference"][i]["corners"][k][a].get<double>(), expected.corners[k][a] + shift, 1e-12);
+      }
+    }
+  }
+  ASSERT_TRUE(session.targets->light);
+  ASSERT_EQ(block["light"]["markers"].size(), session.targets->light->markers.size());
+  EXPECT_EQ(block["light"]["size"].get<double>(), session.targets->light->size);
+  for (size_t i = 0; i < session.targets->light->markers.size(); ++i) {
+    const LightMarkerSpec& expected = session.targets->light->markers[i];
+    EXPECT_EQ(block["light"]["markers"][i]["id"].get<int>(), expected.id);
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(block["light"]["markers"][i]["light_in_marker"][a].get<double>(), expected.light_in_marker[a], 1e-12);
+    }
+  }
+  // Markers beyond the dictionary: an error, nothing written.
+  const RunResult bad = RunIbrdf("targets --out " + dir / "bad" +
+                                 " --ring-count 60 --ring-radius-mm 600 --platform-radius-mm 640 --light-markers 0");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("DICT_4X4_50"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+}
+
+TEST(CaptureCli, SessionInitFromSyntheticPhotos) {
+  ScratchDir dir;
+  const RunResult synth = RunIbrdf("synth --out " + dir / "s" + " --material " + MaterialPath("lambertian50") +
+                                   " --photos 3 --brackets 2 --width 96 --height 72");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const Session truth = Session::Load(dir / "s");
+  std::string photos;
+  for (size_t i = 0; i < truth.photos.size(); ++i) photos += " " + truth.PhotoPath(i);
+  // Nothing about the scene: exit status 2, a draft, the missing items named.
+  const RunResult draft = RunIbrdf("session init" + photos + " --out " + dir / "init");
+  EXPECT_EQ(draft.exit_code, 2) << draft.output;
+  EXPECT_NE(draft.output.find("missing: the light's position"), std::string::npos) << draft.output;
+  EXPECT_TRUE(fs::exists(dir / "init/session.draft.json"));
+  EXPECT_FALSE(fs::exists(dir / "init/session.json"));
+  // Given the scene (and a targets block, from which align would pose the photos): the session, with
+  // the synthetic exposures and brackets read from EXIF.
+  ASSERT_EQ(RunIbrdf("targets --out " + dir / "targets" + " --no-charuco --dpi 72").exit_code, 0);
+  const RunResult done =
+      RunIbrdf("session init" + photos + " --out " + dir / "init" + " --targets " + dir / "targets/targets.json" +
+               " --light-position 1.2 0 0 --light-intensity 1 1 1 --sample-radius 0.04"
+               " --sample-center 0 0 0 --overwrite");
+  ASSERT_EQ(done.exit_code, 0) << done.output;
+  const Session session = Session::Load(dir / "init/session.json");
+  ASSERT_EQ(session.photos.size(), truth.photos.size());
+  for (size_t i = 0; i < truth.photos.size(); ++i) {
+    EXPECT_NEAR(session.photos[i].exposure_s / truth.photos[i].exposure_s, 1.0, 1e-6) << i;
+    EXPECT_EQ(session.photos[i].gain, 1.0);
+    ASSERT_TRUE(session.photos[i].bracket && truth.photos[i].bracket) << i;
+    EXPECT_EQ(*session.photos[i].bracket, *truth.photos[i].bracket) << i;
+  }
+  EXPECT_NEAR(session.camera.FocalX(), truth.camera.FocalX(), 1e-3 * truth.camera.FocalX());
+  EXPECT_FALSE(session.radiometry.saturation_stated);
+}
+
+}  // namespace
+}  // namespace ibrdf
