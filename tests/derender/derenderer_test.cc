@@ -290,7 +290,7 @@ TEST(Derender, DomePhotosOfOnePoseUnderTwoLightsAreTwoMeasurements) {
   for (int i = 0; i < 2; ++i) {
     SCOPED_TRACE("photo " + std::to_string(i));
     const TruthComparison comparison = CompareWithTruth(per_photo[i], *material);
-    ASSERT_GT(comparison.overall.count, 10000u);
+    ASSERT_GT(comparison.overall.count, 1000u);
     for (int c = 0; c < 3; ++c) EXPECT_LT(comparison.overall.median[c], 0.01) << "channel " << c;
   }
   Session wrong = session;
@@ -335,8 +335,11 @@ TEST(Derender, MasksExcludePixelsAndAreCounted) {
   const DerenderResult masked = Derender(session, DerenderOptions());
   ASSERT_GT(masked.samples.size(), 1000u);
   for (const BrdfSample& s : masked.samples) {
-    if (s.image == 0) ASSERT_LT(s.pixel[0], uint32_t(w / 2));
-    if (s.image == 1) ASSERT_LT(s.pixel[1], uint32_t(h / 2));
+    if (s.image == 0) {
+      ASSERT_LT(s.pixel[0], uint32_t(w / 2));
+    } else {
+      ASSERT_LT(s.pixel[1], uint32_t(h / 2));
+    }
   }
   // Exactly the unmasked run's samples inside the masks remain; those outside are counted as masked
   // (with the pixels outside that were rejected for other reasons: the mask is tested first).
