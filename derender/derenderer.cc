@@ -26,6 +26,7 @@
 #include "derender/analytic_sample.h"
 #include "derender/light_calibration.h"
 #include "derender/mesh_sample.h"
+#include "derender/photo_mask.h"
 #include "derender/radiance_image.h"
 #include "scan/convexity.h"
 #include "scan/mesh_file.h"
@@ -40,6 +41,7 @@ constexpr double kDegree = M_PI / 180.0;
 // Rejection reasons in RejectionReasons() order; each pixel counts once, under the first that applies.
 enum Reason {
   kOff,
+  kMasked,
   kMixed,
   kTarget,
   kLowQuality,
@@ -187,6 +189,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
                        std::vector<BrdfSample>* samples, MeshPhotoStats* stats) {
   const MeshSample& mesh = *path.mesh;
   const PhotoSpec& photo = session.photos[photo_index];
+  const Light& light = session.PhotoLight(photo_index);
   const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
   const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
   const Eigen::Vector3d camera_center = world_from_camera.translation;
@@ -266,6 +269,10 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
           ++local.counts[kOff];
           continue;
         }
+        if (!image.mask.empty() && !image.mask[image.Index(x, y)]) {
+          ++local.counts[kMasked];
+          continue;
+        }
         const SurfaceHit& hit = hits[i];
         const Eigen::Vector3d& direction = directions[i];
         if (mask_mixed) {
@@ -295,7 +302,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
           ++local.counts[kBackfacing];
           continue;
         }
-        const Incidence incidence = IncidenceAt(session.light, hit.point, hit.normal);
+        const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
         if (!incidence.lit) {
           ++local.counts[kUnlit];
           continue;
@@ -309,8 +316,8 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
           continue;
         }
         if (path.shadow_rays) {
-          const Reason shadow = ShadowTest(mesh, session.light, incidence, hit.point, hit.normal, hit.fit_rms_m,
-                                           options, &local.shadow_rays);
+          const Reason shadow =
+              ShadowTest(mesh, light, incidence, hit.point, hit.normal, hit.fit_rms_m, options, &local.shadow_rays);
           if (shadow != kNumReasons) {
             ++local.counts[shadow];
             continue;
@@ -436,6 +443,11 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     if (sample.Contains(photo.camera_from_world->Inverse().translation)) {
       ThrowError(where, "the camera centre is inside the sample");
     }
+    if (photo.role == PhotoRole::kMeasurement && !session.PhotoLight(i).has_intensity) {
+      ThrowError(where, "photo " + photo.file + " was taken under " + LightLabel(session.PhotoLight(i)) +
+                            ", which has no intensity and no calibration measures it (give the light's "
+                            "\"intensity\", or white-reference photos under it)");
+    }
   }
   const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
   bool any_sees = groups.empty();
@@ -508,6 +520,7 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
         w->decode_s = 0.0;
         reader.ReadWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1}, &w->decoded,
                           &w->image, &w->decode_s);
+        w->image.mask = ReadGroupMask(session, groups[g]);
         if (mesh_path) {
           DerenderMeshPhoto(session, groups[g].front(), w->image, rays, *mesh_path, options, &w->samples,
                             &w->mesh_stats);
@@ -577,6 +590,7 @@ bool DerenderOptions::Check(std::string* why) const {
 const std::vector<std::pair<std::string, std::string>>& RejectionReasons() {
   static const std::vector<std::pair<std::string, std::string>> kReasons = {
       {"off_sample", "the pixel's ray misses the sample (background, or a cylinder's end cap)"},
+      {"masked", "the pixel sees the sample but the photo's mask (or the session's default mask) excludes it"},
       {"mixed_pixel",
        "mesh: the pixel straddles the silhouette (a corner ray misses, or hits at a very different depth)"},
       {"occluded_by_target", "mesh: a reference marker lies between the camera and the sample"},
@@ -631,6 +645,7 @@ void DerenderPhoto(const Session& session, size_t photo_index, const RadianceIma
                    const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
                    const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected) {
   const PhotoSpec& photo = session.photos[photo_index];
+  const Light& light = session.PhotoLight(photo_index);
   const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
   const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
   const Eigen::Vector3d camera_center = world_from_camera.translation;
@@ -654,7 +669,11 @@ void DerenderPhoto(const Session& session, size_t photo_index, const RadianceIma
         ++counts[kOff];
         continue;
       }
-      const Incidence incidence = IncidenceAt(session.light, hit.point, hit.normal);
+      if (!image.mask.empty() && !image.mask[image.Index(x, y)]) {
+        ++counts[kMasked];
+        continue;
+      }
+      const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
       if (!incidence.lit) {
         ++counts[kUnlit];
         continue;

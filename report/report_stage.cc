@@ -25,6 +25,7 @@
 #include "reconstruct/merl_table.h"
 #include "reconstruct/truth_comparison.h"
 #include "report/photo_comparison.h"
+#include "report/light_photos.h"
 #include "report/photo_statistics.h"
 #include "report/report_script.h"
 #include "report/sphere_render.h"
@@ -442,6 +443,9 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   AtomicDirectory directory(out, options.overwrite);
   const fs::path tmp(directory.temporary_path());
   WritePhoto(samples_path, samples, photos[chosen.photo], chosen, models, tmp, &data, &result);
+  // Multi-light sessions (a dome, a turntable): the lights and a photo under each.
+  const nlohmann::json lights = WriteLightPhotos(samples_path, photos, tmp.string());
+  if (!lights.is_null()) data["lights"] = lights;
   WriteSpheres(models, options.render_size_px, chosen.phase, tmp, &data);
   data["incidence_plane"] = IncidencePlanes(samples, models, options.angles_deg, tmp, &result);
   if (options.explorer) data["explorer"] = ExplorerGrids(samples, models, tmp);

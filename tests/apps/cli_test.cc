@@ -118,6 +118,30 @@ TEST_F(CliTest, PhotoOfWrongSizeNamesThePhoto) {
   ExpectDerenderError({"000.png", "50x40", "96x72"});
 }
 
+// Real rigs (issue 12), bad input through the CLI: one clear error each, no output.
+TEST_F(CliTest, PhotoNamingAnUnknownLightNamesPhotoAndLights) {
+  Edit([](nlohmann::json& j) {
+    j["lights"] = {j["light"], j["light"]};
+    j["lights"][0]["id"] = "L01";
+    j["lights"][1]["id"] = "L02";
+    j.erase("light");
+    j["photos"][0]["light"] = "L01";
+    j["photos"][1]["light"] = "L07";
+  });
+  ExpectDerenderError({manifest_, "/photos/1/light", "\"L07\"", "L01, L02"});
+}
+
+TEST_F(CliTest, MaskOfTheWrongSizeNamesBothFiles) {
+  WriteImage(session_ + "/mask.png", Image(50, 40, 1), PixelFormat::kUint8);
+  Edit([](nlohmann::json& j) { j["mask"] = "mask.png"; });
+  ExpectDerenderError({"mask.png", "000.png", "50x40", "96x72"});
+}
+
+TEST_F(CliTest, LightWithoutIntensityAndNoCalibrationNamesTheLight) {
+  Edit([](nlohmann::json& j) { j["light"].erase("intensity"); });
+  ExpectDerenderError({manifest_, "/light", "has no intensity and no calibration measures it"});
+}
+
 TEST_F(CliTest, NegativeExposureNamesTheField) {
   Edit([](nlohmann::json& j) { j["photos"][0]["exposure_s"] = -0.01; });
   ExpectDerenderError({manifest_, "/photos/0/exposure_s", "positive"});
