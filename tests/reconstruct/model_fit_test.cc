@@ -94,8 +94,9 @@ TEST(ModelFit, GgxRecoversGgxMaterialAndWritesSnippets) {
   const ModelFitResult fit = FitGgx(samples, options);
   ASSERT_TRUE(fit.success);
   EXPECT_LT(RelativeRmsAgainst(*fit.brdf, *material, samples), 0.01) << fit.BriefReport();
-  EXPECT_NE(PbrtV4Material(*fit.brdf, "m").find("coateddiffuse"), std::string::npos);
-  EXPECT_NE(Mitsuba3Material(*fit.brdf, "m").find("roughplastic"), std::string::npos);
+  const RendererSnippets snippets = RendererMaterials(fit, "m");
+  EXPECT_NE(snippets.pbrt.find("coateddiffuse"), std::string::npos);
+  EXPECT_NE(snippets.mitsuba.find("roughplastic"), std::string::npos);
 }
 
 }  // namespace
