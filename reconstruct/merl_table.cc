@@ -69,9 +69,10 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
       }
     }
   }
-  local.evaluations = cells.size();
   if (effective_samples) effective_samples->assign(kMerlCells, 0.0f);
   if (domain) domain->assign(kMerlCells, 0);
+  const double margin = options.domain.theta_d_margin_deg * M_PI / 180.0;
+  const double theta_d_low = regression.theta_d_min() - margin, theta_d_high = regression.theta_d_max() + margin;
   std::mutex mutex;
   ProgressBar progress("tabulate", cells.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 512), [&](const tbb::blocked_range<size_t>& range) {
@@ -83,8 +84,13 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
       const int j = static_cast<int>((flat / kMerlPhiD) % kMerlThetaD);
       const int i = static_cast<int>(flat / (size_t(kMerlPhiD) * kMerlThetaD));
       const HalfDiffAngles angles = MerlCellCentre(i, j, k);
-      const Estimate e = regression.EvaluateAt(RegressionCoordinates(angles));
-      reliability.Add(e);
+      // Beyond the samples' theta_d range a cell is unmeasured whatever its estimate: evaluated only
+      // when --fill extrapolate wants the estimate.
+      const bool beyond = angles.theta_d < theta_d_low || angles.theta_d > theta_d_high;
+      const Estimate e = beyond && options.fill != FillMode::kExtrapolate
+                             ? Estimate()
+                             : regression.EvaluateAt(RegressionCoordinates(angles));
+      if (!beyond || options.fill == FillMode::kExtrapolate) reliability.Add(e);
       DomainClass c = ClassifyEstimate(e, angles.theta_d, regression, options.domain);
       if (e.effective_samples < options.min_effective_samples) c = DomainClass::kUnmeasured;
       Eigen::Vector3d value = e.value;
@@ -118,6 +124,7 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
     local.domain.Merge(counts);
   });
   progress.Finish();
+  local.evaluations = local.reliability.evaluations;
   local.seconds = timer.ElapsedSeconds();
   local.success = true;
   if (summary) *summary = local;

@@ -80,31 +80,6 @@ double RelativeRms(const BrdfModel& model, const std::vector<FitSample>& samples
   return count ? std::sqrt(sum / count) : 0.0;
 }
 
-// One channel's Lafortune fit from one start; returns the final cost.
-template <int kLobes>
-double SolveLafortuneChannel(const std::vector<FitSample>& samples, int channel, const ModelFitOptions& options,
-                             double* parameters) {
-  using Residual = LafortuneResidual<kLobes>;
-  ceres::Problem problem;
-  for (const FitSample& s : samples) {
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Residual, 1, Residual::kParameters>(
-                                 new Residual(s.wi, s.wo, s.value[channel], s.sigma[channel])),
-                             new ceres::HuberLoss(options.huber_scale), parameters);
-  }
-  problem.SetParameterLowerBound(parameters, 0, 0.0);
-  for (int k = 0; k < kLobes; ++k) {
-    for (int j = 1; j <= 2; ++j) {
-      problem.SetParameterLowerBound(parameters, 3 * k + j, -20.0);
-      problem.SetParameterUpperBound(parameters, 3 * k + j, 20.0);
-    }
-    problem.SetParameterLowerBound(parameters, 3 * k + 3, 0.5);
-    problem.SetParameterUpperBound(parameters, 3 * k + 3, 2000.0);
-  }
-  ceres::Solver::Summary summary;
-  ceres::Solve(SolverOptions(options), &problem, &summary);
-  return summary.final_cost;
-}
-
 // Penalty keeping a lobe's maximum anywhere, max(|Cxy|, |Cz|)^n, below `cap`: the excess of n log(max)
 // over log(cap), weighted heavily (the data residuals are in sigmas).
 template <int kLobes>
@@ -154,11 +129,9 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
     for (int k = 0; k < kLobes; ++k) {
       for (int j = 0; j < 3; ++j) p[1 + 3 * k + j] = starts_table[start][k][j];
     }
-    using Residual = LafortuneResidual<kLobes>;
     ceres::Problem problem;
     for (const FitSample& s : samples) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Residual, 1, Residual::kParameters>(
-                                   new Residual(s.wi, s.wo, s.value[c], s.sigma[c])),
+      problem.AddResidualBlock(new LafortuneAnalyticResidual<kLobes>(s.wi, s.wo, s.value[c], s.sigma[c]),
                                new ceres::HuberLoss(options.huber_scale), p);
     }
     const double cap = std::max(options.max_lobe_ratio * maximum[c], 1e-3);
@@ -415,23 +388,25 @@ std::string Rgb(const Eigen::Vector3d& v, const char* separator) {
 }  // namespace
 
 double FresnelDiffuseReflectance(double eta) {
-  if (eta < 1.0) {
-    const double e = 1.0 / eta;
-    return 0.919317 - 3.4793 * e + 6.75335 * e * e - 7.80989 * e * e * e + 4.98554 * e * e * e * e -
-           1.36881 * e * e * e * e * e;
-  }
-  return -9.23372 + eta * (22.2272 + eta * (-20.9292 + eta * (10.2291 + eta * (-2.54396 + eta * 0.254913))));
+  if (eta < 1.0) return -1.4399 * eta * eta + 0.7099 * eta + 0.6681 + 0.0636 / eta;  // Egan and Hilgeman
+  const double e = 1.0 / eta;  // d'Eon and Irving
+  return 0.919317 + e * (-3.4793 + e * (6.75335 + e * (-7.80989 + e * (4.98554 + e * -1.36881))));
 }
 
 PlasticParameters PlasticFromGgx(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& f0, double alpha) {
   PlasticParameters p;
   p.eta = IorFromF0(f0.mean());
   p.alpha = alpha;
-  // roughplastic's diffuse term: rho / (1 - Fdr_int) / eta^2 * t(cos_i) t(cos_o) / pi, t = 1 - F. The
-  // fitted diffuse is matched at 35 degrees (the middle of 0 to 70) on both sides.
+  // A diffuse base under a dielectric coating, with the inter-reflections between them (roughplastic
+  // with nonlinear = true): f_d = rho / (1 - rho Fdr_int) / eta^2 t(cos_i) t(cos_o) / pi, t = 1 - F.
+  // Solved for rho so that f_d = d / pi at 35 degrees (the middle of 0 to 70) on both sides.
   const double t = 1.0 - DielectricFresnel(std::cos(35.0 * M_PI / 180.0), p.eta);
   const double fdr = FresnelDiffuseReflectance(1.0 / p.eta);
-  p.base_albedo = (diffuse_albedo * p.eta * p.eta * (1.0 - fdr) / (t * t)).cwiseMin(1.0);
+  const double e2 = p.eta * p.eta;
+  for (int c = 0; c < 3; ++c) {
+    const double d = diffuse_albedo[c];
+    p.base_albedo[c] = std::min(1.0, d * e2 / (t * t + d * e2 * fdr));
+  }
   return p;
 }
 
@@ -487,6 +462,7 @@ RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::str
             << "    <float name=\"alpha\" value=\"" << p.alpha << "\"/>\n"
             << "    <float name=\"int_ior\" value=\"" << plastic.eta << "\"/>\n"
             << "    <float name=\"ext_ior\" value=\"1.0\"/>\n"
+            << "    <boolean name=\"nonlinear\" value=\"true\"/>\n"
             << "    <rgb name=\"diffuse_reflectance\" value=\"" << Rgb(plastic.base_albedo, ", ") << "\"/>\n"
             << "</bsdf>\n";
   }

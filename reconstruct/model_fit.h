@@ -20,7 +20,7 @@ namespace ibrdf {
 
 struct ModelFitOptions {
   int lafortune_lobes = 3;       // 1 to 3 lobes
-  size_t max_samples = 40000;    // a random subset (fixed seed) of at most this many samples is fitted
+  size_t max_samples = 10000;    // a random subset (fixed seed) of at most this many samples is fitted
   double relative_floor = 0.01;  // sigma is at least this fraction of the value (noise-free samples)
   double absolute_floor = 1e-4;  // and at least this (1/sr)
   double huber_scale = 3.0;      // Huber loss threshold, in sigmas
@@ -70,8 +70,9 @@ nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& nam
 // Renderer materials for a GGX fit, named `name`: a metal (F0 above 0.2 with a diffuse albedo under a
 // tenth of it) as a rough conductor keeping its colour (pbrt-v4 "conductor" with "reflectance", Mitsuba
 // 3 "roughconductor" with eta = 1 and k from F0), anything else as a rough plastic (Mitsuba 3
-// "roughplastic", pbrt-v4 "coateddiffuse") with one IOR from the mean F0 and the base albedo inverted
-// for the coating (roughplastic's closed form), so the rendered diffuse term is the fitted one.
+// "roughplastic" with nonlinear inter-reflection, pbrt-v4 "coateddiffuse") with one IOR from the mean F0
+// and the base albedo inverted for the coating (roughplastic's closed form), so the rendered diffuse
+// term is the fitted one at 35 degrees.
 struct RendererSnippets {
   std::string kind;  // "conductor" or "plastic"
   std::string pbrt, mitsuba;            // the snippets' text
@@ -86,8 +87,9 @@ struct PlasticParameters {
   Eigen::Vector3d base_albedo = Eigen::Vector3d::Zero();      // under the coating (inverted)
 };
 PlasticParameters PlasticFromGgx(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& f0, double alpha);
-// The internal diffuse Fresnel reflectance of a dielectric boundary of relative IOR eta, as Mitsuba 3's
-// fresnel_diffuse_reflectance (d'Eon and Irving's polynomial fit).
+// The diffuse Fresnel reflectance of a dielectric boundary of relative IOR eta, as Mitsuba 3's
+// fresnel_diffuse_reflectance (Egan and Hilgeman's fit below 1, d'Eon and Irving's above); the
+// coating's internal reflectance is FresnelDiffuseReflectance(1 / eta).
 double FresnelDiffuseReflectance(double eta);
 
 }  // namespace ibrdf
