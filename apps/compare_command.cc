@@ -8,8 +8,8 @@
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
-#include "core/sample_file.h"
 #include "core/merl_brdf.h"
+#include "core/sample_file.h"
 #include "reconstruct/reconstruction_error.h"
 #include "reconstruct/truth_comparison.h"
 

@@ -2,8 +2,8 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/logging.h"
-#include "reconstruct/sample_domain.h"
 #include "reconstruct/reconstruction_stage.h"
+#include "reconstruct/sample_domain.h"
 
 namespace ibrdf {
 namespace {
@@ -83,7 +83,8 @@ void AddReconstructCommand(CLI::App& app) {
     StageLog stage("reconstruct");
     ReconstructOptions& options = args->o;
     if (!args->material.empty()) {
-      if (!args->samples.empty()) ThrowError("--material", "evaluates a material without samples: drop " + args->samples);
+      if (!args->samples.empty())
+        ThrowError("--material", "evaluates a material without samples: drop " + args->samples);
       if (options.eval_file.empty()) ThrowError("--material", "needs --eval POINTS.npy");
       RequireWritableOutput(args->out, options.overwrite, {args->material, options.eval_file});
       EvaluateMaterial(args->material, options, args->out);

@@ -70,9 +70,9 @@ struct NormalEquations {
   double a2[kMaxCoefficients][kMaxCoefficients] = {};  // with squared weights: the estimate's variance
   double b[kMaxCoefficients][3] = {};
   double sum_w = 0.0, sum_w2 = 0.0;
-  float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};  // range of the neighbours' values
-  uint32_t count = 0;                             // samples with non-zero weight
-  uint32_t points = 0;                            // points (bins) with non-zero weight
+  float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};                   // range of the neighbours' values
+  uint32_t count = 0;                                              // samples with non-zero weight
+  uint32_t points = 0;                                             // points (bins) with non-zero weight
   float nearest_squared = std::numeric_limits<float>::infinity();  // of the points with non-zero weight
 
   // nanoflann's result-set interface.
@@ -159,7 +159,7 @@ struct LocalRegression::Impl {
   std::unique_ptr<Tree> tree;
   std::vector<Mirror> mirrors;  // the identity first
   bool fold_reciprocity = false, fold_bilateral = false;
-  double scale_h = 1.0, scale_d = 1.0;  // 1 / radius, per coordinate
+  double scale_h = 1.0, scale_d = 1.0;          // 1 / radius, per coordinate
   double theta_d_min = 0.0, theta_d_max = 0.0;  // radians, over the kept samples
 
   // Maps (u, v) into the canonical part of the domain.

@@ -26,10 +26,10 @@ struct TabulateOptions {
 
 struct TabulateSummary {
   bool success = false;
-  ReliabilityCounts reliability;     // of the evaluated cells
-  DomainCounts domain;               // cells within the theta limit, by class (and filled)
-  uint64_t cells_below_horizon = 0;  // beyond max_theta_deg (or the horizon): always -1
-  uint64_t evaluations = 0;          // distinct regression evaluations (bilateral mirrors share one)
+  ReliabilityCounts reliability;                        // of the evaluated cells
+  DomainCounts domain;                                  // cells within the theta limit, by class (and filled)
+  uint64_t cells_below_horizon = 0;                     // beyond max_theta_deg (or the horizon): always -1
+  uint64_t evaluations = 0;                             // distinct regression evaluations (bilateral mirrors share one)
   double theta_d_min_deg = 0.0, theta_d_max_deg = 0.0;  // the samples' theta_d range
   FillMode fill = FillMode::kNone;
   std::string fill_model;  // the model that filled unmeasured cells (kModel)

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include <Eigen/Core>
 #include <ceres/sized_cost_function.h>
+#include <Eigen/Core>
 
 namespace ibrdf {
 

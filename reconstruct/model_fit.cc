@@ -212,12 +212,8 @@ std::string ModelFitResult::BriefReport() const {
 }
 
 nlohmann::json ToJson(const ModelFitResult& fit) {
-  return {{"model", fit.model},
-          {"rel_rms_vs_samples", fit.rel_rms},
-          {"samples", fit.samples_used},
-          {"starts", fit.starts},
-          {"at_bound", fit.at_bound},
-          {"max_directional_albedo", fit.max_albedo},
+  return {{"model", fit.model},    {"rel_rms_vs_samples", fit.rel_rms}, {"samples", fit.samples_used},
+          {"starts", fit.starts},  {"at_bound", fit.at_bound},          {"max_directional_albedo", fit.max_albedo},
           {"seconds", fit.seconds}};
 }
 
@@ -389,7 +385,7 @@ std::string Rgb(const Eigen::Vector3d& v, const char* separator) {
 
 double FresnelDiffuseReflectance(double eta) {
   if (eta < 1.0) return -1.4399 * eta * eta + 0.7099 * eta + 0.6681 + 0.0636 / eta;  // Egan and Hilgeman
-  const double e = 1.0 / eta;  // d'Eon and Irving
+  const double e = 1.0 / eta;                                                        // d'Eon and Irving
   return 0.919317 + e * (-3.4793 + e * (6.75335 + e * (-7.80989 + e * (4.98554 + e * -1.36881))));
 }
 

@@ -74,7 +74,7 @@ nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& nam
 // and the base albedo inverted for the coating (roughplastic's closed form), so the rendered diffuse
 // term is the fitted one at 35 degrees.
 struct RendererSnippets {
-  std::string kind;  // "conductor" or "plastic"
+  std::string kind;                     // "conductor" or "plastic"
   std::string pbrt, mitsuba;            // the snippets' text
   std::string pbrt_file, mitsuba_file;  // suggested file names: NAME.pbrt, NAME.xml
 };
@@ -82,9 +82,9 @@ RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::str
 
 // The snippets' parameters, for tests that evaluate them as the renderers do.
 struct PlasticParameters {
-  double eta = 1.5;                                            // interior IOR (exterior 1)
-  double alpha = 0.1;                                          // GGX roughness, not remapped
-  Eigen::Vector3d base_albedo = Eigen::Vector3d::Zero();      // under the coating (inverted)
+  double eta = 1.5;                                       // interior IOR (exterior 1)
+  double alpha = 0.1;                                     // GGX roughness, not remapped
+  Eigen::Vector3d base_albedo = Eigen::Vector3d::Zero();  // under the coating (inverted)
 };
 PlasticParameters PlasticFromGgx(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& f0, double alpha);
 // The diffuse Fresnel reflectance of a dielectric boundary of relative IOR eta, as Mitsuba 3's

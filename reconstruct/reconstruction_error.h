@@ -44,9 +44,9 @@ nlohmann::json ToJson(const ReconstructionError& error);
 // hemisphere up to max_theta_deg (fixed seed); a lookup hits a valid cell when the cell holds data
 // (>= 0); among hits, the relative error against the truth (where the truth is positive).
 struct MerlLookupCheck {
-  size_t lookups = 0;  // direction pairs drawn
-  size_t hits = 0;     // lookups that landed on a cell with data
-  size_t scored = 0;   // hits scored (truth positive in every channel)
+  size_t lookups = 0;                                // direction pairs drawn
+  size_t hits = 0;                                   // lookups that landed on a cell with data
+  size_t scored = 0;                                 // hits scored (truth positive in every channel)
   Eigen::Vector3d median = Eigen::Vector3d::Zero();  // of |f - f_true| / f_true among hits
   Eigen::Vector3d p95 = Eigen::Vector3d::Zero();
   double p95_all = 0.0;  // over the channels pooled

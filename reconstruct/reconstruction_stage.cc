@@ -153,30 +153,28 @@ void TabulateAndScore(const LocalRegression& regression, const ReconstructOption
   WriteNpyArray(tmp + "/brdf.npy", MerlToArray(table), {90, 90, 180, 3});
   WriteNpyArray(tmp + "/effective_samples.npy", ess, {90, 90, 180});
   WriteBytes(tmp + "/domain.npy", domain, {90, 90, 180});
-  nlohmann::json table_json = {
-      {"cells_measured", tabulated.domain.measured},
-      {"cells_interpolated", tabulated.domain.interpolated},
-      {"cells_unmeasured", tabulated.domain.unmeasured},
-      {"cells_unmeasured_filled", tabulated.domain.filled},
-      {"cells_beyond_theta_limit", tabulated.cells_below_horizon},
-      {"max_theta_deg", options.tabulate.max_theta_deg},
-      {"samples_theta_d_deg", {tabulated.theta_d_min_deg, tabulated.theta_d_max_deg}},
-      {"fill", FillModeName(options.tabulate.fill)},
-      {"domain_rules",
-       {{"measured_nearest_kernel_radii", options.tabulate.domain.measured_nearest},
-        {"max_centroid_offset_kernel_radii", options.tabulate.domain.max_centroid_offset},
-        {"theta_d_margin_deg", options.tabulate.domain.theta_d_margin_deg}}}};
+  nlohmann::json table_json = {{"cells_measured", tabulated.domain.measured},
+                               {"cells_interpolated", tabulated.domain.interpolated},
+                               {"cells_unmeasured", tabulated.domain.unmeasured},
+                               {"cells_unmeasured_filled", tabulated.domain.filled},
+                               {"cells_beyond_theta_limit", tabulated.cells_below_horizon},
+                               {"max_theta_deg", options.tabulate.max_theta_deg},
+                               {"samples_theta_d_deg", {tabulated.theta_d_min_deg, tabulated.theta_d_max_deg}},
+                               {"fill", FillModeName(options.tabulate.fill)},
+                               {"domain_rules",
+                                {{"measured_nearest_kernel_radii", options.tabulate.domain.measured_nearest},
+                                 {"max_centroid_offset_kernel_radii", options.tabulate.domain.max_centroid_offset},
+                                 {"theta_d_margin_deg", options.tabulate.domain.theta_d_margin_deg}}}};
   if (!tabulated.fill_model.empty()) table_json["fill_model"] = tabulated.fill_model;
   WriteJsonFile(tmp + "/brdf.json",
                 {{"format", "ibrdf-merl-table"},
                  {"version", 1},
                  {"files", {"brdf.binary", "brdf.npy", "domain.npy", "effective_samples.npy"}},
                  {"domain_classes", {{"0", "unmeasured"}, {"1", "interpolated"}, {"2", "measured"}}},
-                 {"unmeasured_value",
-                  options.tabulate.fill == FillMode::kNone
-                      ? "-1 (MERL's no data)"
-                      : std::string("filled by ") + FillModeName(options.tabulate.fill) +
-                            " where possible (domain.npy 0 with a value >= 0: invented), else -1"},
+                 {"unmeasured_value", options.tabulate.fill == FillMode::kNone
+                                          ? "-1 (MERL's no data)"
+                                          : std::string("filled by ") + FillModeName(options.tabulate.fill) +
+                                                " where possible (domain.npy 0 with a value >= 0: invented), else -1"},
                  {"table", table_json}});
   (*timings)["write_s"] = timer.ElapsedSeconds();
   summary["regression"]["reliability"] = ToJson(tabulated.reliability);

@@ -105,7 +105,7 @@ TEST_F(RealStyleSession, NoCellBeyondTheSamplesThetaDIsMeasuredAndTheMaskAgreesW
       }
     }
   }
-  EXPECT_GT(beyond, 500000u);  // most of the table lies beyond theta_d = 25 degrees
+  EXPECT_GT(beyond, 500000u);            // most of the table lies beyond theta_d = 25 degrees
   EXPECT_EQ(unmeasured_with_value, 0u);  // no fill: unmeasured cells hold MERL's "no data"
   EXPECT_EQ(table.at("cells_unmeasured").get<uint64_t>(), counts[0]);
   EXPECT_EQ(table.at("cells_interpolated").get<uint64_t>(), counts[1]);
