@@ -26,7 +26,7 @@ void AddSynthCommand(CLI::App& app) {
   // An option whose default --help shows.
   auto add = [&c](const char* n, auto& v, const char* h) { return c.add_option(n, v, h)->capture_default_str(); };
   c.add_option("--out", args->out, "Session folder to write (must not exist unless --overwrite)")->required();
-  c.add_option("--material", args->material, "Material JSON (samples/materials/*.json)")
+  c.add_option("--material", args->material, "Material JSON (samples/materials/*.json) or a MERL table (.binary)")
       ->required()
       ->check(CLI::ExistingFile);
   add("--sample", r.sample, "sphere or cylinder")->check(CLI::IsMember({"sphere", "cylinder"}));

@@ -20,7 +20,7 @@ namespace ibrdf {
 
 struct ModelFitOptions {
   int lafortune_lobes = 3;       // 1 to 3 lobes
-  size_t max_samples = 10000;    // a random subset (fixed seed) of at most this many samples is fitted
+  size_t max_samples = 20000;    // a random subset (fixed seed) of at most this many samples is fitted
   double relative_floor = 0.01;  // sigma is at least this fraction of the value (noise-free samples)
   double absolute_floor = 1e-4;  // and at least this (1/sr)
   double huber_scale = 3.0;      // Huber loss threshold, in sigmas
