@@ -4,6 +4,7 @@
 #include "core/logging.h"
 #include "core/sample_file.h"
 #include "reconstruct/reconstruction_stage.h"
+#include "reconstruct/sample_domain.h"
 
 namespace ibrdf {
 namespace {
@@ -13,21 +14,23 @@ void AddReconstructCommand(CLI::App& app) {
       "reconstruct",
       "Reconstruct a smooth isotropic BRDF from samples by local polynomial regression (elliptical kernel\n"
       "in half/difference coordinates, folded by reciprocity and bilateral symmetry); writes into DIR:\n"
-      "brdf.binary (MERL 90x90x180), brdf.npy (90,90,180,3; -1 unmeasured), effective_samples.npy,\n"
-      "lafortune.json and ggx.json (material files), ggx.pbrt and ggx.xml (pbrt-v4, Mitsuba 3) and\n"
-      "summary.json (timings, reliability counts, fit errors; error against the truth with --truth).\n"
+      "brdf.binary (MERL 90x90x180), brdf.npy (90,90,180,3; -1 unmeasured), domain.npy (per cell: 2\n"
+      "measured, 1 interpolated, 0 unmeasured), brdf.json (the table's counts and fill), effective_samples.npy,\n"
+      "lafortune.json and ggx.json (material files), NAME.pbrt and NAME.xml (pbrt-v4, Mitsuba 3) and\n"
+      "summary.json (timings, counts by class, fit errors; error against the truth with --truth).\n"
       "With --eval POINTS.npy (float64, N x 3: theta_i, theta_e, delta_phi in radians) also eval.npy (N x 3\n"
-      "RGB values, -1 where unsupported) and, with --truth, eval_truth.npy (the true values there).\n"
+      "RGB values, -1 where unmeasured unless --fill), eval_domain.npy (the class per point) and, with\n"
+      "--truth, eval_truth.npy (the true values there). --material M --eval P evaluates a material instead.\n"
       "--bandwidth loo|gcv selects the kernel radii (both scaled by each of --bandwidth-scales) by\n"
       "leave-one-out or generalized cross-validation; the criterion curve goes to the log and summary.json.");
   struct Args {
-    std::string samples, out, bandwidth = "given";
+    std::string samples, out, bandwidth = "given", fill = "none", material;
     ReconstructOptions o;
     bool no_fold = false, no_fits = false, linear_values = false;
   };
   auto args = std::make_shared<Args>();
   ReconstructOptions& o = args->o;
-  command->add_option("samples", args->samples, "Sample file (.npy) from `ibrdf derender`")->required();
+  command->add_option("samples", args->samples, "Sample file (.npy) from `ibrdf derender` (not with --material)");
   command->add_option("--out", args->out, "Output folder (created; replaced only with --overwrite)")->required();
   command->add_option("--degree", o.regression.degree, "Local polynomial degree: 0, 1 or 2")->capture_default_str();
   command->add_option("--radius-h-deg", o.regression.radius_h_deg, "Kernel radius along the sheets (theta_h)")
@@ -66,16 +69,40 @@ void AddReconstructCommand(CLI::App& app) {
   command->add_option("--truth", o.truth_file, "truth.json (or a material file) to score the reconstruction against");
   command->add_option("--eval", o.eval_file,
                       "Also evaluate at these points: .npy float64 (N, 3) theta_i, theta_e, delta_phi (radians)");
+  command->add_option("--material", args->material,
+                      "With --eval and no samples: evaluate this material file, truth.json or MERL table (.binary)\n"
+                      "at the points (eval.npy; no regression)");
+  command
+      ->add_option("--fill", args->fill,
+                   "Unmeasured cells and points: 'none' (-1, MERL's no data), 'model' (the chosen fit) or\n"
+                   "'extrapolate' (the regression's own estimate); recorded in summary.json and brdf.json")
+      ->capture_default_str();
+  command->add_option("--name", o.name, "Name of the fitted materials (default: the samples' session folder)");
   command->add_flag("--eval-only", o.eval_only, "With --eval: skip the MERL table and the fits (for benchmarks)");
   command->add_flag("--overwrite", o.overwrite, "Replace an existing output folder");
   command->callback([args] {
     StageLog stage("reconstruct");
     ReconstructOptions& options = args->o;
+    if (!args->material.empty()) {
+      if (!args->samples.empty())
+        ThrowError("--material", "evaluates a material without samples: drop " + args->samples);
+      if (options.eval_file.empty()) ThrowError("--material", "needs --eval POINTS.npy");
+      RequireWritableOutput(args->out, options.overwrite, {args->material, options.eval_file});
+      EvaluateMaterial(args->material, options, args->out);
+      return;
+    }
+    if (args->samples.empty()) ThrowError("reconstruct", "a sample file is required (or --material with --eval)");
     RequireWritableOutput(args->out, options.overwrite,
                           {args->samples, SidecarPath(args->samples), options.truth_file, options.eval_file});
+    if (!ParseFillMode(args->fill, &options.tabulate.fill)) {
+      ThrowError("--fill", "expected 'none', 'model' or 'extrapolate', got '" + args->fill + "'");
+    }
     if (args->no_fold) options.regression.fold_reciprocity = options.regression.fold_bilateral = false;
     if (args->linear_values) options.regression.log_space = false;
     options.fits = !args->no_fits;
+    if (options.tabulate.fill == FillMode::kModel && (!options.fits || options.eval_only)) {
+      ThrowError("--fill model", "fills with the chosen fit: drop --no-fits / --eval-only");
+    }
     // The option groups checked here too, so that a message names the flags.
     std::string why;
     if (!options.regression.Check(&why)) ThrowError("--degree/--radius", why);

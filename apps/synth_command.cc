@@ -2,6 +2,7 @@
 #include "apps/commands.h"
 #include "core/brdf_model.h"
 #include "core/logging.h"
+#include "core/merl_brdf.h"
 #include "synth/synth_request.h"
 #include "synth/synthetic.h"
 
@@ -26,7 +27,7 @@ void AddSynthCommand(CLI::App& app) {
   // An option whose default --help shows.
   auto add = [&c](const char* n, auto& v, const char* h) { return c.add_option(n, v, h)->capture_default_str(); };
   c.add_option("--out", args->out, "Session folder to write (must not exist unless --overwrite)")->required();
-  c.add_option("--material", args->material, "Material JSON (samples/materials/*.json)")
+  c.add_option("--material", args->material, "Material JSON (samples/materials/*.json) or a MERL table (.binary)")
       ->required()
       ->check(CLI::ExistingFile);
   add("--sample", r.sample, "sphere or cylinder")->check(CLI::IsMember({"sphere", "cylinder"}));
@@ -108,6 +109,11 @@ void AddSynthCommand(CLI::App& app) {
     const std::unique_ptr<BrdfModel> material = LoadMaterial(args->material);
     const SynthSummary summary = WriteSyntheticSession(options, *material, args->material, args->out, args->overwrite);
     Log(1, summary.BriefReport());
+    if (const auto* merl = dynamic_cast<const MerlBrdf*>(material.get()); merl && merl->no_data_lookups() > 0) {
+      Log(0, "warning: " + std::to_string(merl->no_data_lookups()) + " of " + std::to_string(merl->lookups()) +
+                 " BRDF lookups in " + args->material + " hit cells without data (MERL's -1), rendered as 0; " +
+                 std::to_string(merl->cells_without_data()) + " of its cells have no data");
+    }
     Log(1, "session written to " + args->out + "/session.json (truth in " + args->out + "/truth.json)");
     if (request.charuco_photos > 0) {
       const CharucoPhotosSummary photos = WriteSessionCharucoPhotos(args->out, request.charuco_photos, options.seed);

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "core/json_reader.h"
+#include "core/merl_brdf.h"
 
 namespace ibrdf {
 
@@ -125,13 +127,21 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
     const double alpha = object.Number("alpha");
     if (!(alpha > 0.0 && alpha <= 1.0)) ThrowError(object.Where("alpha"), "expected 0 < alpha <= 1");
     brdf = std::make_unique<GgxBrdf>(diffuse, f0, alpha);
+  } else if (model == "merl") {
+    std::filesystem::path table = object.String("file");
+    if (table.is_relative() && !file.empty()) table = std::filesystem::path(file).parent_path() / table;
+    brdf = std::make_unique<MerlBrdf>(table.string());
   } else {
-    ThrowError(object.Where("model"), "unknown model \"" + model + "\" (expected lambertian, lafortune or ggx)");
+    ThrowError(object.Where("model"),
+               "unknown model \"" + model + "\" (expected lambertian, lafortune, ggx or merl)");
   }
   object.Finish();
   return brdf;
 }
 
-std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path) { return MaterialFromJson(ReadJsonFile(path), path); }
+std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path) {
+  if (IsMerlPath(path)) return std::make_unique<MerlBrdf>(path);
+  return MaterialFromJson(ReadJsonFile(path), path);
+}
 
 }  // namespace ibrdf

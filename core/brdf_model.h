@@ -11,6 +11,7 @@
 //   ggx:        "diffuse_albedo": [r,g,b], "specular_f0": [r,g,b], "alpha": a
 //               f = diffuse_albedo/pi + D(h) G(wi, wo) F(wi.h) / (4 cos_i cos_o), GGX D (Walter et al.
 //               2007), separable Smith shadowing for GGX, Schlick's Fresnel
+//   merl:       "file": "x.binary"  a MERL table (core/merl_brdf.h), looked up as the MERL reader does
 // plus optional "name" and "description" strings.
 #pragma once
 
@@ -83,7 +84,7 @@ class GgxBrdf : public BrdfModel {
 std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const std::string& file,
                                             const std::string& pointer = "");
 
-// Reads a material file (see the format above).
+// Reads a material file (see the format above), or a MERL table (a ".binary" path, core/merl_brdf.h).
 std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path);
 
 }  // namespace ibrdf

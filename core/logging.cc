@@ -66,8 +66,13 @@ void ProgressBar::Draw(uint64_t done, bool final) {
   line << "   " << label_ << " [" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << done << "/"
        << total_;
   char seconds[32];
-  std::snprintf(seconds, sizeof(seconds), " %.1f s", timer_.ElapsedSeconds());
+  const double elapsed = timer_.ElapsedSeconds();
+  std::snprintf(seconds, sizeof(seconds), " %.1f s", elapsed);
   line << seconds;
+  if (!final && done > 0 && done < total_) {  // the time estimate: the rate so far, extrapolated
+    std::snprintf(seconds, sizeof(seconds), ", about %.0f s left", elapsed * double(total_ - done) / double(done));
+    line << seconds;
+  }
   if (tty_) {
     std::cerr << "\r" << line.str() << (final ? "\n" : "") << std::flush;
   } else {

@@ -70,9 +70,10 @@ struct NormalEquations {
   double a2[kMaxCoefficients][kMaxCoefficients] = {};  // with squared weights: the estimate's variance
   double b[kMaxCoefficients][3] = {};
   double sum_w = 0.0, sum_w2 = 0.0;
-  float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};  // range of the neighbours' values
-  uint32_t count = 0;                             // samples with non-zero weight
-  uint32_t points = 0;                            // points (bins) with non-zero weight
+  float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};                   // range of the neighbours' values
+  uint32_t count = 0;                                              // samples with non-zero weight
+  uint32_t points = 0;                                             // points (bins) with non-zero weight
+  float nearest_squared = std::numeric_limits<float>::infinity();  // of the points with non-zero weight
 
   // nanoflann's result-set interface.
   float worstDist() const { return radius_squared; }
@@ -128,6 +129,7 @@ struct NormalEquations {
     }
     sum_w += nw;
     sum_w2 += nw2;
+    nearest_squared = std::min(nearest_squared, distance_squared);
     count += static_cast<uint32_t>(n);
     ++points;
     return true;
@@ -139,6 +141,7 @@ struct NormalEquations {
     std::fill(std::begin(self_basis), std::end(self_basis), 0.0);
     sum_w = sum_w2 = 0.0;
     count = points = 0;
+    nearest_squared = std::numeric_limits<float>::infinity();
   }
 };
 
@@ -156,7 +159,8 @@ struct LocalRegression::Impl {
   std::unique_ptr<Tree> tree;
   std::vector<Mirror> mirrors;  // the identity first
   bool fold_reciprocity = false, fold_bilateral = false;
-  double scale_h = 1.0, scale_d = 1.0;  // 1 / radius, per coordinate
+  double scale_h = 1.0, scale_d = 1.0;          // 1 / radius, per coordinate
+  double theta_d_min = 0.0, theta_d_max = 0.0;  // radians, over the kept samples
 
   // Maps (u, v) into the canonical part of the domain.
   void Fold(double* u, double* v) const {
@@ -372,6 +376,15 @@ LocalRegression::LocalRegression(const std::vector<BrdfSample>& samples, const L
   impl.values.shrink_to_fit();
   impl.ranges.shrink_to_fit();
   impl.counts.shrink_to_fit();
+  if (kept > 0) {
+    float low = xyz[2], high = xyz[2];
+    for (size_t i = 1; i < kept; ++i) {
+      low = std::min(low, xyz[3 * i + 2]);
+      high = std::max(high, xyz[3 * i + 2]);
+    }
+    impl.theta_d_min = low / impl.scale_d;
+    impl.theta_d_max = high / impl.scale_d;
+  }
   impl.sample_xyz = std::move(xyz);
   impl.sample_values = std::move(values);
   impl.tree = std::make_unique<Tree>(3, impl.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(24));
@@ -383,6 +396,10 @@ LocalRegression::~LocalRegression() = default;
 size_t LocalRegression::size() const { return impl_->sample_values.size() / 3; }
 
 size_t LocalRegression::points() const { return impl_->counts.size(); }
+
+double LocalRegression::theta_d_min() const { return impl_->theta_d_min; }
+
+double LocalRegression::theta_d_max() const { return impl_->theta_d_max; }
 
 Estimate LocalRegression::Evaluate(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const {
   return EvaluateAt(RegressionCoordinates(wi, wo));
@@ -440,6 +457,7 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
   estimate.centroid_offset = static_cast<float>(
       growth * std::sqrt(eq.a[0][1] * eq.a[0][1] + eq.a[0][2] * eq.a[0][2] + eq.a[0][3] * eq.a[0][3]) / eq.sum_w);
   estimate.effective_samples = static_cast<float>(eq.sum_w * eq.sum_w / eq.sum_w2);
+  estimate.nearest = std::sqrt(eq.nearest_squared);  // the tree is in given-radius units
   for (int degree = options_.degree; degree >= 0; --degree) {
     const int m = kCoefficients[degree];
     Eigen::Vector3d value;

@@ -28,6 +28,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -100,6 +101,9 @@ struct Estimate {
   // given, before growth). Inside sampled territory it is small; a query beside a single sheet (a
   // cylinder's incidence plane) or beyond the edge of the data is an extrapolation and has a large one.
   float centroid_offset = 0.0f;
+  // Distance from the query to the nearest point of the regression (a bin's centroid, or a sample
+  // without binning) inside the final support, in kernel radii as given; infinity when there is none.
+  float nearest = std::numeric_limits<float>::infinity();
   uint32_t neighbors = 0;  // samples with non-zero weight (mirrored images included)
   int8_t degree = -1;      // degree used; -1 when unsupported
   EstimateStatus status = EstimateStatus::kUnsupported;
@@ -168,6 +172,9 @@ class LocalRegression {
   size_t size() const;    // samples used
   size_t points() const;  // points in the kd-tree: occupied bins (or samples without binning)
   uint64_t skipped_samples() const { return skipped_; }
+  // The range of theta_d (radians) the samples cover; both 0 without samples.
+  double theta_d_min() const;
+  double theta_d_max() const;
   const LocalRegressionOptions& options() const { return options_; }
 
  private:

@@ -3,7 +3,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <fstream>
+#include <mutex>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "core/error.h"
 #include "core/file_util.h"
@@ -11,134 +14,45 @@
 
 namespace ibrdf {
 
-const double kMerlScale[3] = {1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0};
-
-// The three index functions follow BRDFRead.cpp line by line (including its arithmetic order), so a
-// direction lands in the same cell as in the reader.
-int MerlThetaHalfIndex(double theta_h) {
-  if (theta_h <= 0.0) return 0;
-  const double theta_half_deg = (theta_h / (M_PI / 2.0)) * kMerlThetaH;
-  const double temp = std::sqrt(theta_half_deg * kMerlThetaH);
-  int index = static_cast<int>(temp);
-  if (index < 0) index = 0;
-  if (index >= kMerlThetaH) index = kMerlThetaH - 1;
-  return index;
-}
-
-int MerlThetaDiffIndex(double theta_d) {
-  int index = static_cast<int>(theta_d / (M_PI * 0.5) * kMerlThetaD);
-  if (index < 0) return 0;
-  if (index < kMerlThetaD - 1) return index;
-  return kMerlThetaD - 1;
-}
-
-int MerlPhiDiffIndex(double phi_d) {
-  if (phi_d < 0.0) phi_d += M_PI;
-  int index = static_cast<int>(phi_d / M_PI * (2 * kMerlPhiD) / 2);
-  if (index < 0) return 0;
-  if (index < kMerlPhiD - 1) return index;
-  return kMerlPhiD - 1;
-}
-
-HalfDiffAngles MerlCellCentre(int i, int j, int k) {
-  HalfDiffAngles angles;
-  const double t = (i + 0.5) / kMerlThetaH;
-  angles.theta_h = t * t * (M_PI / 2.0);
-  angles.phi_h = 0.0;
-  angles.theta_d = (j + 0.5) / kMerlThetaD * (M_PI / 2.0);
-  angles.phi_d = (k + 0.5) / kMerlPhiD * M_PI;
-  return angles;
-}
-
-Eigen::Vector3d MerlTable::Cell(size_t flat) const {
-  return {stored_[flat] * kMerlScale[0], stored_[flat + kMerlCells] * kMerlScale[1],
-          stored_[flat + 2 * kMerlCells] * kMerlScale[2]};
-}
-
-void MerlTable::SetCell(size_t flat, const Eigen::Vector3d& brdf) {
-  for (int c = 0; c < 3; ++c) stored_[flat + c * kMerlCells] = brdf[c] / kMerlScale[c];
-}
-
-void MerlTable::SetUnmeasured(size_t flat) {
-  for (int c = 0; c < 3; ++c) stored_[flat + c * kMerlCells] = -1.0;
-}
-
-Eigen::Vector3d MerlTable::Lookup(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const {
-  HalfDiffAngles angles;
-  ToHalfDiff(wi, wo, &angles);
-  return Cell(MerlFlatIndex(MerlThetaHalfIndex(angles.theta_h), MerlThetaDiffIndex(angles.theta_d),
-                            MerlPhiDiffIndex(angles.phi_d)));
-}
-
-void WriteMerl(const std::string& path, const MerlTable& table) {
-  AtomicFile file(path);
-  {
-    std::ofstream out(file.temporary_path(), std::ios::binary);
-    if (!out) ThrowError(path, "cannot write file");
-    const int32_t dims[3] = {kMerlThetaH, kMerlThetaD, kMerlPhiD};
-    out.write(reinterpret_cast<const char*>(dims), sizeof(dims));
-    out.write(reinterpret_cast<const char*>(table.stored().data()),
-              static_cast<std::streamsize>(table.stored().size() * sizeof(double)));
-    if (!out) ThrowError(path, "write failed (disk full?)");
-  }
-  file.Commit();
-}
-
-MerlTable ReadMerl(const std::string& path) {
-  RequireFile(path, "MERL BRDF file");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  const std::streamoff size = in.tellg();
-  in.seekg(0);
-  int32_t dims[3] = {0, 0, 0};
-  if (!in.read(reinterpret_cast<char*>(dims), sizeof(dims))) ThrowError(path, "too short for a MERL header");
-  if (dims[0] != kMerlThetaH || dims[1] != kMerlThetaD || dims[2] != kMerlPhiD) {
-    ThrowError(path, "dimensions " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
-                         std::to_string(dims[2]) + ", expected 90 x 90 x 180 (a MERL .binary file)");
-  }
-  const std::streamoff expected = static_cast<std::streamoff>(sizeof(dims) + 3 * kMerlCells * sizeof(double));
-  if (size != expected) {
-    ThrowError(path, "size " + std::to_string(size) + " bytes, expected " + std::to_string(expected));
-  }
-  MerlTable table;
-  in.read(reinterpret_cast<char*>(table.stored().data()),
-          static_cast<std::streamsize>(3 * kMerlCells * sizeof(double)));
-  if (!in) ThrowError(path, "read failed");
-  for (size_t i = 0; i < table.stored().size(); ++i) {
-    if (!std::isfinite(table.stored()[i])) ThrowError(path, "value " + std::to_string(i) + " is not finite");
-  }
-  return table;
-}
-
 bool TabulateOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GT(max_theta_deg, 0.0);
   IBRDF_CHECK_OPTION_LE(max_theta_deg, 90.0);
   IBRDF_CHECK_OPTION_GE(min_effective_samples, 0.0f);
-  return true;
+  return domain.Check(why);
 }
 
 std::string TabulateSummary::BriefReport() const {
-  char buffer[320];
+  char buffer[480];
   std::snprintf(buffer, sizeof(buffer),
-                "tabulate: %llu cells measured, %llu beyond the horizon limit, %llu unsupported; %llu evaluations "
-                "in %.2f s",
-                (unsigned long long)cells_measured, (unsigned long long)cells_below_horizon,
-                (unsigned long long)cells_unsupported, (unsigned long long)evaluations, seconds);
+                "tabulate: %s within the theta limit, %llu beyond it; samples' theta_d %.1f to %.1f deg; "
+                "unmeasured cells %s; %llu evaluations in %.2f s",
+                domain.Brief().c_str(), (unsigned long long)cells_below_horizon, theta_d_min_deg, theta_d_max_deg,
+                fill == FillMode::kNone ? "written as -1 (no data)"
+                                        : (std::string("filled by ") + FillModeName(fill) +
+                                           (fill_model.empty() ? "" : " (" + fill_model + ")"))
+                                              .c_str(),
+                (unsigned long long)evaluations, seconds);
   return buffer;
 }
 
 MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions& options, TabulateSummary* summary,
-                       std::vector<float>* effective_samples, std::vector<uint8_t>* measured_domain) {
+                       std::vector<float>* effective_samples, std::vector<uint8_t>* domain,
+                       const BrdfModel* fill_model) {
   std::string why;
   if (!options.Check(&why)) ThrowError("tabulate options", why);
+  if (options.fill == FillMode::kModel && !fill_model) ThrowError("tabulate options", "fill 'model' without a model");
   Timer timer;
   const bool mirror = regression.options().fold_bilateral;
   const int phi_count = mirror ? kMerlPhiD / 2 : kMerlPhiD;
   const double cos_limit = std::cos(options.max_theta_deg * M_PI / 180.0);
   // The cells to evaluate: inside the horizon limit; with bilateral folding, the first half of phi_d.
-  std::vector<Eigen::Vector3d> points;
   std::vector<size_t> cells;
   MerlTable table;
   TabulateSummary local;
+  local.fill = options.fill;
+  if (fill_model && options.fill == FillMode::kModel) local.fill_model = fill_model->ModelName();
+  local.theta_d_min_deg = regression.theta_d_min() * 180.0 / M_PI;
+  local.theta_d_max_deg = regression.theta_d_max() * 180.0 / M_PI;
   for (int i = 0; i < kMerlThetaH; ++i) {
     for (int j = 0; j < kMerlThetaD; ++j) {
       for (int k = 0; k < kMerlPhiD; ++k) {
@@ -151,37 +65,66 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
           continue;
         }
         if (k >= phi_count) continue;
-        points.push_back(RegressionCoordinates(angles));
         cells.push_back(MerlFlatIndex(i, j, k));
       }
     }
   }
-  const std::vector<Estimate> estimates = regression.EvaluateMany(points, &local.reliability);
-  local.evaluations = points.size();
   if (effective_samples) effective_samples->assign(kMerlCells, 0.0f);
-  if (measured_domain) measured_domain->assign(kMerlCells, 0);
-  for (size_t p = 0; p < cells.size(); ++p) {
-    const Estimate& e = estimates[p];
-    const size_t flat = cells[p];
-    std::vector<size_t> targets = {flat};
-    if (mirror) {
+  if (domain) domain->assign(kMerlCells, 0);
+  const double margin = options.domain.theta_d_margin_deg * M_PI / 180.0;
+  const double theta_d_low = regression.theta_d_min() - margin, theta_d_high = regression.theta_d_max() + margin;
+  std::mutex mutex;
+  ProgressBar progress("tabulate", cells.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 512), [&](const tbb::blocked_range<size_t>& range) {
+    ReliabilityCounts reliability;
+    DomainCounts counts;
+    for (size_t p = range.begin(); p != range.end(); ++p) {
+      const size_t flat = cells[p];
       const int k = static_cast<int>(flat % kMerlPhiD);
-      const size_t mirrored = flat - k + (kMerlPhiD - 1 - k);
+      const int j = static_cast<int>((flat / kMerlPhiD) % kMerlThetaD);
+      const int i = static_cast<int>(flat / (size_t(kMerlPhiD) * kMerlThetaD));
+      const HalfDiffAngles angles = MerlCellCentre(i, j, k);
+      // Beyond the samples' theta_d range a cell is unmeasured whatever its estimate: evaluated only
+      // when --fill extrapolate wants the estimate.
+      const bool beyond = angles.theta_d < theta_d_low || angles.theta_d > theta_d_high;
+      const Estimate e = beyond && options.fill != FillMode::kExtrapolate
+                             ? Estimate()
+                             : regression.EvaluateAt(RegressionCoordinates(angles));
+      if (!beyond || options.fill == FillMode::kExtrapolate) reliability.Add(e);
+      DomainClass c = ClassifyEstimate(e, angles.theta_d, regression, options.domain);
+      if (e.effective_samples < options.min_effective_samples) c = DomainClass::kUnmeasured;
+      Eigen::Vector3d value = e.value;
+      bool has_value = c != DomainClass::kUnmeasured;
+      if (!has_value && options.fill == FillMode::kExtrapolate && e.status != EstimateStatus::kUnsupported) {
+        has_value = true;
+      } else if (!has_value && options.fill == FillMode::kModel) {
+        Eigen::Vector3d wi, wo;
+        FromHalfDiff(angles, &wi, &wo);
+        value = fill_model->Eval(wi, wo);
+        has_value = value.allFinite();
+      }
       // The mirrored cell is inside the horizon whenever this one is (bilateral symmetry of the geometry).
-      targets.push_back(mirrored);
-    }
-    for (size_t target : targets) {
-      if (e.status == EstimateStatus::kUnsupported || e.effective_samples < options.min_effective_samples) {
-        table.SetUnmeasured(target);
-        ++local.cells_unsupported;
-      } else {
-        table.SetCell(target, e.value);
-        ++local.cells_measured;
-        if (measured_domain) (*measured_domain)[target] = InMeasuredDomain(e) ? 1 : 0;
-        if (effective_samples) (*effective_samples)[target] = e.effective_samples;
+      const int targets = mirror ? 2 : 1;
+      for (int t = 0; t < targets; ++t) {
+        const size_t target = t == 0 ? flat : flat - k + (kMerlPhiD - 1 - k);
+        counts.Add(c);
+        if (c == DomainClass::kUnmeasured && has_value) ++counts.filled;
+        if (has_value) {
+          table.SetCell(target, value);
+        } else {
+          table.SetUnmeasured(target);
+        }
+        if (domain) (*domain)[target] = static_cast<uint8_t>(c);
+        if (effective_samples && c != DomainClass::kUnmeasured) (*effective_samples)[target] = e.effective_samples;
       }
     }
-  }
+    progress.Add(range.size());
+    std::lock_guard<std::mutex> lock(mutex);
+    local.reliability.Merge(reliability);
+    local.domain.Merge(counts);
+  });
+  progress.Finish();
+  local.evaluations = local.reliability.evaluations;
   local.seconds = timer.ElapsedSeconds();
   local.success = true;
   if (summary) *summary = local;

@@ -1,11 +1,6 @@
-// The MERL BRDF database's binary format (Matusik et al. 2003, BRDFRead.cpp), bit-compatible with its
-// reader: three int32 dimensions 90, 90, 180 (theta_h, theta_d, phi_d), then 90*90*180 doubles per
-// channel, red, green, blue, each value stored as brdf / scale with RED_SCALE = 1/1500,
-// GREEN_SCALE = 1.15/1500, BLUE_SCALE = 1.66/1500. The flat index is
-// phi_d_index + 180 * (theta_d_index + 90 * theta_h_index). theta_h is indexed non-linearly,
-// index = sqrt(theta_h / (pi/2)) * 90; theta_d and phi_d linearly, phi_d over [0, pi) (reciprocity
-// folds phi_d + pi onto phi_d). Cells without a value (below the horizon, or no samples near them)
-// hold -1, as the MERL data marks unmeasured cells with negative values.
+// Tabulation of a local regression to the MERL format (core/merl_format.h describes the file): every
+// cell centre evaluated, classified measured / interpolated / unmeasured by where the samples are
+// (reconstruct/sample_domain.h), unmeasured cells written as -1 or filled on request.
 #pragma once
 
 #include <cstdint>
@@ -14,81 +9,44 @@
 
 #include <Eigen/Core>
 
-#include "core/brdf_coords.h"
+#include "core/brdf_model.h"
+#include "core/merl_format.h"
 #include "reconstruct/local_regression.h"
+#include "reconstruct/sample_domain.h"
 
 namespace ibrdf {
 
-constexpr int kMerlThetaH = 90;
-constexpr int kMerlThetaD = 90;
-constexpr int kMerlPhiD = 180;
-constexpr size_t kMerlCells = size_t(kMerlThetaH) * kMerlThetaD * kMerlPhiD;
-// The reader's per-channel scales: value = stored * scale.
-extern const double kMerlScale[3];
-
-// The reader's index functions (clamped to the table).
-int MerlThetaHalfIndex(double theta_h);
-int MerlThetaDiffIndex(double theta_d);
-int MerlPhiDiffIndex(double phi_d);
-inline size_t MerlFlatIndex(int i_theta_h, int i_theta_d, int i_phi_d) {
-  return size_t(i_phi_d) + size_t(kMerlPhiD) * (size_t(i_theta_d) + size_t(kMerlThetaD) * size_t(i_theta_h));
-}
-// The centre of a cell in index space: theta_h = ((i + 0.5) / 90)^2 pi/2, theta_d = (j + 0.5) / 90 pi/2,
-// phi_d = (k + 0.5) / 180 pi, phi_h = 0. The reader's index functions map it back to (i, j, k).
-HalfDiffAngles MerlCellCentre(int i_theta_h, int i_theta_d, int i_phi_d);
-
-// A MERL table in memory, holding exactly the stored doubles (brdf / scale, or -1).
-class MerlTable {
- public:
-  MerlTable() : stored_(3 * kMerlCells, -1.0) {}  // every cell unmeasured
-
-  // The cell's RGB BRDF in 1/sr (stored * scale); negative when unmeasured.
-  Eigen::Vector3d Cell(size_t flat) const;
-  bool Measured(size_t flat) const {
-    return stored_[flat] >= 0.0 && stored_[flat + kMerlCells] >= 0.0 && stored_[flat + 2 * kMerlCells] >= 0.0;
-  }
-  void SetCell(size_t flat, const Eigen::Vector3d& brdf);
-  void SetUnmeasured(size_t flat);
-  // As BRDFRead.cpp's lookup_brdf_val: the cell of (wi, wo) in the local frame; negative if unmeasured.
-  Eigen::Vector3d Lookup(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const;
-
-  const std::vector<double>& stored() const { return stored_; }
-  std::vector<double>& stored() { return stored_; }
-
- private:
-  std::vector<double> stored_;  // 3 * kMerlCells, channel-major as in the file
-};
-
-// Writes the binary file atomically; reads one back, checking the dimensions and the size (Error naming
-// the file otherwise).
-void WriteMerl(const std::string& path, const MerlTable& table);
-MerlTable ReadMerl(const std::string& path);
-
 struct TabulateOptions {
-  double max_theta_deg = 90.0;         // cells with theta_i or theta_e beyond this are unmeasured (-1)
-  float min_effective_samples = 0.0f;  // cells whose estimate has fewer are marked unmeasured
+  double max_theta_deg = 90.0;         // cells with theta_i or theta_e beyond this are not tabulated (-1)
+  float min_effective_samples = 0.0f;  // cells whose estimate has fewer are unmeasured
+  DomainRules domain;                  // measured / interpolated / unmeasured (reconstruct/sample_domain.h)
+  FillMode fill = FillMode::kNone;     // what unmeasured cells hold (kModel needs a model to fill with)
   bool Check(std::string* why) const;
 };
 
 struct TabulateSummary {
   bool success = false;
-  ReliabilityCounts reliability;     // of the evaluated cells
-  uint64_t cells_measured = 0;       // cells with a value
-  uint64_t cells_below_horizon = 0;  // beyond max_theta_deg (or the horizon)
-  uint64_t cells_unsupported = 0;    // evaluated but left unmeasured (no samples, too few)
-  uint64_t evaluations = 0;          // distinct regression evaluations (bilateral mirrors share one)
+  ReliabilityCounts reliability;                        // of the evaluated cells
+  DomainCounts domain;                                  // cells within the theta limit, by class (and filled)
+  uint64_t cells_below_horizon = 0;                     // beyond max_theta_deg (or the horizon): always -1
+  uint64_t evaluations = 0;                             // distinct regression evaluations (bilateral mirrors share one)
+  double theta_d_min_deg = 0.0, theta_d_max_deg = 0.0;  // the samples' theta_d range
+  FillMode fill = FillMode::kNone;
+  std::string fill_model;  // the model that filled unmeasured cells (kModel)
   double seconds = 0.0;
   std::string BriefReport() const;
 };
 
-// Evaluates the regression at every cell centre of the MERL grid (TBB-parallel). With bilateral
-// folding, cells k and 179 - k share one evaluation. `effective_samples` (optional) gets each cell's
-// effective sample count (kMerlCells floats, 0 where unmeasured); `measured_domain` (optional) 1 for
-// each cell in the measured domain (InMeasuredDomain: tabulated, support not grown, not an
-// extrapolation), 0 elsewhere.
+// Evaluates the regression at every cell centre of the MERL grid (TBB-parallel, with a progress bar and
+// a time estimate). With bilateral folding, cells k and 179 - k share one evaluation. Each cell within
+// the theta limit is classified (ClassifyEstimate); measured and interpolated cells get the estimate,
+// unmeasured ones -1, or with options.fill the regression's estimate (kExtrapolate, where it has one)
+// or `fill_model` (kModel; required then). `effective_samples` (optional) gets each cell's effective
+// sample count (kMerlCells floats, 0 where unmeasured); `domain` (optional) each cell's DomainClass
+// (kMerlCells bytes, 0 beyond the theta limit). Throws Error on bad options.
 MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions& options, TabulateSummary* summary,
-                       std::vector<float>* effective_samples = nullptr,
-                       std::vector<uint8_t>* measured_domain = nullptr);
+                       std::vector<float>* effective_samples = nullptr, std::vector<uint8_t>* domain = nullptr,
+                       const BrdfModel* fill_model = nullptr);
 
 // The table as a float64 array of shape (90, 90, 180, 3) in 1/sr (-1 where unmeasured), for .npy.
 std::vector<double> MerlToArray(const MerlTable& table);

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include <ceres/sized_cost_function.h>
 #include <Eigen/Core>
 
 namespace ibrdf {
@@ -38,6 +39,45 @@ struct LafortuneResidual {
   }
 
   double xy, z, value, inv_sigma;
+};
+
+// The same residual with analytic derivatives (what the fit uses: about three times faster than
+// automatic differentiation); tests check it against LafortuneResidual and numeric differences.
+template <int kLobes>
+class LafortuneAnalyticResidual : public ceres::SizedCostFunction<1, 1 + 3 * kLobes> {
+ public:
+  LafortuneAnalyticResidual(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo, double value, double sigma)
+      : xy_(wi.x() * wo.x() + wi.y() * wo.y()), z_(wi.z() * wo.z()), value_(value), inv_sigma_(1.0 / sigma) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double* p = parameters[0];
+    double f = p[0] / M_PI;
+    double* j = jacobians && jacobians[0] ? jacobians[0] : nullptr;
+    if (j) j[0] = inv_sigma_ / M_PI;
+    for (int k = 0; k < kLobes; ++k) {
+      const double base = p[1 + 3 * k] * xy_ + p[2 + 3 * k] * z_;
+      const double n = p[3 + 3 * k];
+      if (!(base > 0.0)) {
+        if (j) j[1 + 3 * k] = j[2 + 3 * k] = j[3 + 3 * k] = 0.0;
+        continue;
+      }
+      const double log_base = std::log(base);
+      if (n * log_base > 100.0) return false;  // overflow on a trial step: Ceres shrinks the step
+      const double lobe = std::exp(n * log_base);
+      f += lobe;
+      if (j) {
+        const double d_base = n * lobe / base;
+        j[1 + 3 * k] = inv_sigma_ * d_base * xy_;
+        j[2 + 3 * k] = inv_sigma_ * d_base * z_;
+        j[3 + 3 * k] = inv_sigma_ * lobe * log_base;
+      }
+    }
+    residuals[0] = (f - value_) * inv_sigma_;
+    return std::isfinite(residuals[0]);
+  }
+
+ private:
+  double xy_, z_, value_, inv_sigma_;
 };
 
 // GGX microfacet model as GgxBrdf evaluates it, all three channels: parameters [diffuse_albedo r g b],

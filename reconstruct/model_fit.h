@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
 #include <nlohmann/json_fwd.hpp>
 
 #include "core/brdf_model.h"
@@ -19,12 +20,15 @@ namespace ibrdf {
 
 struct ModelFitOptions {
   int lafortune_lobes = 3;       // 1 to 3 lobes
-  size_t max_samples = 40000;    // a random subset (fixed seed) of at most this many samples is fitted
+  size_t max_samples = 20000;    // a random subset (fixed seed) of at most this many samples is fitted
   double relative_floor = 0.01;  // sigma is at least this fraction of the value (noise-free samples)
   double absolute_floor = 1e-4;  // and at least this (1/sr)
   double huber_scale = 3.0;      // Huber loss threshold, in sigmas
   int max_iterations = 200;      // per Ceres solve
   double max_theta_deg = 80.0;   // samples beyond this theta_i or theta_e are left out
+  // A Lafortune lobe's largest value anywhere, max(|Cxy|, |Cz|)^n, is held below this many times the
+  // largest sample value (a penalty): no lobe grows without bound towards unsampled directions.
+  double max_lobe_ratio = 3.0;
   uint64_t seed = 1;
   bool Check(std::string* why) const;
 };
@@ -37,21 +41,55 @@ struct ModelFitResult {
   double final_cost = 0.0;  // Ceres cost, summed over the channel fits
   double rel_rms = 0.0;     // RMS of (f_fit - f) / f over the samples used and channels
   int starts = 0;           // initial guesses tried (the best is kept)
+  // Parameters that ended at a bound of the fit ("n lobe 1 G at 2000"): reported, never silent.
+  std::vector<std::string> at_bound;
+  // The largest directional albedo over a dense grid of incidence directions on the whole hemisphere
+  // (0 to 89.5 degrees), per channel's max; a plausible BRDF keeps it at most 1.
+  double max_albedo = 0.0;
   double seconds = 0.0;
   std::string BriefReport() const;
 };
+
+// The directional albedo of `brdf` for light from polar angle theta_i (radians), per channel: the
+// integral of f cos(theta_o) over the exitant hemisphere (midpoint rule, 48 x 96 cells in (cos^2 theta_o,
+// phi_o)), and its maximum over theta_i in 0 to 89.5 degrees (40 angles).
+Eigen::Vector3d DirectionalAlbedo(const BrdfModel& brdf, double theta_i);
+double MaxDirectionalAlbedo(const BrdfModel& brdf);
 
 // Fits each colour channel separately with `lafortune_lobes` lobes from several starting points.
 ModelFitResult FitLafortune(const std::vector<BrdfSample>& samples, const ModelFitOptions& options);
 // Fits diffuse albedo and specular F0 per channel and one GGX alpha.
 ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOptions& options);
 
+// The fit as summary JSON: model, error, samples, starts, time, parameters at a bound, plausibility.
+nlohmann::json ToJson(const ModelFitResult& fit);
+
 // The material file of a fit, with name and description (how and from what it was fitted).
 nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& name);
 
-// Material snippets for the GGX fit (their analytic microfacet materials; see docs/reconstruct.md for
-// what is approximate: one scalar IOR from the mean F0, and a dielectric coating over the diffuse base).
-std::string PbrtV4Material(const BrdfModel& ggx, const std::string& name);
-std::string Mitsuba3Material(const BrdfModel& ggx, const std::string& name);
+// Renderer materials for a GGX fit, named `name`: a metal (F0 above 0.2 with a diffuse albedo under a
+// tenth of it) as a rough conductor keeping its colour (pbrt-v4 "conductor" with "reflectance", Mitsuba
+// 3 "roughconductor" with eta = 1 and k from F0), anything else as a rough plastic (Mitsuba 3
+// "roughplastic" with nonlinear inter-reflection, pbrt-v4 "coateddiffuse") with one IOR from the mean F0
+// and the base albedo inverted for the coating (roughplastic's closed form), so the rendered diffuse
+// term is the fitted one at 35 degrees.
+struct RendererSnippets {
+  std::string kind;                     // "conductor" or "plastic"
+  std::string pbrt, mitsuba;            // the snippets' text
+  std::string pbrt_file, mitsuba_file;  // suggested file names: NAME.pbrt, NAME.xml
+};
+RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::string& name);
+
+// The snippets' parameters, for tests that evaluate them as the renderers do.
+struct PlasticParameters {
+  double eta = 1.5;                                       // interior IOR (exterior 1)
+  double alpha = 0.1;                                     // GGX roughness, not remapped
+  Eigen::Vector3d base_albedo = Eigen::Vector3d::Zero();  // under the coating (inverted)
+};
+PlasticParameters PlasticFromGgx(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& f0, double alpha);
+// The diffuse Fresnel reflectance of a dielectric boundary of relative IOR eta, as Mitsuba 3's
+// fresnel_diffuse_reflectance (Egan and Hilgeman's fit below 1, d'Eon and Irving's above); the
+// coating's internal reflectance is FresnelDiffuseReflectance(1 / eta).
+double FresnelDiffuseReflectance(double eta);
 
 }  // namespace ibrdf

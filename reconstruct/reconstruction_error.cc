@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include <nlohmann/json.hpp>
 
@@ -53,6 +54,7 @@ class Accumulator {
       error_.rel_rms_all = std::sqrt(sum_.sum() / (3.0 * error_.points));
       for (int c = 0; c < 3; ++c) {
         error_.median[c] = PercentileInPlace(&abs_[c], 0.5);
+        error_.p95[c] = PercentileInPlace(&abs_[c], 0.95);
       }
     }
     return error_;
@@ -111,7 +113,68 @@ nlohmann::json ToJson(const ReconstructionError& error) {
   auto rgb = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
   return {{"cells_scored", error.points},           {"cells_outside", error.outside},
           {"coverage", error.coverage()},           {"rel_rms_error", rgb(error.rel_rms)},
-          {"rel_rms_error_all", error.rel_rms_all}, {"median_abs_rel_error", rgb(error.median)}};
+          {"rel_rms_error_all", error.rel_rms_all}, {"median_abs_rel_error", rgb(error.median)},
+          {"p95_abs_rel_error", rgb(error.p95)}};
+}
+
+std::string MerlLookupCheck::Brief() const {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "MERL lookups at %zu random direction pairs: %.1f %% hit a cell with data; among them |rel. "
+                "error| median %.2f %%, 95th percentile %.2f %% (R G B pooled)",
+                lookups, 100.0 * hit_fraction(), 100.0 * median.mean(), 100.0 * p95_all);
+  return buffer;
+}
+
+MerlLookupCheck CheckMerlLookups(const MerlTable& table, const BrdfModel& truth, size_t lookups, double max_theta_deg,
+                                 uint64_t seed) {
+  MerlLookupCheck check;
+  check.lookups = lookups;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double cos_limit = std::cos(max_theta_deg * M_PI / 180.0);
+  // Uniform by solid angle over the cap theta <= max_theta: cos(theta) uniform in [cos_limit, 1].
+  const auto direction = [&] {
+    const double z = cos_limit + (1.0 - cos_limit) * uniform(rng);
+    const double phi = 2.0 * M_PI * uniform(rng);
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    return Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z);
+  };
+  std::vector<double> channel[3], pooled;
+  for (size_t n = 0; n < lookups; ++n) {
+    const Eigen::Vector3d wi = direction(), wo = direction();
+    const Eigen::Vector3d f = table.Lookup(wi, wo);
+    if ((f.array() < 0.0).any()) continue;
+    ++check.hits;
+    const Eigen::Vector3d t = truth.Eval(wi, wo);
+    if (!(t.array() > 0.0).all()) continue;
+    ++check.scored;
+    for (int c = 0; c < 3; ++c) {
+      const double rel = std::abs(f[c] - t[c]) / t[c];
+      channel[c].push_back(rel);
+      pooled.push_back(rel);
+    }
+  }
+  if (check.scored > 0) {
+    for (int c = 0; c < 3; ++c) {
+      check.median[c] = PercentileInPlace(&channel[c], 0.5);
+      check.p95[c] = PercentileInPlace(&channel[c], 0.95);
+    }
+    check.p95_all = PercentileInPlace(&pooled, 0.95);
+  }
+  return check;
+}
+
+nlohmann::json ToJson(const MerlLookupCheck& check) {
+  auto rgb = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
+  return {{"lookups", check.lookups},
+          {"hits", check.hits},
+          {"hit_fraction", check.hit_fraction()},
+          {"scored", check.scored},
+          {"median_abs_rel_error", rgb(check.median)},
+          {"p95_abs_rel_error", rgb(check.p95)},
+          {"p95_abs_rel_error_all", check.p95_all},
+          {"directions", "wi, wo uniform by solid angle over the hemisphere, independent, fixed seed"}};
 }
 
 }  // namespace ibrdf

@@ -24,6 +24,7 @@ struct ReconstructionError {
   Eigen::Vector3d rel_rms = Eigen::Vector3d::Zero();  // per channel, of (f - f_true) / f_true
   double rel_rms_all = 0.0;                           // over channels
   Eigen::Vector3d median = Eigen::Vector3d::Zero();   // of |f - f_true| / f_true
+  Eigen::Vector3d p95 = Eigen::Vector3d::Zero();      // 95th percentile of |f - f_true| / f_true
   double coverage() const { return points + outside ? double(points) / double(points + outside) : 0.0; }
   std::string Brief() const;
 };
@@ -37,5 +38,23 @@ ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfMode
                                           const std::vector<uint8_t>* measured_domain = nullptr);
 
 nlohmann::json ToJson(const ReconstructionError& error);
+
+// What a renderer or a colleague doing MERL lookups (BRDFRead.cpp's lookup_brdf_val) at random
+// directions gets from a table: wi and wo drawn uniformly (by solid angle) and independently over the
+// hemisphere up to max_theta_deg (fixed seed); a lookup hits a valid cell when the cell holds data
+// (>= 0); among hits, the relative error against the truth (where the truth is positive).
+struct MerlLookupCheck {
+  size_t lookups = 0;                                // direction pairs drawn
+  size_t hits = 0;                                   // lookups that landed on a cell with data
+  size_t scored = 0;                                 // hits scored (truth positive in every channel)
+  Eigen::Vector3d median = Eigen::Vector3d::Zero();  // of |f - f_true| / f_true among hits
+  Eigen::Vector3d p95 = Eigen::Vector3d::Zero();
+  double p95_all = 0.0;  // over the channels pooled
+  double hit_fraction() const { return lookups ? double(hits) / double(lookups) : 0.0; }
+  std::string Brief() const;
+};
+MerlLookupCheck CheckMerlLookups(const MerlTable& table, const BrdfModel& truth, size_t lookups = 200000,
+                                 double max_theta_deg = 90.0, uint64_t seed = 1);
+nlohmann::json ToJson(const MerlLookupCheck& check);
 
 }  // namespace ibrdf

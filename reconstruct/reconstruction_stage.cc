@@ -1,9 +1,14 @@
 #include "reconstruct/reconstruction_stage.h"
 
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "core/brdf_coords.h"
 #include "core/brdf_model.h"
@@ -11,7 +16,9 @@
 #include "core/file_util.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "core/merl_brdf.h"
 #include "core/npy.h"
+#include "reconstruct/sample_domain.h"
 #include "reconstruct/truth_comparison.h"
 
 namespace ibrdf {
@@ -20,33 +27,43 @@ namespace {
 // What the stage reads besides the samples: the evaluation points and the truth.
 struct StageInputs {
   std::vector<Eigen::Vector3d> eval_wi, eval_wo;
+  std::vector<double> eval_theta_d;
   std::unique_ptr<BrdfModel> truth;
 };
+
+// A truth file: truth.json of a synthetic session (the "ibrdf-truth" wrapper), a material file or a
+// MERL table.
+std::unique_ptr<BrdfModel> LoadTruth(const std::string& path) { return LoadTruthFile(path); }
+
+// Reads the evaluation points (theta_i, theta_e, delta_phi) into direction pairs.
+void LoadEvalPoints(const std::string& eval_file, StageInputs* inputs) {
+  std::vector<size_t> shape;
+  const std::vector<double> points = ReadNpyArray(eval_file, &shape, true);
+  if (shape.size() != 2 || shape[1] != 3) ThrowError(eval_file, "expected a float64 array of shape (N, 3)");
+  inputs->eval_wi.resize(shape[0]);
+  inputs->eval_wo.resize(shape[0]);
+  inputs->eval_theta_d.resize(shape[0]);
+  for (size_t i = 0; i < shape[0]; ++i) {
+    // Validated where read: a point outside the angles' ranges would be answered, wrongly.
+    if (!(points[3 * i] >= 0 && points[3 * i] <= M_PI / 2 && points[3 * i + 1] >= 0 &&
+          points[3 * i + 1] <= M_PI / 2 && std::abs(points[3 * i + 2]) <= M_PI)) {
+      ThrowError(eval_file, "row " + std::to_string(i) + ": expected theta_i, theta_e in [0, pi/2] and delta_phi in [-pi, pi]");
+    }
+    inputs->eval_wi[i] = FromSpherical(points[3 * i], 0.0);
+    inputs->eval_wo[i] = FromSpherical(points[3 * i + 1], points[3 * i + 2]);
+    HalfDiffAngles angles;
+    ToHalfDiff(inputs->eval_wi[i], inputs->eval_wo[i], &angles);
+    inputs->eval_theta_d[i] = angles.theta_d;
+  }
+}
 
 // Checks the options and reads the eval and truth files (before the samples, as the command always did).
 StageInputs LoadInputs(const ReconstructOptions& options) {
   std::string why;
   if (!options.Check(&why)) ThrowError("reconstruct options", why);
   StageInputs inputs;
-  if (!options.eval_file.empty()) {
-    std::vector<size_t> shape;
-    const std::vector<double> points = ReadNpyArray(options.eval_file, &shape, /*require_finite=*/true);
-    if (shape.size() != 2 || shape[1] != 3) ThrowError(options.eval_file, "expected a float64 array of shape (N, 3)");
-    for (size_t i = 0; i < shape[0]; ++i) {
-      // Validated where read: a point outside the angles' ranges would be answered, wrongly.
-      if (!(points[3 * i] >= 0 && points[3 * i] <= M_PI / 2 && points[3 * i + 1] >= 0 &&
-            points[3 * i + 1] <= M_PI / 2 && std::abs(points[3 * i + 2]) <= M_PI)) {
-        ThrowError(options.eval_file,
-                   "row " + std::to_string(i) + ": expected theta_i, theta_e in [0, pi/2] and delta_phi in [-pi, pi]");
-      }
-      inputs.eval_wi.push_back(FromSpherical(points[3 * i], 0.0));
-      inputs.eval_wo.push_back(FromSpherical(points[3 * i + 1], points[3 * i + 2]));
-    }
-  }
-  if (!options.truth_file.empty()) {
-    const nlohmann::json json = ReadJsonFile(options.truth_file);
-    inputs.truth = json.contains("material") ? LoadTruthMaterial(options.truth_file) : LoadMaterial(options.truth_file);
-  }
+  if (!options.eval_file.empty()) LoadEvalPoints(options.eval_file, &inputs);
+  if (!options.truth_file.empty()) inputs.truth = LoadTruth(options.truth_file);
   return inputs;
 }
 
@@ -60,22 +77,46 @@ void WriteText(const std::string& path, const std::string& text) {
   file.Commit();
 }
 
-// Evaluates the regression at the eval points into eval.npy (and the truth into eval_truth.npy).
-void EvaluatePoints(const LocalRegression& regression, const StageInputs& inputs, const std::string& eval_file,
-                    const std::string& tmp, nlohmann::json* summary, nlohmann::json* timings) {
+void WriteBytes(const std::string& path, const std::vector<uint8_t>& bytes, const std::vector<size_t>& shape) {
+  WriteNpy(path, "'|u1'", shape, 1, bytes.data(), bytes.size());
+}
+
+// Evaluates the regression at the eval points into eval.npy and eval_domain.npy (and the truth into
+// eval_truth.npy): unmeasured points are -1 unless the fill mode gives them a value.
+void EvaluatePoints(const LocalRegression& regression, const StageInputs& inputs, const ReconstructOptions& options,
+                    const BrdfModel* fill_model, const std::string& tmp, nlohmann::json* summary,
+                    nlohmann::json* timings) {
   Timer timer;
   const size_t n = inputs.eval_wi.size();
   std::vector<Eigen::Vector3d> uvw(n);
   for (size_t i = 0; i < n; ++i) uvw[i] = RegressionCoordinates(inputs.eval_wi[i], inputs.eval_wo[i]);
   ReliabilityCounts counts;
   const std::vector<Estimate> estimates = regression.EvaluateMany(uvw, &counts);
-  (*timings)["eval_s"] = timer.ElapsedSeconds();
-  std::vector<double> values(3 * n), true_values;
+  std::vector<double> values(3 * n, -1.0), true_values;
+  std::vector<uint8_t> classes(n);
+  DomainCounts domain;
+  const FillMode fill = options.tabulate.fill;
   for (size_t i = 0; i < n; ++i) {
-    const bool supported = estimates[i].status != EstimateStatus::kUnsupported;
-    for (int c = 0; c < 3; ++c) values[3 * i + c] = supported ? estimates[i].value[c] : -1.0;
+    const Estimate& e = estimates[i];
+    DomainClass c = ClassifyEstimate(e, inputs.eval_theta_d[i], regression, options.tabulate.domain);
+    if (e.effective_samples < options.tabulate.min_effective_samples) c = DomainClass::kUnmeasured;
+    classes[i] = static_cast<uint8_t>(c);
+    domain.Add(c);
+    Eigen::Vector3d value = e.value;
+    bool has_value = c != DomainClass::kUnmeasured;
+    if (!has_value && fill == FillMode::kExtrapolate && e.status != EstimateStatus::kUnsupported) {
+      has_value = true;
+    } else if (!has_value && fill == FillMode::kModel && fill_model) {
+      value = fill_model->Eval(inputs.eval_wi[i], inputs.eval_wo[i]);
+      has_value = value.allFinite();
+    }
+    if (!has_value) continue;
+    if (c == DomainClass::kUnmeasured) ++domain.filled;
+    for (int ch = 0; ch < 3; ++ch) values[3 * i + ch] = value[ch];
   }
+  (*timings)["eval_s"] = timer.ElapsedSeconds();
   WriteNpyArray(tmp + "/eval.npy", values, {n, 3});
+  WriteBytes(tmp + "/eval_domain.npy", classes, {n});
   if (inputs.truth) {
     true_values.resize(3 * n);
     for (size_t i = 0; i < n; ++i) {
@@ -84,71 +125,149 @@ void EvaluatePoints(const LocalRegression& regression, const StageInputs& inputs
     }
     WriteNpyArray(tmp + "/eval_truth.npy", true_values, {n, 3});
   }
-  (*summary)["eval"] = {{"points", n}, {"file", eval_file}, {"reliability", ToJson(counts)}};
-  Log(1, "evaluated " + std::to_string(n) + " points: " + counts.Brief());
+  (*summary)["eval"] = {{"points", n},
+                        {"file", options.eval_file},
+                        {"reliability", ToJson(counts)},
+                        {"domain", ToJson(domain)},
+                        {"fill", FillModeName(fill)}};
+  Log(1, "evaluated " + std::to_string(n) + " points: " + domain.Brief() + "; " + counts.Brief());
 }
 
-// The MERL table and its .npy forms, scored against the truth when there is one.
+// The MERL table, its .npy forms, domain.npy and the table's sidecar brdf.json, scored against the
+// truth when there is one.
 void TabulateAndScore(const LocalRegression& regression, const ReconstructOptions& options, const BrdfModel* truth,
-                      const std::string& tmp, ReconstructResult* result, nlohmann::json* timings) {
+                      const BrdfModel* fill_model, const std::string& tmp, ReconstructResult* result,
+                      nlohmann::json* timings) {
   nlohmann::json& summary = result->summary;
   TabulateSummary tabulated;
   std::vector<float> ess;
-  std::vector<uint8_t> measured_domain;
-  const MerlTable table = TabulateMerl(regression, options.tabulate, &tabulated, &ess, &measured_domain);
+  std::vector<uint8_t> domain;
+  const MerlTable table = TabulateMerl(regression, options.tabulate, &tabulated, &ess, &domain, fill_model);
   (*timings)["tabulate_s"] = tabulated.seconds;
   Log(1, "regression: " + std::to_string(regression.size()) + " samples in " + std::to_string(regression.points()) +
              " points, " + tabulated.reliability.Brief());
   Log(1, tabulated.BriefReport());
+  if (tabulated.domain.unmeasured > 0) {
+    Log(1, std::to_string(tabulated.domain.unmeasured) + " cells are unmeasured (no samples around them): " +
+               (options.tabulate.fill == FillMode::kNone
+                    ? std::string("written as -1, MERL's \"no data\" (--fill model|extrapolate fills them)")
+                    : std::to_string(tabulated.domain.filled) + " of them filled by --fill " +
+                          FillModeName(options.tabulate.fill) + ": invented values, recorded in brdf.json"));
+  }
   Timer timer;
   WriteMerl(tmp + "/brdf.binary", table);
   WriteNpyArray(tmp + "/brdf.npy", MerlToArray(table), {90, 90, 180, 3});
   WriteNpyArray(tmp + "/effective_samples.npy", ess, {90, 90, 180});
+  WriteBytes(tmp + "/domain.npy", domain, {90, 90, 180});
+  nlohmann::json table_json = {{"cells_measured", tabulated.domain.measured},
+                               {"cells_interpolated", tabulated.domain.interpolated},
+                               {"cells_unmeasured", tabulated.domain.unmeasured},
+                               {"cells_unmeasured_filled", tabulated.domain.filled},
+                               {"cells_beyond_theta_limit", tabulated.cells_below_horizon},
+                               {"max_theta_deg", options.tabulate.max_theta_deg},
+                               {"samples_theta_d_deg", {tabulated.theta_d_min_deg, tabulated.theta_d_max_deg}},
+                               {"fill", FillModeName(options.tabulate.fill)},
+                               {"domain_rules",
+                                {{"measured_nearest_kernel_radii", options.tabulate.domain.measured_nearest},
+                                 {"max_centroid_offset_kernel_radii", options.tabulate.domain.max_centroid_offset},
+                                 {"theta_d_margin_deg", options.tabulate.domain.theta_d_margin_deg}}}};
+  if (!tabulated.fill_model.empty()) table_json["fill_model"] = tabulated.fill_model;
+  WriteJsonFile(tmp + "/brdf.json",
+                {{"format", "ibrdf-merl-table"},
+                 {"version", 1},
+                 {"files", {"brdf.binary", "brdf.npy", "domain.npy", "effective_samples.npy"}},
+                 {"domain_classes", {{"0", "unmeasured"}, {"1", "interpolated"}, {"2", "measured"}}},
+                 {"unmeasured_value", options.tabulate.fill == FillMode::kNone
+                                          ? "-1 (MERL's no data)"
+                                          : std::string("filled by ") + FillModeName(options.tabulate.fill) +
+                                                " where possible (domain.npy 0 with a value >= 0: invented), else -1"},
+                 {"table", table_json}});
   (*timings)["write_s"] = timer.ElapsedSeconds();
   summary["regression"]["reliability"] = ToJson(tabulated.reliability);
-  summary["table"] = {{"cells_measured", tabulated.cells_measured},
-                      {"cells_beyond_theta_limit", tabulated.cells_below_horizon},
-                      {"cells_unsupported", tabulated.cells_unsupported},
-                      {"max_theta_deg", options.tabulate.max_theta_deg}};
+  summary["table"] = table_json;
   result->tabulated = true;
-  result->cells_measured = tabulated.cells_measured;
+  result->cells_measured = tabulated.domain.measured;
+  result->cells_interpolated = tabulated.domain.interpolated;
+  result->cells_unmeasured = tabulated.domain.unmeasured;
+  result->cells_filled = tabulated.domain.filled;
   if (!truth) return;
-  // The measured domain: cells within 80 degrees whose estimate interpolates its samples.
-  const ReconstructionError error = CompareTableWithTruth(table, *truth, 80.0, &measured_domain);
+  // Scored over the valid cells (measured or interpolated), the measured ones alone, and every cell
+  // holding a value (filled ones included).
+  std::vector<uint8_t> measured_only(domain.size());
+  for (size_t i = 0; i < domain.size(); ++i) measured_only[i] = domain[i] == uint8_t(DomainClass::kMeasured);
+  const ReconstructionError error = CompareTableWithTruth(table, *truth, 80.0, &domain);
   summary["error_against_truth"] = ToJson(error);
   summary["error_against_truth"]["truth"] = options.truth_file;
-  summary["error_against_truth"]["domain"] =
-      "theta_i, theta_e <= 80 deg; support not grown; samples' centroid within 0.5 kernel radii";
-  Log(1, "against the truth (theta <= 80, measured domain): " + error.Brief());
+  summary["error_against_truth"]["domain"] = "theta_i, theta_e <= 80 deg; cells measured or interpolated (domain.npy)";
+  Log(1, "against the truth (theta <= 80, measured and interpolated cells): " + error.Brief());
+  summary["error_against_truth_measured"] = ToJson(CompareTableWithTruth(table, *truth, 80.0, &measured_only));
   const ReconstructionError all = CompareTableWithTruth(table, *truth, 80.0);
   summary["error_against_truth_all_tabulated"] = ToJson(all);
-  Log(1, "against the truth (theta <= 80, every tabulated cell): " + all.Brief());
+  Log(1, "against the truth (theta <= 80, every cell holding a value): " + all.Brief());
+  const MerlLookupCheck lookups = CheckMerlLookups(table, *truth);
+  summary["merl_lookups_against_truth"] = ToJson(lookups);
+  Log(1, lookups.Brief());
   result->scored = true;
   result->error_against_truth = error;
 }
 
-// The Lafortune and GGX fits and their material files.
-void FitModels(const std::vector<BrdfSample>& samples, const ModelFitOptions& options, const std::string& tmp,
-               ReconstructResult* result, nlohmann::json* timings) {
+// A name for the fitted materials: the samples' session folder, else the samples file's stem; letters,
+// digits, '-' and '_' only.
+std::string MaterialName(const ReconstructOptions& options, const std::string& samples_file) {
+  namespace fs = std::filesystem;
+  std::string name = options.name;
+  if (name.empty() && !samples_file.empty()) {
+    name = fs::path(samples_file).stem().string();
+    const std::string sidecar = SidecarPath(samples_file);
+    std::error_code ec;
+    if (fs::is_regular_file(sidecar, ec)) {
+      try {
+        const nlohmann::json json = ReadJsonFile(sidecar);
+        if (json.contains("session") && json["session"].is_string()) {
+          const std::string folder = fs::path(json["session"].get<std::string>()).parent_path().filename().string();
+          if (!folder.empty()) name = folder;
+        }
+      } catch (const Error&) {
+        // The sidecar is the derenderer's business; a name is a courtesy.
+      }
+    }
+  }
+  if (name.empty()) name = "ibrdf_fit";
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  }
+  return name;
+}
+
+// The Lafortune and GGX fits, their material files and renderer snippets; returns the chosen model
+// (lowest relative RMS against the samples).
+std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, const ModelFitOptions& options,
+                                     const std::string& name, const std::string& tmp, ReconstructResult* result,
+                                     nlohmann::json* timings) {
   Timer timer;
-  const ModelFitResult lafortune = FitLafortune(samples, options);
+  ModelFitResult lafortune = FitLafortune(samples, options);
   Log(1, lafortune.BriefReport());
-  WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, "lafortune-fit"));
-  const ModelFitResult ggx = FitGgx(samples, options);
+  WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, name + "-lafortune"));
+  ModelFitResult ggx = FitGgx(samples, options);
   Log(1, ggx.BriefReport());
-  WriteJsonFile(tmp + "/ggx.json", FitMaterialJson(ggx, "ggx-fit"));
-  WriteText(tmp + "/ggx.pbrt", PbrtV4Material(*ggx.brdf, "ggx_fit"));
-  WriteText(tmp + "/ggx.xml", Mitsuba3Material(*ggx.brdf, "ggx_fit"));
+  WriteJsonFile(tmp + "/ggx.json", FitMaterialJson(ggx, name + "-ggx"));
+  const RendererSnippets snippets = RendererMaterials(ggx, name);
+  WriteText(tmp + "/" + snippets.pbrt_file, snippets.pbrt);
+  WriteText(tmp + "/" + snippets.mitsuba_file, snippets.mitsuba);
   (*timings)["fits_s"] = timer.ElapsedSeconds();
-  result->summary["fits"] = {
-      {"lafortune",
-       {{"rel_rms_vs_samples", lafortune.rel_rms},
-        {"samples", lafortune.samples_used},
-        {"seconds", lafortune.seconds}}},
-      {"ggx", {{"rel_rms_vs_samples", ggx.rel_rms}, {"samples", ggx.samples_used}, {"seconds", ggx.seconds}}}};
+  const bool lafortune_chosen = lafortune.rel_rms < ggx.rel_rms;
+  result->summary["fits"] = {{"lafortune", ToJson(lafortune)},
+                             {"ggx", ToJson(ggx)},
+                             {"chosen", lafortune_chosen ? "lafortune" : "ggx"},
+                             {"renderer_snippets", {snippets.pbrt_file, snippets.mitsuba_file}},
+                             {"snippet_kind", snippets.kind}};
   result->fitted = true;
   result->lafortune_rel_rms = lafortune.rel_rms;
   result->ggx_rel_rms = ggx.rel_rms;
+  result->chosen_model = lafortune_chosen ? "lafortune" : "ggx";
+  Log(1, "chosen model: " + result->chosen_model + " (relative RMS against the samples " +
+             std::to_string(100.0 * std::min(lafortune.rel_rms, ggx.rel_rms)) + " %)");
+  return std::move(lafortune_chosen ? lafortune.brdf : ggx.brdf);
 }
 
 nlohmann::json RegressionJson(const ReconstructOptions& options, const LocalRegressionOptions& r,
@@ -195,13 +314,19 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
   timings["build_s"] = timer.ElapsedSeconds();
   result.samples_used = regression.size();
   result.points = regression.points();
+  std::unique_ptr<BrdfModel> chosen;
+  if (options.fits && !options.eval_only) {
+    chosen = FitModels(samples, options.fit, MaterialName(options, samples_file), tmp, &result, &timings);
+  }
+  const BrdfModel* fill_model = options.tabulate.fill == FillMode::kModel ? chosen.get() : nullptr;
   if (!inputs.eval_wi.empty()) {
-    EvaluatePoints(regression, inputs, options.eval_file, tmp, &result.summary, &timings);
+    EvaluatePoints(regression, inputs, options, fill_model, tmp, &result.summary, &timings);
     result.eval_points = inputs.eval_wi.size();
   }
   result.summary["regression"] = RegressionJson(options, result.regression, regression);
-  if (!options.eval_only) TabulateAndScore(regression, options, inputs.truth.get(), tmp, &result, &timings);
-  if (options.fits && !options.eval_only) FitModels(samples, options.fit, tmp, &result, &timings);
+  if (!options.eval_only) {
+    TabulateAndScore(regression, options, inputs.truth.get(), fill_model, tmp, &result, &timings);
+  }
   result.total_s = total.ElapsedSeconds();
   timings["total_s"] = result.total_s;
   result.summary["timings_s"] = timings;
@@ -225,6 +350,8 @@ bool ReconstructOptions::Check(std::string* why) const {
   if (!tabulate.Check(&inner)) return fail("tabulate");
   if (!fit.Check(&inner)) return fail("fit");
   IBRDF_CHECK_OPTION(!eval_only || !eval_file.empty());
+  // --fill model fills with the chosen fit, so the fits must run.
+  IBRDF_CHECK_OPTION(tabulate.fill != FillMode::kModel || (fits && !eval_only));
   return true;
 }
 
@@ -233,8 +360,15 @@ std::string ReconstructResult::BriefReport() const {
   out << "reconstruct: " << (success ? "" : "FAILED, ") << samples << " samples (" << samples_used << " used, "
       << points << " points)";
   if (eval_points) out << ", " << eval_points << " points evaluated";
-  if (tabulated) out << ", " << cells_measured << " cells measured";
-  if (fitted) out << ", fits rel. RMS Lafortune " << lafortune_rel_rms << " GGX " << ggx_rel_rms;
+  if (tabulated) {
+    out << ", cells " << cells_measured << " measured, " << cells_interpolated << " interpolated, " << cells_unmeasured
+        << " unmeasured";
+    if (cells_filled) out << " (" << cells_filled << " filled)";
+  }
+  if (fitted) {
+    out << ", fits rel. RMS Lafortune " << lafortune_rel_rms << " GGX " << ggx_rel_rms << " (chosen " << chosen_model
+        << ")";
+  }
   if (scored) out << ", against the truth " << error_against_truth.Brief();
   out << ", " << total_s << " s";
   return out.str();
@@ -253,6 +387,59 @@ ReconstructResult ReconstructFile(const std::string& samples_file, const Reconst
   const Timer total;
   const std::vector<BrdfSample> samples = ReadSamples(samples_file);
   return Run(samples, options, inputs, out_dir, samples_file, total);
+}
+
+}  // namespace ibrdf
+
+namespace ibrdf {
+
+ReconstructResult EvaluateMaterial(const std::string& material_file, const ReconstructOptions& options,
+                                   const std::string& out_dir) {
+  const Timer total;
+  if (options.eval_file.empty()) ThrowError("--material", "needs --eval POINTS.npy");
+  StageInputs inputs;
+  LoadEvalPoints(options.eval_file, &inputs);
+  const std::unique_ptr<BrdfModel> material = LoadTruth(material_file);
+  ReconstructResult result;
+  AtomicDirectory dir(out_dir, options.overwrite);
+  const std::string tmp = dir.temporary_path();
+  const Timer timer;
+  const size_t n = inputs.eval_wi.size();
+  std::vector<double> values(3 * n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const Eigen::Vector3d f = material->Eval(inputs.eval_wi[i], inputs.eval_wo[i]);
+      for (int c = 0; c < 3; ++c) values[3 * i + c] = f[c];
+    }
+  });
+  const double eval_s = timer.ElapsedSeconds();
+  uint64_t no_data = 0;
+  if (const auto* merl = dynamic_cast<const MerlBrdf*>(material.get())) {
+    // The MERL reader's "no data": -1 where the looked-up cell has none.
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d f = merl->table().Lookup(inputs.eval_wi[i], inputs.eval_wo[i]);
+      if ((f.array() < 0.0).any() && inputs.eval_wi[i].z() > 0.0 && inputs.eval_wo[i].z() > 0.0) {
+        for (int c = 0; c < 3; ++c) values[3 * i + c] = -1.0;
+        ++no_data;
+      }
+    }
+  }
+  WriteNpyArray(tmp + "/eval.npy", values, {n, 3});
+  result.eval_points = n;
+  result.total_s = total.ElapsedSeconds();
+  result.summary = {{"format", "ibrdf-reconstruction"},
+                    {"version", 1},
+                    {"material", material_file},
+                    {"model", material->ModelName()},
+                    {"eval", {{"points", n}, {"file", options.eval_file}, {"no_data", no_data}}},
+                    {"timings_s", {{"eval_s", eval_s}, {"total_s", result.total_s}}}};
+  WriteJsonFile(tmp + "/summary.json", result.summary);
+  dir.Commit();
+  Log(1, "evaluated " + material->ModelName() + " material " + material_file + " at " + std::to_string(n) +
+             " points in " + std::to_string(eval_s) + " s" +
+             (no_data ? " (" + std::to_string(no_data) + " on cells without data: -1)" : ""));
+  result.success = true;
+  return result;
 }
 
 }  // namespace ibrdf

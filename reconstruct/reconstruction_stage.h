@@ -5,9 +5,11 @@
 // truth when one is given, and a JSON summary. `ibrdf reconstruct` is this function behind flags.
 //
 // The output folder (written atomically: it appears only when complete) holds brdf.binary (MERL
-// 90x90x180), brdf.npy (90,90,180,3; -1 unmeasured), effective_samples.npy, lafortune.json and ggx.json
-// (material files), ggx.pbrt and ggx.xml (pbrt-v4, Mitsuba 3), summary.json, and with evaluation
-// points eval.npy (and eval_truth.npy with a truth). docs/reconstruct.md describes them.
+// 90x90x180), brdf.npy (90,90,180,3; -1 unmeasured), domain.npy (each cell measured 2, interpolated 1,
+// unmeasured 0), brdf.json (the table's sidecar: counts, fill), effective_samples.npy, lafortune.json
+// and ggx.json (material files), the renderer snippets, summary.json, and with evaluation points
+// eval.npy and eval_domain.npy (and eval_truth.npy with a truth). docs/reconstruct.md describes them.
+// EvaluateMaterial evaluates a material file at the points without any samples or regression.
 #pragma once
 
 #include <cstddef>
@@ -41,9 +43,12 @@ struct ReconstructOptions {
   // in radians (empty: none). Writes eval.npy (N x 3 RGB, -1 where unsupported).
   std::string eval_file;
   bool eval_only = false;  // with eval_file: skip the MERL table and the fits (for benchmarks)
-  // truth.json of a synthetic session or a material file to score against (empty: none).
+  // truth.json of a synthetic session, a material file or a MERL table to score against (empty: none).
   std::string truth_file;
   bool overwrite = false;  // replace an existing output folder
+  // Name of the fitted materials in their files and snippets (empty: from the samples' session folder,
+  // else the samples file's name).
+  std::string name;
   // False with `*why` naming the failing constraint (prefixed with the option group that failed).
   bool Check(std::string* why) const;
 };
@@ -57,10 +62,14 @@ struct ReconstructResult {
   LocalRegressionOptions regression;        // the kernel used (the selected radii with select_bandwidth)
   size_t eval_points = 0;                   // points evaluated (eval_file)
   bool tabulated = false;                   // the MERL table was written (not eval_only)
-  uint64_t cells_measured = 0;              // MERL cells with a value
+  uint64_t cells_measured = 0;              // MERL cells classified measured
+  uint64_t cells_interpolated = 0;          // interpolated (inside the samples' domain)
+  uint64_t cells_unmeasured = 0;            // unmeasured (within the theta limit), written -1 unless filled
+  uint64_t cells_filled = 0;                // unmeasured cells filled (--fill)
   bool fitted = false;                      // the Lafortune and GGX fits ran
   double lafortune_rel_rms = 0.0;           // relative RMS of the Lafortune fit against the samples
   double ggx_rel_rms = 0.0;                 // likewise for GGX
+  std::string chosen_model;                 // the fit with the lowest error (the one --fill model uses)
   bool scored = false;                      // compared with the truth (a truth and a table)
   ReconstructionError error_against_truth;  // in the measured domain (theta <= 80 degrees)
   double total_s = 0.0;                     // wall time of the stage
@@ -80,5 +89,12 @@ ReconstructResult Reconstruct(const std::vector<BrdfSample>& samples, const Reco
 // files, as `ibrdf reconstruct` does; the total time includes reading them.
 ReconstructResult ReconstructFile(const std::string& samples_file, const ReconstructOptions& options,
                                   const std::string& out_dir);
+
+// Evaluates `material_file` (a material file, truth.json or MERL table) at the points of
+// options.eval_file into `out_dir`/eval.npy (N x 3 RGB; -1 where a MERL table has no data) and
+// summary.json, without samples or regression (`ibrdf reconstruct --material M --eval P`). Throws
+// Error on an unreadable material or points file.
+ReconstructResult EvaluateMaterial(const std::string& material_file, const ReconstructOptions& options,
+                                   const std::string& out_dir);
 
 }  // namespace ibrdf

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
+#include "core/merl_brdf.h"
 #include "core/sample_file.h"
 #include "core/statistics.h"
 
@@ -125,6 +126,13 @@ std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path) {
   std::unique_ptr<BrdfModel> material = MaterialFromJson(root.Raw("material"), truth_path, "/material");
   root.Finish();
   return material;
+}
+
+std::unique_ptr<BrdfModel> LoadTruthFile(const std::string& path) {
+  if (IsMerlPath(path)) return LoadMaterial(path);
+  const nlohmann::json json = ReadJsonFile(path);
+  if (json.is_object() && json.contains("format")) return LoadTruthMaterial(path);
+  return MaterialFromJson(json, path);
 }
 
 std::string TruthPathFromSidecar(const std::string& samples_path) {

@@ -44,6 +44,8 @@ nlohmann::json ToJson(const TruthComparison& comparison);
 // written by synth/synthetic.cc). Throws Error naming the file and field for another format or an
 // unknown version.
 std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path);
+// Any truth: truth.json (as LoadTruthMaterial), a plain material file, or a MERL table (".binary").
+std::unique_ptr<BrdfModel> LoadTruthFile(const std::string& path);
 
 // truth.json beside the session the samples came from, as the samples' sidecar records it. Throws Error
 // (suggesting --truth) when there is no sidecar, it names no session, or the session has no truth.json.

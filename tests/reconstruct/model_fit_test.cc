@@ -40,6 +40,23 @@ TEST(ModelFit, LafortuneCostGradientIsCorrect) {
   delete cost;
 }
 
+TEST(ModelFit, LafortuneAnalyticCostMatchesAutoDiffAndNumericGradient) {
+  const Eigen::Vector3d wi = FromSpherical(0.5, 0.2), wo = FromSpherical(0.6, 2.9);
+  LafortuneAnalyticResidual<3> analytic(wi, wo, 0.7, 0.05);
+  LafortuneResidual<3> reference(wi, wo, 0.7, 0.05);
+  double p[10] = {0.3, -1.0, 0.8, 20.0, 0.5, 0.6, 3.0, -0.6, 0.4, 2.0};
+  const double* parameters[1] = {p};
+  double r_analytic = 0.0, r_reference = 0.0;
+  ASSERT_TRUE(analytic.Evaluate(parameters, &r_analytic, nullptr));
+  ASSERT_TRUE(reference(p, &r_reference));
+  EXPECT_NEAR(r_analytic, r_reference, 1e-12 * std::max(1.0, std::abs(r_reference)));
+  ceres::NumericDiffOptions numeric;
+  const std::vector<const ceres::Manifold*>* no_manifolds = nullptr;
+  ceres::GradientChecker checker(&analytic, no_manifolds, numeric);
+  ceres::GradientChecker::ProbeResults results;
+  EXPECT_TRUE(checker.Probe(parameters, 1e-6, &results)) << results.error_log;
+}
+
 TEST(ModelFit, GgxCostGradientIsCorrect) {
   const Eigen::Vector3d wi = FromSpherical(0.5, 0.2), wo = FromSpherical(0.6, 2.9);
   auto* cost = new ceres::AutoDiffCostFunction<GgxResidual, 3, 3, 3, 1>(
@@ -94,8 +111,79 @@ TEST(ModelFit, GgxRecoversGgxMaterialAndWritesSnippets) {
   const ModelFitResult fit = FitGgx(samples, options);
   ASSERT_TRUE(fit.success);
   EXPECT_LT(RelativeRmsAgainst(*fit.brdf, *material, samples), 0.01) << fit.BriefReport();
-  EXPECT_NE(PbrtV4Material(*fit.brdf, "m").find("coateddiffuse"), std::string::npos);
-  EXPECT_NE(Mitsuba3Material(*fit.brdf, "m").find("roughplastic"), std::string::npos);
+  const RendererSnippets snippets = RendererMaterials(fit, "m");
+  EXPECT_NE(snippets.pbrt.find("coateddiffuse"), std::string::npos);
+  EXPECT_NE(snippets.mitsuba.find("roughplastic"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace ibrdf
+
+namespace ibrdf {
+namespace {
+
+// A one-lobe truth (bluepaint's diffuse and its main specular lobe): the one-lobe fit of its session
+// recovers the lobe's exponent within 20 % in every channel, and says when a parameter sits at a bound.
+TEST(ModelFitPlausibility, OneLobeFitRecoversTheExponent) {
+  const auto bluepaint = LoadMaterial(MaterialPath("bluepaint"));
+  const auto& three = dynamic_cast<const LafortuneBrdf&>(*bluepaint);
+  const LafortuneBrdf truth(three.diffuse(), {three.lobes()[2]});
+  const auto samples = testing::SessionSamples(truth, CameraEffects::None(), 12, 200, 150);
+  ModelFitOptions options;
+  options.lafortune_lobes = 1;
+  options.max_samples = 5000;
+  const ModelFitResult fit = FitLafortune(samples, options);
+  ASSERT_TRUE(fit.success);
+  const auto& fitted = dynamic_cast<const LafortuneBrdf&>(*fit.brdf);
+  for (int c = 0; c < 3; ++c) {
+    const double n_true = truth.lobes()[0].n[c];
+    EXPECT_NEAR(fitted.lobes()[0].n[c], n_true, 0.2 * n_true) << c << ": " << fit.BriefReport();
+  }
+  EXPECT_TRUE(fit.at_bound.empty()) << fit.BriefReport();
+}
+
+// Every bundled material and a Lafortune truth with broad lobes: each fitted model's directional
+// albedo stays at most 1 over the whole hemisphere, no fit exceeds 3x the truth at retro-reflection
+// up to grazing (never sampled: the cameras start 8 degrees from the light), and the chosen model
+// (the lower error against the samples) is within 3x of the truth there up to 80 degrees, the
+// derenderer's grazing limit. Beyond it the felt's grazing retro-reflection is under-estimated (5x
+// at 85 degrees): reported in docs/benchmarks.md, not tested.
+TEST(ModelFitPlausibility, FitsArePlausibleWhereNoCameraLooked) {
+  std::vector<std::pair<std::string, std::unique_ptr<BrdfModel>>> truths;
+  for (const char* name : {"bluepaint", "clay", "felt", "glossy-ggx", "lambertian50", "primer"}) {
+    truths.emplace_back(name, LoadMaterial(MaterialPath(name)));
+  }
+  const LafortuneLobe broad_retro{Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Constant(0.5),
+                                  Eigen::Vector3d::Constant(2.0)};
+  const LafortuneLobe broad_forward{Eigen::Vector3d::Constant(-0.5), Eigen::Vector3d::Constant(0.5),
+                                    Eigen::Vector3d::Constant(3.0)};
+  truths.emplace_back("broad-lafortune",
+                      std::make_unique<LafortuneBrdf>(Eigen::Vector3d(0.3, 0.3, 0.3),
+                                                      std::vector<LafortuneLobe>{broad_retro, broad_forward}));
+  for (const auto& [name, truth] : truths) {
+    ASSERT_LE(MaxDirectionalAlbedo(*truth), 1.0) << name << ": the truth itself must be plausible";
+    const auto samples = testing::SessionSamples(*truth, CameraEffects::None(), 10, 200, 150);
+    ModelFitOptions options;
+    options.max_samples = 4000;
+    const ModelFitResult lafortune = FitLafortune(samples, options), ggx = FitGgx(samples, options);
+    const ModelFitResult& chosen = lafortune.rel_rms < ggx.rel_rms ? lafortune : ggx;
+    for (const ModelFitResult* fit : {&lafortune, &ggx}) {
+      ASSERT_TRUE(fit->success);
+      EXPECT_LE(fit->max_albedo, 1.0) << name << " " << fit->BriefReport();
+      EXPECT_NEAR(fit->max_albedo, MaxDirectionalAlbedo(*fit->brdf), 1e-12);
+      for (double theta_deg : {70.0, 80.0, 85.0, 89.0}) {
+        const Eigen::Vector3d w = FromSpherical(theta_deg * M_PI / 180.0, 0.3);
+        const Eigen::Vector3d f = fit->brdf->Eval(w, w), t = truth->Eval(w, w);
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_LE(f[c], 3.0 * t[c]) << name << " " << fit->model << " retro at " << theta_deg << " deg, channel " << c
+                                      << ": " << fit->brdf->ToJson().dump();
+          if (fit != &chosen || theta_deg > 80.0) continue;
+          EXPECT_GE(f[c], t[c] / 3.0) << name << " " << fit->model << " retro at " << theta_deg << " deg, channel " << c
+                                      << ": " << fit->brdf->ToJson().dump();
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
