@@ -78,7 +78,7 @@ PoseMarkers CollectMarkers(const Session& session, const MarkerDictionary& dicti
     }
   }
   if (targets.light) {
-    if (session.light.kind != Light::Kind::kPoint) {
+    if (session.lights.at(targets.light->light).kind != Light::Kind::kPoint) {
       ThrowError(session.manifest_path + ": /targets/light", "markers on the light need a point light");
     }
     for (const LightMarkerSpec& marker : targets.light->markers) {
@@ -281,7 +281,7 @@ Session AlignedSession(const Session& session, const AlignResult& result, const 
     photo.camera_from_world = result.images[i].camera_from_world;
     aligned.photos.push_back(photo);
   }
-  if (result.light.fitted) aligned.light.position = result.light.position;
+  if (result.light.fitted) aligned.lights.at(session.targets->light->light).position = result.light.position;
   const TargetsSpec& targets = *session.targets;
   if (targets.unknown_layout) {
     TargetsSpec& aligned_targets = *aligned.targets;

@@ -11,7 +11,8 @@ void AddSynthCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "synth",
       "Render a synthetic measurement session (photos, session.json, truth.json) of an analytic sphere or\n"
-      "cylinder with a known BRDF, cameras on an arc from beside the light to opposite it (paper, Fig. 3/4);\n"
+      "cylinder with a known BRDF, cameras on an arc from beside the light to opposite it (paper, Fig. 3/4),\n"
+      "or (--rig) a light dome or a turntable;\n"
       "or (--shape) of a squash, clay pot or dented sphere as a mesh sample with simulated range scans.");
   struct Args {
     std::string out, material;
@@ -31,9 +32,19 @@ void AddSynthCommand(CLI::App& app) {
   add("--sample", r.sample, "sphere or cylinder")->check(CLI::IsMember({"sphere", "cylinder"}));
   add("--radius", o.scene.sample_radius, "Sample radius, metres");
   add("--length", o.scene.cylinder_length, "Cylinder length, metres (axis vertical)");
-  add("--photos", o.rig.num_photos, "Number of photos on the arc");
-  add("--arc-start-deg", o.rig.arc_start_deg, "First camera azimuth from the light direction");
-  add("--arc-end-deg", o.rig.arc_end_deg, "Last camera azimuth from the light direction");
+  add("--rig", r.rig,
+      "arc: one light, cameras on an arc (the paper); dome: one fixed camera, a light per photo on the\n"
+      "upper hemisphere; turntable: camera and light fixed while the sample turns (a pose and a light\n"
+      "per photo in the sample's frame)")
+      ->check(CLI::IsMember({"arc", "dome", "turntable"}));
+  add("--photos", o.rig.num_photos, "Number of photos (arc: cameras; dome: lights; turntable: turntable stops)");
+  add("--arc-start-deg", o.rig.arc_start_deg,
+      "First camera azimuth from the light direction (dome: the smallest angle between camera and a light)");
+  add("--arc-end-deg", o.rig.arc_end_deg,
+      "Last camera azimuth from the light direction (dome: the largest angle between camera and a light)");
+  add("--dome-min-elevation-deg", o.rig.dome_min_elevation_deg, "Dome: the lowest lights' elevation");
+  add("--turntable-phase-deg", o.rig.turntable_phase_deg, "Turntable: camera azimuth from the light, in the lab");
+  add("--turntable-span-deg", o.rig.turntable_span_deg, "Turntable: the sample's turn over all photos");
   add("--camera-distance", o.rig.camera_distance, "Metres from the sample centre");
   auto* elevation =
       add("--camera-elevation-deg", o.rig.camera_elevation_deg, "Camera elevation above the light's plane");
@@ -59,7 +70,7 @@ void AddSynthCommand(CLI::App& app) {
   add("--brackets", o.radiometry.brackets, "Exposures per pose (an HDR bracket): the auto-exposure and shorter ones");
   add("--bracket-step-ev", o.radiometry.bracket_step_ev, "Stops between a bracket's exposures");
   c.add_flag("--light-unknown", o.radiometry.light_unknown,
-             "State a unit light intensity in session.json and add a white-reference photo that calibrates it");
+             "State no light intensity in session.json and add a white-reference photo per light that measures it");
   add("--exposure-target", o.rig.exposure_target, "Auto-exposure: 99th percentile lands here");
   add("--fill-light", o.scene.fill_light,
       "Unmodelled fill light along each normal, as a fraction of the light's irradiance");

@@ -5,6 +5,10 @@
 
 namespace ibrdf {
 
+const char* LightKindName(Light::Kind kind) { return kind == Light::Kind::kPoint ? "point" : "directional"; }
+
+std::string LightLabel(const Light& light) { return light.id.empty() ? "the light" : "light " + light.id; }
+
 Incidence IncidenceAt(const Light& light, const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
   Incidence incidence;
   double inverse_square = 1.0;

@@ -1,11 +1,16 @@
 // The one small light of an image-based BRDF measurement (the paper's section 3).
 #pragma once
 
+#include <string>
+
 #include <Eigen/Core>
 
 namespace ibrdf {
 
 struct Light {
+  // The light's name in the session (docs/session-format.md, version 2: photos name their light by
+  // it); empty for the one light of a session that states a single `light`.
+  std::string id;
   enum class Kind {
     kPoint,        // a small source at `position`; `intensity` is radiant intensity (per steradian)
     kDirectional,  // a distant source towards `direction`; `intensity` is irradiance at normal incidence
@@ -16,7 +21,16 @@ struct Light {
   // RGB, in the session's radiance units (linear pixel value per second of exposure at unit gain)
   // times square metres for a point light.
   Eigen::Vector3d intensity = Eigen::Vector3d::Ones();
+  // False where the session states no intensity for this light: a calibration (the white reference,
+  // derender/light_calibration.h) must measure it before the light is used; `intensity` is then a
+  // placeholder (ones).
+  bool has_intensity = true;
 };
+
+// "point", "directional".
+const char* LightKindName(Light::Kind kind);
+// The light's name for messages: "light L07", or "the light" for an unnamed one.
+std::string LightLabel(const Light& light);
 
 // What a surface point receives from the light.
 struct Incidence {

@@ -38,7 +38,7 @@ std::array<Eigen::Vector3d, 4> MarkerCorners(JsonObject& marker) {
 }
 
 constexpr char kFormat[] = "ibrdf-session";
-constexpr int kVersion = 1;
+constexpr int kVersion = 2;  // written; versions 1 and 2 are read
 
 void RequirePositive(JsonObject& object, const std::string& key, double value) {
   if (!(value > 0.0)) ThrowError(object.Where(key), "must be positive, got " + std::to_string(value));
@@ -59,8 +59,15 @@ Camera ParseCamera(JsonObject object) {
   return Camera::Create(model, width, height, std::move(params), object.Where());
 }
 
-Light ParseLight(JsonObject object) {
+// A light object: the single `light` (any version) or an entry of version 2's `lights` (which needs
+// an id). Version 2 lets a light leave out its intensity when a calibration measures it (checked once
+// the calibration block is read).
+Light ParseLight(JsonObject object, int version, bool needs_id) {
   Light light;
+  if (version >= 2 && (needs_id || object.Has("id"))) {
+    light.id = object.String("id");
+    if (light.id.empty()) ThrowError(object.Where("id"), "a light's id must not be empty");
+  }
   const std::string kind = object.String("kind");
   if (kind == "point") {
     light.kind = Light::Kind::kPoint;
@@ -73,12 +80,53 @@ Light ParseLight(JsonObject object) {
   } else {
     ThrowError(object.Where("kind"), "unknown light kind \"" + kind + "\" (expected point or directional)");
   }
-  light.intensity = object.Vector3("intensity");
-  if ((light.intensity.array() < 0.0).any() || !(light.intensity.maxCoeff() > 0.0)) {
-    ThrowError(object.Where("intensity"), "must be non-negative and not all zero");
+  if (version >= 2 && !object.Has("intensity")) {
+    light.has_intensity = false;
+  } else {
+    light.intensity = object.Vector3("intensity");
+    if ((light.intensity.array() < 0.0).any() || !(light.intensity.maxCoeff() > 0.0)) {
+      ThrowError(object.Where("intensity"), "must be non-negative and not all zero");
+    }
   }
   object.Finish();
   return light;
+}
+
+// "L01, L02, L03" for messages (at most 12 ids shown).
+std::string LightIds(const std::vector<Light>& lights) {
+  std::string ids;
+  for (size_t k = 0; k < lights.size() && k < 12; ++k) ids += (k ? ", " : "") + lights[k].id;
+  if (lights.size() > 12) ids += ", ... (" + std::to_string(lights.size()) + " lights)";
+  return ids;
+}
+
+// What a photo's keys are checked against: the manifest's version and its lights.
+struct PhotoContext {
+  int version = 1;
+  const std::vector<Light>* lights = nullptr;
+  bool white_reference = false;  // a white-reference photo (no role, no mask)
+};
+
+// A photo's (or a light-marker block's) `light`: the id of one of the session's lights. With one light
+// the key may be left out; with several it is required (`required`, for photos that are lit).
+size_t ParseLightReference(JsonObject& object, const std::vector<Light>& lights, bool required,
+                           const std::string& what) {
+  if (!object.Has("light")) {
+    if (lights.size() == 1 || !required) return 0;
+    ThrowError(object.Where("light"), what + " must name its light: the session has " + std::to_string(lights.size()) +
+                                          " (" + LightIds(lights) + ")");
+  }
+  const std::string id = object.String("light");
+  for (size_t k = 0; k < lights.size(); ++k) {
+    if (lights[k].id == id && !id.empty()) return k;
+  }
+  if (lights.size() == 1 && lights[0].id.empty()) {
+    ThrowError(object.Where("light"), what + " names light \"" + id +
+                                          "\" but the session's one light has no id (give it \"id\": \"" + id +
+                                          "\", or leave the photo's light out)");
+  }
+  ThrowError(object.Where("light"), what + " names light \"" + id +
+                                        "\", which the session does not have (its lights: " + LightIds(lights) + ")");
 }
 
 Rigid3d ParsePose(JsonObject object);
@@ -239,7 +287,7 @@ Rigid3d ParsePose(JsonObject object) {
   return pose;
 }
 
-PhotoSpec ParsePhoto(JsonObject object, const std::string& directory) {
+PhotoSpec ParsePhoto(JsonObject object, const std::string& directory, const PhotoContext& context) {
   PhotoSpec photo;
   photo.file = object.String("file");
   photo.exposure_s = object.Number("exposure_s");
@@ -257,13 +305,33 @@ PhotoSpec ParsePhoto(JsonObject object, const std::string& directory) {
     photo.bracket = object.Integer("bracket");
     if (*photo.bracket < 0) ThrowError(object.Where("bracket"), "bracket ids are non-negative");
   }
+  if (context.version < 2) {
+    for (const char* key : {"light", "mask"}) {
+      if (object.Has(key)) {
+        ThrowError(object.Where(key),
+                   std::string("a photo's \"") + key + "\" needs \"version\": 2 (this manifest is version 1)");
+      }
+    }
+  } else {
+    photo.light = ParseLightReference(object, *context.lights, photo.role == PhotoRole::kMeasurement, "the photo");
+    if (object.Has("mask")) {
+      if (context.white_reference) ThrowError(object.Where("mask"), "a white-reference photo takes no mask");
+      if (photo.role == PhotoRole::kTargets) {
+        ThrowError(object.Where("mask"), "a targets photo is not derendered; masks apply to measurement photos");
+      }
+      photo.mask = object.String("mask");
+      if (photo.mask.empty()) ThrowError(object.Where("mask"), "empty file name");
+      const std::string mask_path = ResolvePath(directory, photo.mask);
+      if (!fs::is_regular_file(mask_path)) ThrowError(object.Where("mask"), "mask " + mask_path + " does not exist");
+    }
+  }
   const std::string path = ResolvePath(directory, photo.file);
   if (!fs::is_regular_file(path)) ThrowError(object.Where("file"), "photo " + path + " does not exist");
   object.Finish();
   return photo;
 }
 
-TargetsSpec ParseTargets(JsonObject object) {
+TargetsSpec ParseTargets(JsonObject object, const std::vector<Light>& lights) {
   TargetsSpec targets;
   targets.dictionary = object.String("dictionary");
   std::set<int> seen;
@@ -339,6 +407,7 @@ TargetsSpec ParseTargets(JsonObject object) {
   if (object.Has("light")) {
     JsonObject light = object.Object("light");
     LightTargetsSpec spec;
+    spec.light = ParseLightReference(light, lights, true, "the light's markers");
     spec.size = light.Number("size");
     RequirePositive(light, "size", spec.size);
     for (JsonObject& marker : light.Objects("markers")) {
@@ -357,7 +426,8 @@ TargetsSpec ParseTargets(JsonObject object) {
   return targets;
 }
 
-CalibrationSpec ParseCalibration(JsonObject object, const std::string& directory) {
+CalibrationSpec ParseCalibration(JsonObject object, const std::string& directory, PhotoContext context) {
+  context.white_reference = true;
   CalibrationSpec calibration;
   if (object.Has("white_reference")) {
     JsonObject white = object.Object("white_reference");
@@ -373,7 +443,7 @@ CalibrationSpec ParseCalibration(JsonObject object, const std::string& directory
     spec.size = white.Number("size");
     RequirePositive(white, "size", spec.size);
     for (JsonObject& photo : white.Objects("photos")) {
-      spec.photos.push_back(ParsePhoto(photo, directory));
+      spec.photos.push_back(ParsePhoto(photo, directory, context));
       if (spec.photos.back().role != PhotoRole::kMeasurement) {
         ThrowError(photo.Where("role"), "a white-reference photo has no role");
       }
@@ -438,22 +508,66 @@ Session Session::Load(const std::string& path) {
   const std::string format = root.String("format");
   if (format != kFormat) ThrowError(root.Where("format"), "expected \"" + std::string(kFormat) + "\"");
   const int version = root.Integer("version");
-  if (version != kVersion) {
-    ThrowError(root.Where("version"), "unsupported version " + std::to_string(version) + " (this ibrdf reads version " +
-                                          std::to_string(kVersion) + ")");
+  if (version != 1 && version != 2) {
+    ThrowError(root.Where("version"),
+               "unsupported version " + std::to_string(version) + " (this ibrdf reads versions 1 and 2)");
   }
   session.name = root.String("name", fs::path(session.directory).filename().string());
   session.description = root.String("description", "");
   session.camera = ParseCamera(root.Object("camera"));
-  session.light = ParseLight(root.Object("light"));
+  session.lights.clear();
+  if (version >= 2 && root.Has("lights")) {
+    if (root.Has("light")) {
+      ThrowError(root.Where("light"), "give either one \"light\" or a \"lights\" array, not both");
+    }
+    for (JsonObject& light : root.Objects("lights")) {
+      session.lights.push_back(ParseLight(light, version, true));
+      for (size_t k = 0; k + 1 < session.lights.size(); ++k) {
+        if (session.lights[k].id == session.lights.back().id) {
+          ThrowError(light.Where("id"), "light id \"" + session.lights.back().id + "\" is listed twice");
+        }
+      }
+    }
+    if (session.lights.empty()) ThrowError(root.Where("lights"), "expected at least one light");
+  } else {
+    session.lights.push_back(ParseLight(root.Object("light"), version, false));
+  }
+  if (version >= 2 && root.Has("mask")) {
+    session.mask = root.String("mask");
+    if (session.mask.empty()) ThrowError(root.Where("mask"), "empty file name");
+    const std::string mask_path = ResolvePath(session.directory, session.mask);
+    if (!fs::is_regular_file(mask_path)) ThrowError(root.Where("mask"), "mask " + mask_path + " does not exist");
+  }
+  PhotoContext context;
+  context.version = version;
+  context.lights = &session.lights;
   session.sample = ParseSample(root.Object("sample"));
   if (root.Has("radiometry")) session.radiometry = ParseRadiometry(root.Object("radiometry"), session.directory);
-  if (root.Has("calibration")) session.calibration = ParseCalibration(root.Object("calibration"), session.directory);
-  if (root.Has("targets")) session.targets = ParseTargets(root.Object("targets"));
+  if (root.Has("calibration")) {
+    session.calibration = ParseCalibration(root.Object("calibration"), session.directory, context);
+  }
+  if (root.Has("targets")) session.targets = ParseTargets(root.Object("targets"), session.lights);
   for (JsonObject& photo : root.Objects("photos")) {
-    session.photos.push_back(ParsePhoto(photo, session.directory));
+    session.photos.push_back(ParsePhoto(photo, session.directory, context));
   }
   if (session.photos.empty()) ThrowError(root.Where("photos"), "a session needs at least one photo");
+  // A light without a stated intensity needs a calibration that measures it.
+  for (size_t k = 0; k < session.lights.size(); ++k) {
+    const Light& light = session.lights[k];
+    if (light.has_intensity) continue;
+    bool calibrated = false;
+    if (session.calibration && session.calibration->white_reference) {
+      for (const PhotoSpec& photo : session.calibration->white_reference->photos) calibrated |= photo.light == k;
+    }
+    if (!calibrated) {
+      const std::string pointer = root.Has("lights") ? "/lights/" + std::to_string(k) : "/light";
+      ThrowError(session.manifest_path + ": " + pointer,
+                 LightLabel(light) +
+                     " has no intensity and no calibration measures it: give its \"intensity\", or "
+                     "white-reference photos under it (calibration.white_reference.photos" +
+                     (light.id.empty() ? std::string() : " with \"light\": \"" + light.id + "\"") + ")");
+    }
+  }
   root.Finish();
   return session;
 }
@@ -468,12 +582,28 @@ nlohmann::json Session::ToJson() const {
                     {"width", camera.width},
                     {"height", camera.height},
                     {"params", camera.params}};
-  if (light.kind == Light::Kind::kPoint) {
-    json["light"] = {{"kind", "point"}, {"position", ibrdf::ToJson(light.position)}};
+  auto light_json = [](const Light& light) {
+    nlohmann::json l;
+    if (!light.id.empty()) l["id"] = light.id;
+    l["kind"] = LightKindName(light.kind);
+    if (light.kind == Light::Kind::kPoint) {
+      l["position"] = ibrdf::ToJson(light.position);
+    } else {
+      l["direction"] = ibrdf::ToJson(light.direction);
+    }
+    if (light.has_intensity) l["intensity"] = ibrdf::ToJson(light.intensity);
+    return l;
+  };
+  IBRDF_CHECK(!lights.empty()) << "a session without lights";
+  // One unnamed light: the `light` shorthand; otherwise the `lights` array, and photos name theirs.
+  const bool named_lights = lights.size() > 1 || !lights[0].id.empty();
+  if (!named_lights) {
+    json["light"] = light_json(lights[0]);
   } else {
-    json["light"] = {{"kind", "directional"}, {"direction", ibrdf::ToJson(light.direction)}};
+    json["lights"] = nlohmann::json::array();
+    for (const Light& light : lights) json["lights"].push_back(light_json(light));
   }
-  json["light"]["intensity"] = ibrdf::ToJson(light.intensity);
+  if (!mask.empty()) json["mask"] = mask;
   nlohmann::json& s = json["sample"];
   s["kind"] = SampleKindName(sample.kind);
   if (sample.kind == SampleSpec::Kind::kMesh) {
@@ -559,10 +689,13 @@ nlohmann::json Session::ToJson() const {
         markers.push_back({{"id", m.id}, {"light_in_marker", ibrdf::ToJson(m.light_in_marker)}});
       }
       json["targets"]["light"] = {{"size", targets->light->size}, {"markers", markers}};
+      if (named_lights) json["targets"]["light"]["light"] = lights.at(targets->light->light).id;
     }
   }
-  auto photo_json = [](const PhotoSpec& photo) {
+  auto photo_json = [&](const PhotoSpec& photo) {
     nlohmann::json p = {{"file", photo.file}, {"exposure_s", photo.exposure_s}, {"gain", photo.gain}};
+    if (named_lights) p["light"] = lights.at(photo.light).id;
+    if (!photo.mask.empty()) p["mask"] = photo.mask;
     if (photo.camera_from_world) p["camera_from_world"] = PoseToJson(*photo.camera_from_world);
     if (photo.role == PhotoRole::kTargets) p["role"] = "targets";
     if (photo.bracket) p["bracket"] = *photo.bracket;
@@ -601,7 +734,11 @@ Session Session::Rebased(const std::string& dir, PathStyle style) const {
     *file = style == PathStyle::kAbsolute || relative.empty() ? absolute.string() : relative.string();
   };
   Session rebased = *this;
-  for (PhotoSpec& photo : rebased.photos) rebase(&photo.file);
+  for (PhotoSpec& photo : rebased.photos) {
+    rebase(&photo.file);
+    rebase(&photo.mask);
+  }
+  rebase(&rebased.mask);
   rebase(&rebased.radiometry.flat_field);
   if (rebased.calibration && rebased.calibration->white_reference) {
     for (PhotoSpec& photo : rebased.calibration->white_reference->photos) rebase(&photo.file);
@@ -624,6 +761,10 @@ std::string Session::SaveRebased(const std::string& dir, PathStyle style) const 
 std::vector<std::string> Session::InputFiles() const {
   std::vector<std::string> files;
   for (const PhotoSpec& photo : photos) files.push_back(AbsolutePath(photo.file));
+  if (!mask.empty()) files.push_back(AbsolutePath(mask));
+  for (const PhotoSpec& photo : photos) {
+    if (!photo.mask.empty()) files.push_back(AbsolutePath(photo.mask));
+  }
   if (!radiometry.flat_field.empty()) files.push_back(AbsolutePath(radiometry.flat_field));
   if (calibration && calibration->white_reference) {
     for (const PhotoSpec& photo : calibration->white_reference->photos) files.push_back(AbsolutePath(photo.file));
@@ -637,6 +778,26 @@ std::vector<std::string> Session::InputFiles() const {
 
 std::string Session::PhotoPath(size_t i) const { return ResolvePath(directory, photos.at(i).file); }
 
+const Light& Session::PhotoLight(size_t i) const {
+  const size_t light = photos.at(i).light;
+  IBRDF_CHECK(light < lights.size()) << "photo " << i << " names light " << light << " of " << lights.size();
+  return lights[light];
+}
+
+std::string Session::PhotoMaskPath(size_t i) const {
+  const PhotoSpec& photo = photos.at(i);
+  if (photo.role == PhotoRole::kTargets) return "";
+  const std::string& file = photo.mask.empty() ? mask : photo.mask;
+  return file.empty() ? "" : ResolvePath(directory, file);
+}
+
+int Session::LightIndex(const std::string& id) const {
+  for (size_t k = 0; k < lights.size(); ++k) {
+    if (lights[k].id == id) return static_cast<int>(k);
+  }
+  return -1;
+}
+
 void Session::CheckPhotos() const {
   for (size_t i = 0; i < photos.size(); ++i) {
     const ImageSpec spec = ReadImageSpec(PhotoPath(i));
@@ -648,6 +809,16 @@ void Session::CheckPhotos() const {
     }
     if (spec.channels != 1 && spec.channels < 3) {
       ThrowError(PhotoPath(i), "expected 1 (grey) or 3+ (RGB) channels, got " + std::to_string(spec.channels));
+    }
+    const std::string mask_path = PhotoMaskPath(i);
+    if (!mask_path.empty()) {
+      const ImageSpec mask_spec = ReadImageSpec(mask_path);
+      if (mask_spec.width != spec.width || mask_spec.height != spec.height) {
+        ThrowError(mask_path, "mask is " + std::to_string(mask_spec.width) + "x" + std::to_string(mask_spec.height) +
+                                  " but its photo " + PhotoPath(i) + " is " + std::to_string(spec.width) + "x" +
+                                  std::to_string(spec.height) + " (" + manifest_path + ": /photos/" +
+                                  std::to_string(i) + ")");
+      }
     }
   }
 }

@@ -91,6 +91,7 @@ struct LightMarkerSpec {
 
 // The markers on the light (the paper's section 3.2: the light's position from targets on it).
 struct LightTargetsSpec {
+  size_t light = 0;                      // the light they sit on: an index into Session::lights
   double size = 0.0;                     // metres, printed side of every light marker (border included)
   std::vector<LightMarkerSpec> markers;  // at least one
 };
@@ -130,10 +131,15 @@ struct PhotoSpec {
   double gain = 1.0;                         // linear gain relative to the base ISO
   std::optional<Rigid3d> camera_from_world;  // known pose, if any
   PhotoRole role = PhotoRole::kMeasurement;
-  // Exposure bracket: measurement photos with the same bracket id are exposures of one pose, merged
-  // into one high-dynamic-range radiance image (derender/radiance_image.h). Absent: photos with
-  // identical poses still form one bracket.
+  // Exposure bracket: measurement photos with the same bracket id are exposures of one pose under one
+  // light, merged into one high-dynamic-range radiance image (derender/radiance_image.h). Absent:
+  // photos with identical poses and the same light still form one bracket.
   std::optional<int> bracket;
+  // The light the photo was taken under: an index into Session::lights (the manifest names it by id).
+  size_t light = 0;
+  // Optional mask image (relative to the session folder): non-zero pixels are usable, zero pixels are
+  // never sampled. Empty: the session's default mask (Session::mask), if any.
+  std::string mask;
 };
 
 // A white reference (the paper's Spectralon step): a flat Lambertian target of known reflectance at a
@@ -158,7 +164,11 @@ struct Session {
   std::string directory;      // folder holding the manifest; relative paths resolve against it
   std::string manifest_path;  // the manifest file
   Camera camera;
-  Light light;
+  // The lights, at least one; each photo names its own (PhotoSpec::light). A version-1 manifest (or a
+  // version-2 one with the single `light` shorthand) has exactly one, with an empty id.
+  std::vector<Light> lights{Light()};
+  // The default mask of every measurement photo without its own (PhotoSpec::mask); empty: none.
+  std::string mask;
   SampleSpec sample;
   RadiometrySpec radiometry;
   std::vector<PhotoSpec> photos;
@@ -199,8 +209,16 @@ struct Session {
 
   // Absolute or session-relative path of photo i.
   std::string PhotoPath(size_t i) const;
+  // The light photo i was taken under.
+  const Light& PhotoLight(size_t i) const;
+  // The mask of photo i (its own, else the session's default) resolved against the session folder;
+  // empty when it has none.
+  std::string PhotoMaskPath(size_t i) const;
+  // The index of the light with this id in `lights`; -1 when there is none.
+  int LightIndex(const std::string& id) const;
 
-  // Opens every photo's header and checks its size against the camera; throws Error naming the photo.
+  // Opens every photo's header (and its mask's) and checks its size against the camera; throws Error
+  // naming the photo (and, for a mask of the wrong size, both files).
   void CheckPhotos() const;
 };
 

@@ -22,6 +22,7 @@
 #include "derender/analytic_sample.h"
 #include "derender/light_calibration.h"
 #include "derender/mesh_sample.h"
+#include "derender/photo_mask.h"
 #include "derender/radiance_image.h"
 #include "scan/convexity.h"
 #include "scan/scan_io.h"
@@ -37,6 +38,7 @@ constexpr double kDegree = M_PI / 180.0;
 // Rejection reasons in RejectionReasons() order; each pixel counts once, under the first that applies.
 enum Reason {
   kOff,
+  kMasked,
   kMixed,
   kTarget,
   kLowQuality,
@@ -184,6 +186,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
                        std::vector<BrdfSample>* samples, MeshPhotoStats* stats) {
   const MeshSample& mesh = *path.mesh;
   const PhotoSpec& photo = session.photos[photo_index];
+  const Light& light = session.PhotoLight(photo_index);
   const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
   const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
   const Eigen::Vector3d camera_center = world_from_camera.translation;
@@ -263,6 +266,10 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
           ++local.counts[kOff];
           continue;
         }
+        if (!image.mask.empty() && !image.mask[image.Index(x, y)]) {
+          ++local.counts[kMasked];
+          continue;
+        }
         const SurfaceHit& hit = hits[i];
         const Eigen::Vector3d& direction = directions[i];
         if (mask_mixed) {
@@ -292,7 +299,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
           ++local.counts[kBackfacing];
           continue;
         }
-        const Incidence incidence = IncidenceAt(session.light, hit.point, hit.normal);
+        const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
         if (!incidence.lit) {
           ++local.counts[kUnlit];
           continue;
@@ -306,8 +313,8 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
           continue;
         }
         if (path.shadow_rays) {
-          const Reason shadow = ShadowTest(mesh, session.light, incidence, hit.point, hit.normal, hit.fit_rms_m,
-                                           options, &local.shadow_rays);
+          const Reason shadow =
+              ShadowTest(mesh, light, incidence, hit.point, hit.normal, hit.fit_rms_m, options, &local.shadow_rays);
           if (shadow != kNumReasons) {
             ++local.counts[shadow];
             continue;
@@ -415,6 +422,11 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     if (sample.Contains(photo.camera_from_world->Inverse().translation)) {
       ThrowError(where, "the camera centre is inside the sample");
     }
+    if (photo.role == PhotoRole::kMeasurement && !session.PhotoLight(i).has_intensity) {
+      ThrowError(where, "photo " + photo.file + " was taken under " + LightLabel(session.PhotoLight(i)) +
+                            ", which has no intensity and no calibration measures it (give the light's "
+                            "\"intensity\", or white-reference photos under it)");
+    }
   }
   const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
   bool any_sees = groups.empty();
@@ -436,7 +448,8 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   std::vector<double> decode_s(groups.size(), 0.0);
   ProgressBar progress("photos", groups.size());
   tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
-    const RadianceImage image = ReadRadianceImage(session, groups[g], options.min_signal, &decode_s[g]);
+    RadianceImage image = ReadRadianceImage(session, groups[g], options.min_signal, &decode_s[g]);
+    image.mask = ReadGroupMask(session, groups[g]);
     if (mesh_path) {
       DerenderMeshPhoto(session, groups[g].front(), image, rays, *mesh_path, options, &per_group[g],
                         &per_group_mesh[g]);
@@ -509,6 +522,7 @@ bool DerenderOptions::Check(std::string* why) const {
 const std::vector<std::pair<std::string, std::string>>& RejectionReasons() {
   static const std::vector<std::pair<std::string, std::string>> kReasons = {
       {"off_sample", "the pixel's ray misses the sample (background, or a cylinder's end cap)"},
+      {"masked", "the pixel sees the sample but the photo's mask (or the session's default mask) excludes it"},
       {"mixed_pixel",
        "mesh: the pixel straddles the silhouette (a corner ray misses, or hits at a very different depth)"},
       {"occluded_by_target", "mesh: a reference marker lies between the camera and the sample"},
@@ -563,6 +577,7 @@ void DerenderPhoto(const Session& session, size_t photo_index, const RadianceIma
                    const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
                    const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected) {
   const PhotoSpec& photo = session.photos[photo_index];
+  const Light& light = session.PhotoLight(photo_index);
   const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
   const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
   const Eigen::Vector3d camera_center = world_from_camera.translation;
@@ -586,7 +601,11 @@ void DerenderPhoto(const Session& session, size_t photo_index, const RadianceIma
         ++counts[kOff];
         continue;
       }
-      const Incidence incidence = IncidenceAt(session.light, hit.point, hit.normal);
+      if (!image.mask.empty() && !image.mask[image.Index(x, y)]) {
+        ++counts[kMasked];
+        continue;
+      }
+      const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
       if (!incidence.lit) {
         ++counts[kUnlit];
         continue;

@@ -56,47 +56,59 @@ bool LightCalibrationOptions::Check(std::string* why) const {
 
 std::string LightCalibrationReport::BriefReport() const {
   if (!calibrated)
-    return "light calibration: none (the session has no white reference; its light intensity is used as stated)";
+    return "light calibration: none (the session has no white reference; its light intensities are used as stated)";
+  std::string text = "light calibration: white reference, " + std::to_string(photos) + " photos";
   char buffer[512];
-  std::snprintf(buffer, sizeof(buffer),
-                "light calibration: white reference, %d photos, %llu of %llu interior pixels in %.2f s: "
-                "intensity (%.6g, %.6g, %.6g) -> (%.6g, %.6g, %.6g), spread %.2f %%, %.2f %%, %.2f %%; rejected: ",
-                photos, static_cast<unsigned long long>(pixels_used), static_cast<unsigned long long>(interior_pixels),
-                total_s, stated_intensity[0], stated_intensity[1], stated_intensity[2], calibrated_intensity[0],
-                calibrated_intensity[1], calibrated_intensity[2], 100.0 * spread[0], 100.0 * spread[1],
-                100.0 * spread[2]);
-  return buffer + FormatCounts(rejected);
+  std::snprintf(buffer, sizeof(buffer), " in %.2f s", total_s);
+  text += buffer;
+  for (const LightIntensityReport& light : lights) {
+    char stated[128] = "not stated";
+    if (light.stated) {
+      std::snprintf(stated, sizeof(stated), "(%.6g, %.6g, %.6g)", light.stated_intensity[0], light.stated_intensity[1],
+                    light.stated_intensity[2]);
+    }
+    std::snprintf(buffer, sizeof(buffer),
+                  "; %s%s%d photos, %llu of %llu interior pixels: intensity %s -> (%.6g, %.6g, %.6g), spread %.2f %%, "
+                  "%.2f %%, %.2f %%; rejected: ",
+                  light.light.empty() ? "" : "light ", light.light.empty() ? "" : (light.light + ": ").c_str(),
+                  light.photos, static_cast<unsigned long long>(light.pixels_used),
+                  static_cast<unsigned long long>(light.interior_pixels), stated, light.calibrated_intensity[0],
+                  light.calibrated_intensity[1], light.calibrated_intensity[2], 100.0 * light.spread[0],
+                  100.0 * light.spread[1], 100.0 * light.spread[2]);
+    text += buffer + FormatCounts(light.rejected);
+  }
+  return text;
 }
 
-Session ApplyLightCalibration(const Session& session, LightCalibrationReport* report,
-                              const LightCalibrationOptions& options) {
-  IBRDF_CHECK(report != nullptr);
-  Timer timer;
-  *report = LightCalibrationReport();
-  report->stated_intensity = session.light.intensity;
-  Session calibrated = session;
-  if (!session.calibration || !session.calibration->white_reference) {
-    report->calibrated_intensity = session.light.intensity;
-    report->success = true;
-    return calibrated;
-  }
-  std::string why;
-  if (!options.Check(&why)) ThrowError("light calibration options", why);
+namespace {
+
+// The white reference's measurement of light `light_index` from the white-reference photos `photos`
+// (indices into white.photos) taken under it.
+void CalibrateLight(const Session& session, size_t light_index, const std::vector<size_t>& photos,
+                    const LightCalibrationOptions& options, LightIntensityReport* report) {
   const WhiteReferenceSpec& white = *session.calibration->white_reference;
+  const Light& light = session.lights[light_index];
   const std::string where = session.manifest_path + ": /calibration/white_reference";
+  const std::string label = session.lights.size() > 1 ? " (" + LightLabel(light) + ")" : std::string();
   const double radius = 0.5 * options.interior_fraction * white.size;
   const double cos_max = std::cos(options.max_theta_deg * kDegree);
+  report->light = light.id;
+  report->photos = static_cast<int>(photos.size());
+  report->stated = light.has_intensity;
+  if (light.has_intensity) report->stated_intensity = light.intensity;
   // The light with unit intensity: its irradiance per unit of intensity at each point.
-  Light unit_light = session.light;
+  Light unit_light = light;
   unit_light.intensity = Eigen::Vector3d::Ones();
   {
     const Incidence incidence = IncidenceAt(unit_light, white.center, white.normal);
-    if (!incidence.lit) ThrowError(where, "the white reference faces away from the light (check its normal)");
+    if (!incidence.lit) {
+      ThrowError(where, "the white reference faces away from " + LightLabel(light) + " (check its normal)");
+    }
   }
 
   const RadianceReader reader(session);
   std::vector<double> estimates[3];
-  for (size_t k = 0; k < white.photos.size(); ++k) {
+  for (size_t k : photos) {
     const PhotoSpec& photo = white.photos[k];
     const std::string photo_where = where + "/photos/" + std::to_string(k);
     const std::string path = ResolvePath(session.directory, photo.file);
@@ -160,28 +172,56 @@ Session ApplyLightCalibration(const Session& session, LightCalibrationReport* re
     }
   }
   if (report->interior_pixels < uint64_t(options.min_pixels)) {
-    ThrowError(where,
-               "the white reference is not in view: its interior covers " + std::to_string(report->interior_pixels) +
-                   " pixel centres in " + std::to_string(white.photos.size()) + " photos (at least " +
-                   std::to_string(options.min_pixels) + " needed; check center, normal, size and the photos' poses)");
+    ThrowError(where, "the white reference is not in view" + label + ": its interior covers " +
+                          std::to_string(report->interior_pixels) + " pixel centres in " +
+                          std::to_string(photos.size()) + " photos (at least " + std::to_string(options.min_pixels) +
+                          " needed; check center, normal, size and the photos' poses)");
   }
   if (report->pixels_used < uint64_t(options.min_pixels)) {
     ThrowError(where, "only " + std::to_string(report->pixels_used) + " of the white reference's " +
-                          std::to_string(report->interior_pixels) +
-                          " interior pixels are measurable (rejected: " + FormatCounts(report->rejected) +
-                          "); at least " + std::to_string(options.min_pixels) + " needed");
+                          std::to_string(report->interior_pixels) + " interior pixels are measurable" + label +
+                          " (rejected: " + FormatCounts(report->rejected) + "); at least " +
+                          std::to_string(options.min_pixels) + " needed");
   }
   for (int c = 0; c < 3; ++c) {
     const double median = Median(estimates[c]);
     if (!(median > 0.0 && std::isfinite(median))) {
-      ThrowError(where, "the white reference gives no positive light intensity in channel " + std::to_string(c));
+      ThrowError(where,
+                 "the white reference gives no positive light intensity in channel " + std::to_string(c) + label);
     }
     std::vector<double> deviations(estimates[c].size());
     for (size_t i = 0; i < deviations.size(); ++i) deviations[i] = std::abs(estimates[c][i] - median);
     report->calibrated_intensity[c] = median;
     report->spread[c] = 1.4826 * Median(deviations) / median;
   }
-  calibrated.light.intensity = report->calibrated_intensity;
+}
+
+}  // namespace
+
+Session ApplyLightCalibration(const Session& session, LightCalibrationReport* report,
+                              const LightCalibrationOptions& options) {
+  IBRDF_CHECK(report != nullptr);
+  Timer timer;
+  *report = LightCalibrationReport();
+  Session calibrated = session;
+  if (!session.calibration || !session.calibration->white_reference) {
+    report->success = true;
+    return calibrated;
+  }
+  std::string why;
+  if (!options.Check(&why)) ThrowError("light calibration options", why);
+  const WhiteReferenceSpec& white = *session.calibration->white_reference;
+  for (size_t k = 0; k < session.lights.size(); ++k) {
+    std::vector<size_t> photos;
+    for (size_t j = 0; j < white.photos.size(); ++j) {
+      if (white.photos[j].light == k) photos.push_back(j);
+    }
+    if (photos.empty()) continue;
+    report->lights.emplace_back();
+    CalibrateLight(session, k, photos, options, &report->lights.back());
+    calibrated.lights[k].intensity = report->lights.back().calibrated_intensity;
+    calibrated.lights[k].has_intensity = true;
+  }
   report->photos = static_cast<int>(white.photos.size());
   report->calibrated = true;
   report->total_s = timer.ElapsedSeconds();

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -32,27 +33,39 @@ struct LightCalibrationOptions {
   bool Check(std::string* why) const;
 };
 
-struct LightCalibrationReport {
-  // The report is filled as the step goes: true once ApplyLightCalibration returned; false when it
-  // threw (the report then holds what was counted before the error).
-  bool success = false;
-  bool calibrated = false;  // false where the session has no white reference (the light is unchanged)
-  int photos = 0;           // white-reference photos
-  Eigen::Vector3d stated_intensity = Eigen::Vector3d::Zero();      // the session's light intensity
+// One light's white-reference measurement.
+struct LightIntensityReport {
+  std::string light;    // the light's id; empty for a session's one unnamed light
+  int photos = 0;       // white-reference photos taken under this light
+  bool stated = false;  // whether the session states an intensity for this light
+  Eigen::Vector3d stated_intensity = Eigen::Vector3d::Zero();      // the session's (zero when not stated)
   Eigen::Vector3d calibrated_intensity = Eigen::Vector3d::Zero();  // the white reference's
-  uint64_t interior_pixels = 0;  // pixel centres on the target's interior, over all photos
+  uint64_t interior_pixels = 0;  // pixel centres on the target's interior, over this light's photos
   uint64_t pixels_used = 0;
   RejectionCounts rejected;  // non_finite, saturated, below_signal, grazing
   // Per channel, the robust relative spread of the per-pixel estimates (1.4826 MAD / median): noise
   // plus any unevenness (a wrong pose or reflectance shows here).
   Eigen::Vector3d spread = Eigen::Vector3d::Zero();
+};
+
+struct LightCalibrationReport {
+  // The report is filled as the step goes: true once ApplyLightCalibration returned; false when it
+  // threw (the report then holds what was counted before the error).
+  bool success = false;
+  bool calibrated = false;  // false where the session has no white reference (the lights are unchanged)
+  int photos = 0;           // white-reference photos, all lights together
+  // One entry per light that has white-reference photos, in the session's order of lights.
+  std::vector<LightIntensityReport> lights;
   double total_s = 0.0;
   // "light calibration: white reference, 2 photos, 4210 pixels: intensity (1, 1, 1) -> (0.41, ...)"
+  // (one clause per light).
   std::string BriefReport() const;
 };
 
-// The session with its light's intensity replaced by the white reference's measurement, when the
-// session has one (calibration.white_reference); otherwise the session unchanged. The white-reference
+// The session with each light's intensity replaced by the white reference's measurement under that
+// light (the white-reference photos that name it), when the session has a white reference
+// (calibration.white_reference); otherwise the session unchanged. Lights without white-reference
+// photos keep their stated intensity. The white-reference
 // photos go through the same radiometric chain as the measurement photos (radiance_image.h: response,
 // black level, exposure and gain, flat field). Throws Error naming the photo for a target that is
 // saturated (more than max_saturated_fraction of its interior clipped), and naming the manifest's

@@ -45,12 +45,14 @@ void JoinBracket(const Session& session, size_t i, std::vector<size_t>* group) {
     const PhotoSpec& other = session.photos[j];
     const double other_exposure = other.exposure_s * other.gain;
     if (std::abs(exposure - other_exposure) <= 1e-9 * std::max(exposure, other_exposure)) {
+      const Light& light = session.PhotoLight(i);
       ThrowError(where, "photos " + other.file + " (/photos/" + std::to_string(j) + ") and " + photo.file +
-                            " have the same camera pose and the same exposure (exposure_s x gain = " +
-                            std::to_string(exposure) +
+                            " have the same camera pose, the same light" +
+                            (light.id.empty() ? std::string() : " (" + light.id + ")") +
+                            " and the same exposure (exposure_s x gain = " + std::to_string(exposure) +
                             "), so they are not an exposure bracket; photos of one pose under different lights "
-                            "are separate measurements, which a session with one light cannot describe, and a "
-                            "repeated photo should be left out");
+                            "are separate measurements (name each photo's light, session format version 2), and "
+                            "a repeated photo should be left out");
     }
   }
   if (group->size() >= 255) {
@@ -76,6 +78,13 @@ std::vector<std::vector<size_t>> ExposureGroups(const Session& session) {
       }
       std::vector<size_t>& group = groups[it->second];
       const PhotoSpec& first = session.photos[group.front()];
+      if (photo.light != first.light) {
+        ThrowError(session.manifest_path + ": /photos/" + std::to_string(i) + "/bracket",
+                   "photo " + photo.file + " is in bracket " + std::to_string(*photo.bracket) + " with photo " +
+                       first.file + " but it was taken under " + LightLabel(session.PhotoLight(i)) + " and " +
+                       first.file + " under " + LightLabel(session.PhotoLight(group.front())) +
+                       " (a bracket is one camera pose under one light)");
+      }
       if (first.camera_from_world && photo.camera_from_world) {
         const double translation = (first.camera_from_world->translation - photo.camera_from_world->translation).norm();
         const double rotation = first.camera_from_world->rotation.angularDistance(photo.camera_from_world->rotation);
@@ -89,12 +98,13 @@ std::vector<std::vector<size_t>> ExposureGroups(const Session& session) {
       JoinBracket(session, i, &group);
       continue;
     }
-    // No bracket id: identical poses are one bracket.
+    // No bracket id: identical poses under the same light are one bracket.
     bool joined = false;
     if (photo.camera_from_world) {
       for (std::vector<size_t>& group : groups) {
         const PhotoSpec& first = session.photos[group.front()];
-        if (!first.bracket && first.camera_from_world && SamePose(*first.camera_from_world, *photo.camera_from_world)) {
+        if (!first.bracket && first.light == photo.light && first.camera_from_world &&
+            SamePose(*first.camera_from_world, *photo.camera_from_world)) {
           JoinBracket(session, i, &group);
           joined = true;
           break;

@@ -37,18 +37,21 @@ struct RadianceImage {
   // Per pixel, how many exposures of the bracket were merged (0 where flagged). Filled for brackets of
   // more than one photo only (empty otherwise).
   std::vector<uint8_t> exposures_used;
+  // Per pixel, 0 where the photos' masks exclude it, 1 where usable (photo_mask.h); empty: no mask.
+  std::vector<uint8_t> mask;
 
   size_t Index(int x, int y) const { return size_t(y) * width + x; }
 };
 
-// The photos to derender, grouped by pose: measurement photos with the same `bracket` id form one
-// group (an exposure bracket; their poses must agree to 1 mm and 0.06 degrees); measurement photos
-// without a bracket id form one group per distinct camera_from_world (identical poses are a bracket);
-// a photo without a pose is a group of its own. Alignment-only photos (role "targets") are in no
-// group. Groups are ordered by their first photo. A bracket's photos must differ in exposure
-// (exposure_s x gain): two photos of one pose and one exposure are never averaged. Throws Error naming
-// the manifest's photo (and, for a repeated exposure, both files) for a bracket whose poses disagree,
-// a repeated exposure, or more than 255 exposures.
+// The photos to derender, grouped by pose and light: measurement photos with the same `bracket` id
+// form one group (an exposure bracket; their poses must agree to 1 mm and 0.06 degrees, and their
+// light must be the same); measurement photos without a bracket id form one group per distinct
+// camera_from_world and light (identical poses under one light are a bracket; under different lights
+// they are separate measurements); a photo without a pose is a group of its own. Alignment-only
+// photos (role "targets") are in no group. Groups are ordered by their first photo. A bracket's photos
+// must differ in exposure (exposure_s x gain): two photos of one pose, one light and one exposure are
+// never averaged. Throws Error naming the manifest's photo (and, for a repeated exposure, both files)
+// for a bracket whose poses or lights disagree, a repeated exposure, or more than 255 exposures.
 std::vector<std::vector<size_t>> ExposureGroups(const Session& session);
 
 // The session's radiometric chain, prepared once (response lookup table, flat field) and applied to

@@ -21,6 +21,7 @@
 #include "core/session.h"
 #include "reconstruct/merl_table.h"
 #include "reconstruct/truth_comparison.h"
+#include "report/light_photos.h"
 #include "report/photo_statistics.h"
 #include "report/report_script.h"
 #include "report/sphere_render.h"
@@ -181,6 +182,9 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   AtomicDirectory directory(out, options.overwrite);
   const fs::path tmp(directory.temporary_path());
   WritePhoto(samples_path, photos[chosen.photo], chosen, tmp, &data, &result);
+  // Multi-light sessions (a dome, a turntable): the lights and a photo under each.
+  const nlohmann::json lights = WriteLightPhotos(samples_path, photos, tmp.string());
+  if (!lights.is_null()) data["lights"] = lights;
   WriteRenders(models, options.render_size, chosen.phase, tmp, &data);
   data["incidence_plane"] = IncidencePlaneCurves(models);
   WriteJsonFile((tmp / "report-data.json").string(), data);

@@ -233,6 +233,31 @@ def figure_html(out, name, caption, width=None):
             f'<figcaption>{html.escape(caption)} ({html.escape(name)})</figcaption></figure>\n')
 
 
+# ---- Multi-light sessions (issue 12, real rigs): kept apart from the rest of the page.
+def lights_section(out, data):
+    """The session's lights (a dome, a turntable: a light per photo), what each gave and a photo under
+    each; empty for a one-light session. `data["lights"]` is written by report/light_photos.cc."""
+    lights = data.get("lights")
+    if not lights:
+        return ""
+    rows = []
+    for light in lights:
+        where = light.get("position", light.get("direction", []))
+        phase = light.get("phase_deg")
+        thumb = (f'<img src="{embed(out, light["file"])}" alt="{html.escape(light["file"])}">'
+                 if light.get("file") else html.escape(light.get("note", "no samples")))
+        rows.append(f"<tr><td>{html.escape(light['id'])}</td><td>{light['kind']} "
+                    f"[{', '.join(f'{v:.3f}' for v in where)}]</td><td>{light['photos']}</td>"
+                    f"<td>{light['samples']}</td><td>{'n/a' if phase is None else f'{phase:.0f}'}</td>"
+                    f"<td>{light['photo']}</td><td>{thumb}</td></tr>")
+    used = sum(1 for light in lights if light["samples"] > 0)
+    return (f"<h2>Lights</h2><p>{len(lights)} lights, {used} of them gave samples. Phase: the median angle "
+            f"between light and view over the light's samples. Each photo is linearized, cropped to its samples "
+            f"and tone-mapped on its own.</p><table><tr><th>light</th><th>kind, position or direction (m)</th>"
+            f"<th>photos</th><th>samples</th><th>phase, deg</th><th>photo shown</th><th>photo</th></tr>"
+            + "\n".join(rows) + "</table>\n")
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit("usage: report.py RUN_DIR OUT_DIR")
@@ -307,6 +332,7 @@ BRDF Measurement. Every figure is embedded in this file; the same PNGs lie besid
 <p>The sphere is lit by a distant light at the measured photo's median angle between light and view; each image is
 scaled so its 99th-percentile luminance is 0.8 (sRGB). Magenta: no reconstructed value there.</p>
 {appearance}
+{lights_section(out, data)}
 <h2>Sample coverage</h2>
 {figure_html(out, figures['coverage'], 'exitant directions sampled at each incidence angle')}
 <h2>Incidence plane, three colour channels</h2>

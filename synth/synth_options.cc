@@ -46,6 +46,25 @@ SynthShape SynthShapeFromName(const std::string& name) {
   ThrowError("synth shape", "unknown shape \"" + name + "\" (expected squash, pot or dent)");
 }
 
+const char* SynthRigName(SynthRig rig) {
+  switch (rig) {
+    case SynthRig::kArc:
+      return "arc";
+    case SynthRig::kDome:
+      return "dome";
+    case SynthRig::kTurntable:
+      return "turntable";
+  }
+  return "arc";
+}
+
+SynthRig SynthRigFromName(const std::string& name) {
+  for (SynthRig rig : {SynthRig::kArc, SynthRig::kDome, SynthRig::kTurntable}) {
+    if (name == SynthRigName(rig)) return rig;
+  }
+  ThrowError("synth rig", "unknown rig \"" + name + "\" (expected arc, dome or turntable)");
+}
+
 bool SynthSceneOptions::Check(std::string* why) const {
   // synth renders a sphere or a cylinder (or, with `shape`, a squash, pot or dent as a mesh sample).
   IBRDF_CHECK_OPTION(sample != SampleSpec::Kind::kMesh);
@@ -71,6 +90,18 @@ bool SynthRigOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_LE(frame_fraction, 1.0);
   IBRDF_CHECK_OPTION_GT(exposure_target, 0.0);
   IBRDF_CHECK_OPTION_LE(exposure_target, 1.0);
+  if (rig == SynthRig::kDome) {
+    // The dome reads the arc's range as angles between camera and light: within [0, 180].
+    IBRDF_CHECK_OPTION_GE(arc_start_deg, 0.0);
+    IBRDF_CHECK_OPTION_LE(arc_end_deg, 180.0);
+    IBRDF_CHECK_OPTION_LT(arc_start_deg, arc_end_deg);
+  }
+  IBRDF_CHECK_OPTION_GE(dome_min_elevation_deg, 0.0);
+  IBRDF_CHECK_OPTION_LT(dome_min_elevation_deg, 90.0);
+  IBRDF_CHECK_OPTION_GT(turntable_phase_deg, 0.0);
+  IBRDF_CHECK_OPTION_LT(turntable_phase_deg, 180.0);
+  IBRDF_CHECK_OPTION_GT(turntable_span_deg, 0.0);
+  IBRDF_CHECK_OPTION_LE(turntable_span_deg, 360.0);
   return true;
 }
 
@@ -149,6 +180,9 @@ bool SynthOptions::Check(std::string* why) const {
     IBRDF_CHECK_OPTION_GT(scan.scanner.distance_m, 1.5 * sample_bounding_radius);
     IBRDF_CHECK_OPTION_LT(scan.truth_mesh_spacing_m, 0.1 * sample_bounding_radius);
   }
+  // The coded targets assume the arc's one light along +x (its marker card) and a platform fixed
+  // with the camera's world; the dome and the turntable render the sample alone.
+  if (rig.rig != SynthRig::kArc) IBRDF_CHECK_OPTION(!targets.enabled);
   // The camera and the light well outside the sample, the marker ring around it.
   IBRDF_CHECK_OPTION_GT(rig.camera_distance, 1.5 * sample_bounding_radius);
   IBRDF_CHECK_OPTION_GT(scene.light_distance, sample_bounding_radius);

@@ -51,14 +51,39 @@ struct SynthSceneOptions {
   bool Check(std::string* why) const;
 };
 
+// How camera and light move between photos (docs/synth.md). The world frame is the sample's.
+enum class SynthRig {
+  kArc,        // the paper's: one light along +x, the camera on an arc from beside it to opposite it
+  kDome,       // one fixed camera, a light per photo on the upper hemisphere (a light stage or dome)
+  kTurntable,  // camera and light fixed in the lab while the sample turns about z: in the sample's
+               // frame both turn together, so each photo has its own pose and its own light
+};
+
+// "arc", "dome", "turntable"; and back (throws Error naming the value otherwise).
+const char* SynthRigName(SynthRig rig);
+SynthRig SynthRigFromName(const std::string& name);
+
 // The camera and where it stands: poses on an arc, the image, the lens and the auto-exposure.
 struct SynthRigOptions {
+  SynthRig rig = SynthRig::kArc;
   double camera_distance = 0.8;  // metres from the sample centre
   double camera_elevation_deg = 0.0;
   int num_photos = 20;
   // Camera azimuths from the light direction, evenly spaced: from beside the light to opposite it.
+  // Dome: the angular range of the lights instead, as seen from the sample: lights whose angle from
+  // the camera falls outside [arc_start_deg, arc_end_deg] are left out (near the camera they would
+  // be in its shadow, nearly opposite it only a rim is lit).
   double arc_start_deg = 8.0;
   double arc_end_deg = 172.0;
+  // Dome: num_photos point lights at light_distance, spread evenly over the upper hemisphere (a
+  // Fibonacci spiral, equal area) at elevations from dome_min_elevation_deg to 90; the camera fixed
+  // along +x at camera_elevation_deg; one photo per light.
+  double dome_min_elevation_deg = 5.0;
+  // Turntable: the light along +x and the camera at this azimuth from it (both at their elevations),
+  // fixed in the lab; the sample turns about the vertical axis through its centre by
+  // turntable_span_deg over the photos (360: a full turn, the last photo one step short of the first).
+  double turntable_phase_deg = 60.0;
+  double turntable_span_deg = 360.0;
   // Camera: OPENCV model with the focal length chosen so the sample (or the platform, with targets)
   // spans `frame_fraction` of the shorter image side.
   int width = 800;   // pixels

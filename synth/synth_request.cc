@@ -8,6 +8,7 @@ namespace ibrdf {
 SynthOptions SynthOptionsFromRequest(const SynthRequest& request) {
   SynthOptions options = request.options;
   options.scene.sample = request.sample == "cylinder" ? SampleSpec::Kind::kCylinder : SampleSpec::Kind::kSphere;
+  options.rig.rig = SynthRigFromName(request.rig);
   options.effects = request.effects == "none" ? CameraEffects::None() : CameraEffects();
   CameraEffects& e = options.effects;
   if (request.bits >= 0) e.bits = request.bits;

@@ -16,6 +16,7 @@ namespace ibrdf {
 struct SynthRequest {
   SynthOptions options;             // the fields set directly (sizes, photos, arc, scan, ...)
   std::string sample = "sphere";    // "sphere" or "cylinder"
+  std::string rig = "arc";          // "arc", "dome" or "turntable" (SynthRig)
   std::string shape;                // "", "squash", "pot" or "dent"; a shape implies targets
   std::string effects = "default";  // the camera-effects preset: "default" (12-bit, noise) or "none"
   // Overrides of the preset's camera effects (< 0: the preset's value).

@@ -41,26 +41,137 @@ std::unique_ptr<AnalyticSample> TrueSample(const SynthOptions& options, const Se
   return AnalyticSample::Create(session.sample);
 }
 
+// The arc's one light: a point light along +x at light_distance.
+Light ArcLight(const SynthOptions& options) {
+  Light light;
+  light.kind = Light::Kind::kPoint;
+  light.position = options.scene.origin + options.scene.light_distance * Eigen::Vector3d::UnitX();
+  light.intensity = options.scene.light_intensity;
+  return light;
+}
+
+// A unit direction at `azimuth` and `elevation` (radians) about the vertical.
+Eigen::Vector3d Direction(double azimuth, double elevation) {
+  return Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                         std::sin(elevation));
+}
+
+// Photo i's file name.
+std::string PhotoFile(const SynthOptions& options, int i) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "photos/%03d.%s", i, options.effects.bits == 0 ? "exr" : "png");
+  return name;
+}
+
 // The measurement photos: cameras on the arc, evenly spaced in azimuth from the light direction.
 std::vector<PhotoSpec> ArcPhotos(const SynthOptions& options) {
   std::vector<PhotoSpec> photos;
-  const CameraEffects& effects = options.effects;
   const double elevation = options.rig.camera_elevation_deg * kDegree;
   for (int i = 0; i < options.rig.num_photos; ++i) {
     const double t = options.rig.num_photos == 1 ? 0.0 : double(i) / (options.rig.num_photos - 1);
     const double azimuth =
         (options.rig.arc_start_deg + t * (options.rig.arc_end_deg - options.rig.arc_start_deg)) * kDegree;
-    const Eigen::Vector3d direction(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
-                                    std::sin(elevation));
+    const Eigen::Vector3d direction = Direction(azimuth, elevation);
     PhotoSpec photo;
-    char name[32];
-    std::snprintf(name, sizeof(name), "photos/%03d.%s", i, effects.bits == 0 ? "exr" : "png");
-    photo.file = name;
+    photo.file = PhotoFile(options, i);
     photo.camera_from_world = LookAtCameraFromWorld(options.scene.origin + options.rig.camera_distance * direction,
                                                     options.scene.origin, Eigen::Vector3d::UnitZ());
     photos.push_back(photo);
   }
   return photos;
+}
+
+// The dome's light directions: n points of a Fibonacci spiral (equal area) over the band of the
+// upper hemisphere above dome_min_elevation_deg, keeping those whose angle from the camera lies in
+// [arc_start_deg, arc_end_deg]; the spiral is made denser until exactly num_photos are kept.
+std::vector<Eigen::Vector3d> DomeLightDirections(const SynthOptions& options, const Eigen::Vector3d& to_camera) {
+  const SynthRigOptions& rig = options.rig;
+  const double z_min = std::sin(rig.dome_min_elevation_deg * kDegree);
+  const double golden_angle = M_PI * (3.0 - std::sqrt(5.0));
+  for (int n = rig.num_photos; n < 64 * rig.num_photos + 64; ++n) {
+    std::vector<Eigen::Vector3d> kept;
+    for (int k = 0; k < n; ++k) {
+      const double z = 1.0 - (1.0 - z_min) * (k + 0.5) / n;  // equal-area bands from the zenith down
+      const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+      const Eigen::Vector3d d(r * std::cos(golden_angle * k), r * std::sin(golden_angle * k), z);
+      const double angle = std::acos(std::clamp(d.dot(to_camera), -1.0, 1.0)) / kDegree;
+      if (angle >= rig.arc_start_deg && angle <= rig.arc_end_deg) kept.push_back(d);
+    }
+    if (static_cast<int>(kept.size()) == rig.num_photos) return kept;
+  }
+  ThrowError("synth --rig dome", "cannot place " + std::to_string(rig.num_photos) + " lights between " +
+                                     std::to_string(rig.arc_start_deg) + " and " + std::to_string(rig.arc_end_deg) +
+                                     " degrees from the camera");
+}
+
+// The measurement photos and the lights of the rig (SynthRig): the arc's cameras under one light, the
+// dome's one camera under a light per photo, or the turntable's poses and lights in the sample's frame.
+void RigPhotosAndLights(const SynthOptions& options, Session* session) {
+  const SynthRigOptions& rig = options.rig;
+  const Eigen::Vector3d& origin = options.scene.origin;
+  const double elevation = rig.camera_elevation_deg * kDegree;
+  switch (rig.rig) {
+    case SynthRig::kArc:
+      session->lights = {ArcLight(options)};
+      session->photos = ArcPhotos(options);
+      return;
+    case SynthRig::kDome: {
+      const Eigen::Vector3d to_camera = Direction(0.0, elevation);
+      const Rigid3d camera_from_world =
+          LookAtCameraFromWorld(origin + rig.camera_distance * to_camera, origin, Eigen::Vector3d::UnitZ());
+      const std::vector<Eigen::Vector3d> directions = DomeLightDirections(options, to_camera);
+      session->lights.clear();
+      session->photos.clear();
+      for (int i = 0; i < rig.num_photos; ++i) {
+        Light light;
+        char id[16];
+        std::snprintf(id, sizeof(id), "D%02d", i);
+        light.id = id;
+        light.kind = Light::Kind::kPoint;
+        light.position = origin + options.scene.light_distance * directions[i];
+        light.intensity = options.scene.light_intensity;
+        session->lights.push_back(light);
+        PhotoSpec photo;
+        photo.file = PhotoFile(options, i);
+        photo.camera_from_world = camera_from_world;
+        photo.light = i;
+        session->photos.push_back(photo);
+      }
+      return;
+    }
+    case SynthRig::kTurntable: {
+      // In the lab: the light along +x, the camera at turntable_phase_deg from it. The sample turns by
+      // `angle` about the vertical through its centre: lab_from_sample = R(angle) about `origin`.
+      const Eigen::Vector3d light_in_lab = origin + options.scene.light_distance * Eigen::Vector3d::UnitX();
+      const Rigid3d camera_from_lab =
+          LookAtCameraFromWorld(origin + rig.camera_distance * Direction(rig.turntable_phase_deg * kDegree, elevation),
+                                origin, Eigen::Vector3d::UnitZ());
+      const bool full_turn = rig.turntable_span_deg >= 360.0;
+      session->lights.clear();
+      session->photos.clear();
+      for (int i = 0; i < rig.num_photos; ++i) {
+        const double steps = full_turn ? rig.num_photos : std::max(1, rig.num_photos - 1);
+        const double angle = rig.turntable_span_deg * kDegree * i / steps;
+        const Eigen::Quaterniond rotation(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()));
+        const Rigid3d lab_from_sample(rotation, origin - rotation * origin);
+        const Rigid3d sample_from_lab = lab_from_sample.Inverse();
+        Light light;
+        char id[16];
+        std::snprintf(id, sizeof(id), "T%03d", i);
+        light.id = id;
+        light.kind = Light::Kind::kPoint;
+        light.position = sample_from_lab * light_in_lab;
+        light.intensity = options.scene.light_intensity;
+        session->lights.push_back(light);
+        PhotoSpec photo;
+        photo.file = PhotoFile(options, i);
+        photo.camera_from_world = camera_from_lab * lab_from_sample;
+        photo.light = i;
+        session->photos.push_back(photo);
+      }
+      return;
+    }
+  }
 }
 
 // The light-target photos (role "targets"): from behind and above the sample, opposite the light, looking past the
@@ -113,9 +224,7 @@ Session BuildSession(const SynthOptions& options) {
     bounding_radius = AnalyticSample::Create(sample)->BoundingRadius();
   }
 
-  session.light.kind = Light::Kind::kPoint;
-  session.light.position = options.scene.origin + options.scene.light_distance * Eigen::Vector3d::UnitX();
-  session.light.intensity = options.scene.light_intensity;
+  RigPhotosAndLights(options, &session);
 
   const double framed_radius =
       options.targets.enabled ? std::max(bounding_radius, options.targets.platform_radius) : bounding_radius;
@@ -152,7 +261,6 @@ Session BuildSession(const SynthOptions& options) {
     session.targets = targets;
   }
 
-  session.photos = ArcPhotos(options);
   const std::vector<PhotoSpec> target_photos = LightTargetPhotos(options);
   session.photos.insert(session.photos.end(), target_photos.begin(), target_photos.end());
   ExpandBrackets(options, &session);  // radiometry hook: exposure brackets
@@ -396,6 +504,7 @@ Image RenderRadianceImpl(const Session& session, size_t photo_index, const Analy
                          const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask,
                          uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance) {
   const Camera& camera = session.camera;
+  const Light& light = session.PhotoLight(photo_index);
   const AnalyticSample* sample = &truth;
   std::atomic<uint64_t> shadowed{0};
   const Rigid3d world_from_camera = session.photos[photo_index].camera_from_world->Inverse();
@@ -423,7 +532,7 @@ Image RenderRadianceImpl(const Session& session, size_t photo_index, const Analy
             if (fill_irradiance.any()) {
               radiance += weight * material.Eval(Eigen::Vector3d::UnitZ(), wo).cwiseProduct(fill_irradiance);
             }
-            const Incidence incidence = IncidenceAt(session.light, hit.point, hit.normal);
+            const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
             if (!incidence.lit) continue;
             if (shadow_rays) {
               // The shadow ray starts 2 micrometres off the surface (outside the solid) and is blocked
@@ -532,6 +641,10 @@ nlohmann::json GeneratorJson(const SynthOptions& options) {
           {"num_photos", options.rig.num_photos},
           {"arc_start_deg", options.rig.arc_start_deg},
           {"arc_end_deg", options.rig.arc_end_deg},
+          {"rig", SynthRigName(options.rig.rig)},
+          {"dome_min_elevation_deg", options.rig.dome_min_elevation_deg},
+          {"turntable_phase_deg", options.rig.turntable_phase_deg},
+          {"turntable_span_deg", options.rig.turntable_span_deg},
           {"width", options.rig.width},
           {"height", options.rig.height},
           {"exposure_target", options.rig.exposure_target},
@@ -587,11 +700,13 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   uint64_t shadowed = 0;
   const std::unique_ptr<AnalyticSample> truth = TrueSample(options, session);
   const bool shadow_rays = options.scene.shape != SynthShape::kNone;
-  // The fill light's irradiance: fill_light times the point light's at the sample's centre, head on.
+  // The fill light's irradiance: fill_light times the photo's light's at the sample's centre, head on.
   const Eigen::Vector3d centre = truth->BoundingCenter();
-  const Eigen::Vector3d to_light = IncidenceAt(session.light, centre, Eigen::Vector3d::UnitZ()).wi;
-  const Eigen::Vector3d fill_irradiance =
-      options.scene.fill_light * IncidenceAt(session.light, centre, to_light).irradiance;
+  auto fill_irradiance = [&](size_t i) {
+    const Light& light = session.PhotoLight(i);
+    const Eigen::Vector3d to_light = IncidenceAt(light, centre, Eigen::Vector3d::UnitZ()).wi;
+    return Eigen::Vector3d(options.scene.fill_light * IncidenceAt(light, centre, to_light).irradiance);
+  };
   ProgressBar progress("photos", session.photos.size());
   std::unique_ptr<TargetScene> target_scene;
   if (options.targets.enabled) target_scene = std::make_unique<TargetScene>(options);
@@ -600,7 +715,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
     std::vector<uint8_t> mask;
     Image image =
         RenderRadianceImpl(session, i, *truth, shadow_rays, material, effects.supersample, &mask,
-                           session.photos[i].role == PhotoRole::kMeasurement ? &shadowed : nullptr, fill_irradiance);
+                           session.photos[i].role == PhotoRole::kMeasurement ? &shadowed : nullptr, fill_irradiance(i));
     PhotoSpec& photo = session.photos[i];
     photo.exposure_s *= options.rig.exposure_target /
                         AutoExposureReference(image, mask);  // exposure_s holds the bracket's factor (1 without)

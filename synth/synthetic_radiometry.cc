@@ -100,10 +100,10 @@ void ExpandBrackets(const SynthOptions& options, Session* session) {
 namespace {
 
 // The white reference's ideal radiance image: a square of side `size` centred at `center` with normal
-// `normal`, Lambertian of albedo rho, under the session's light; 0 elsewhere. `mask` gets 1 where a
+// `normal`, Lambertian of albedo rho, under `light`; 0 elsewhere. `mask` gets 1 where a
 // pixel centre sees it.
-Image RenderWhiteReference(const Session& session, const Rigid3d& camera_from_world, const WhiteReferenceSpec& white,
-                           int supersample, std::vector<uint8_t>* mask) {
+Image RenderWhiteReference(const Session& session, const Light& light, const Rigid3d& camera_from_world,
+                           const WhiteReferenceSpec& white, int supersample, std::vector<uint8_t>* mask) {
   const Camera& camera = session.camera;
   const Rigid3d world_from_camera = camera_from_world.Inverse();
   const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
@@ -127,7 +127,7 @@ Image RenderWhiteReference(const Session& session, const Rigid3d& camera_from_wo
           const Eigen::Vector3d offset = center + t * direction - white.center;
           if (std::abs(offset.dot(u)) > 0.5 * white.size || std::abs(offset.dot(v)) > 0.5 * white.size) continue;
           if (sx == supersample / 2 && sy == supersample / 2) (*mask)[size_t(y) * camera.width + x] = 1;
-          const Incidence incidence = IncidenceAt(session.light, white.center + offset, white.normal);
+          const Incidence incidence = IncidenceAt(light, white.center + offset, white.normal);
           if (!incidence.lit) continue;
           radiance += weight / M_PI * white.reflectance.cwiseProduct(incidence.irradiance);
         }
@@ -174,36 +174,48 @@ void WriteSynthCalibration(const SynthOptions& options, const std::string& direc
     white.center = session->sample.center;
     white.size = radiometry.white_size;
     const Eigen::Vector3d camera_center = first->camera_from_world->Inverse().translation;
-    const Eigen::Vector3d to_light = session->light.kind == Light::Kind::kPoint
-                                         ? (session->light.position - white.center).normalized()
-                                         : session->light.direction.normalized();
-    white.normal = (to_light + (camera_center - white.center).normalized()).normalized();
-    std::vector<uint8_t> mask;
-    Image image = RenderWhiteReference(*session, *first->camera_from_world, white, effects.supersample, &mask);
-    std::vector<float> levels;
-    for (size_t p = 0; p < mask.size(); ++p) {
-      if (mask[p]) levels.push_back(std::max({image.pixels[3 * p], image.pixels[3 * p + 1], image.pixels[3 * p + 2]}));
+    // The target faces between the camera and the lights' mean direction (the one light's, usually).
+    Eigen::Vector3d to_lights = Eigen::Vector3d::Zero();
+    for (const Light& light : session->lights) {
+      to_lights += light.kind == Light::Kind::kPoint ? (light.position - white.center).normalized()
+                                                     : light.direction.normalized();
     }
-    IBRDF_CHECK(!levels.empty()) << "the white reference is out of view";
-    const double level = PercentileInPlace(&levels, 0.99);
-    PhotoSpec photo;
-    photo.file = std::string("calibration/white-000.") + (effects.bits == 0 ? "exr" : "png");
-    photo.camera_from_world = first->camera_from_world;
-    photo.exposure_s = radiometry.white_exposure_scale * options.rig.exposure_target / level;
-    photo.gain = 1.0;
-    for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
-    ApplyVignetting(session->camera, effects.vignetting, &image);
-    SimulateSensor(effects, options.seed, 0xFFFFull, &image);
-    fs::create_directories(fs::path(directory) / "calibration");
+    white.normal = (to_lights.normalized() + (camera_center - white.center).normalized()).normalized();
     const PixelFormat format = effects.bits == 0   ? PixelFormat::kFloat
                                : effects.bits <= 8 ? PixelFormat::kUint8
                                                    : PixelFormat::kUint16;
-    WriteImage((fs::path(directory) / photo.file).string(), image, format);
-    white.photos.push_back(photo);
+    fs::create_directories(fs::path(directory) / "calibration");
+    // One photo of the target under each light, exposed for it.
+    for (size_t k = 0; k < session->lights.size(); ++k) {
+      std::vector<uint8_t> mask;
+      Image image = RenderWhiteReference(*session, session->lights[k], *first->camera_from_world, white,
+                                         effects.supersample, &mask);
+      std::vector<float> levels;
+      for (size_t p = 0; p < mask.size(); ++p) {
+        if (mask[p])
+          levels.push_back(std::max({image.pixels[3 * p], image.pixels[3 * p + 1], image.pixels[3 * p + 2]}));
+      }
+      IBRDF_CHECK(!levels.empty()) << "the white reference is out of view";
+      const double level = PercentileInPlace(&levels, 0.99);
+      IBRDF_CHECK(level > 0.0) << "the white reference is unlit by light " << k;
+      PhotoSpec photo;
+      char name[48];
+      std::snprintf(name, sizeof(name), "calibration/white-%03zu.%s", k, effects.bits == 0 ? "exr" : "png");
+      photo.file = name;
+      photo.camera_from_world = first->camera_from_world;
+      photo.exposure_s = radiometry.white_exposure_scale * options.rig.exposure_target / level;
+      photo.gain = 1.0;
+      photo.light = k;
+      for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
+      ApplyVignetting(session->camera, effects.vignetting, &image);
+      SimulateSensor(effects, options.seed, 0xFFFFull + k, &image);
+      WriteImage((fs::path(directory) / photo.file).string(), image, format);
+      white.photos.push_back(photo);
+    }
     CalibrationSpec calibration;
     calibration.white_reference = white;
     session->calibration = calibration;
-    session->light.intensity = Eigen::Vector3d::Ones();
+    for (Light& light : session->lights) light.has_intensity = false;  // the white reference measures it
   }
 }
 

@@ -129,7 +129,7 @@ TEST(Align, LightFromItsMarkers) {
   for (const PhotoSpec& photo : truth.photos) target_photos += photo.role == PhotoRole::kTargets;
   EXPECT_EQ(target_photos, 3);
   Session guess = truth;
-  guess.light.position += Eigen::Vector3d(0.05, -0.03, 0.02);
+  guess.lights[0].position += Eigen::Vector3d(0.05, -0.03, 0.02);
   AlignOptions options;
   options.fit_sphere = false;
   const AlignResult result = AlignSession(guess, options);
@@ -138,10 +138,10 @@ TEST(Align, LightFromItsMarkers) {
     EXPECT_GE(marker.photos, 2) << "marker " << marker.id;
     EXPECT_LT(marker.rms_px, 0.2) << "marker " << marker.id;
   }
-  const double error = (result.light.position - truth.light.position).norm();
+  const double error = (result.light.position - truth.lights[0].position).norm();
   std::cout << "light error " << 1e3 * error << " mm, spread " << 1e3 * result.light.spread_m << " mm\n";
   EXPECT_LT(error, 1e-3);
-  EXPECT_LT((result.session.light.position - truth.light.position).norm(), 1e-3);
+  EXPECT_LT((result.session.lights[0].position - truth.lights[0].position).norm(), 1e-3);
   ASSERT_EQ(result.session.photos.size(), truth.photos.size());
   for (size_t i = 0; i < truth.photos.size(); ++i) {
     EXPECT_EQ(result.session.photos[i].role, truth.photos[i].role) << "photo " << i;
@@ -168,7 +168,7 @@ TEST(Align, LightUnseenStaysAsGivenWithAReason) {
   const AlignResult result = AlignSession(session, options);
   EXPECT_FALSE(result.light.fitted);
   EXPECT_NE(result.light.reason.find("no marker of the light"), std::string::npos) << result.light.reason;
-  EXPECT_EQ(result.session.light.position, session.light.position);
+  EXPECT_EQ(result.session.lights[0].position, session.lights[0].position);
 }
 
 // The light block and photo roles round-trip; an unknown key in the light block, an id on both the

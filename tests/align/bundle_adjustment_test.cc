@@ -123,7 +123,7 @@ TEST(BundleAdjustment, UnknownLayoutFromRenderedPhotos) {
   session.targets->unknown_layout = layout;
   // The session's own guesses, stated in the origin marker's frame.
   session.sample.center = origin_from_world * truth.sample.center + Eigen::Vector3d(0.001, -0.001, 0.002);
-  session.light.position = origin_from_world * truth.light.position;
+  session.lights[0].position = origin_from_world * truth.lights[0].position;
   for (PhotoSpec& photo : session.photos) photo.camera_from_world.reset();
 
   const AlignResult result = AlignSession(session, AlignOptions());

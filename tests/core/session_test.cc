@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "tests/error_of.h"
 #include "tests/scratch_dir.h"
 
 namespace fs = std::filesystem;
@@ -94,9 +95,9 @@ TEST_F(SessionTest, LoadsValidSession) {
   EXPECT_EQ(session.camera.height, kHeight);
   EXPECT_EQ(session.camera.params, (std::vector<double>{10.0, 11.0, 4.0, 3.0, -0.08, 0.02, 0.0005, -0.0003}));
 
-  EXPECT_EQ(session.light.kind, Light::Kind::kPoint);
-  EXPECT_EQ(session.light.position, Eigen::Vector3d(0.1, 0.2, 1.5));
-  EXPECT_EQ(session.light.intensity, Eigen::Vector3d(1.0, 2.0, 3.0));
+  EXPECT_EQ(session.lights[0].kind, Light::Kind::kPoint);
+  EXPECT_EQ(session.lights[0].position, Eigen::Vector3d(0.1, 0.2, 1.5));
+  EXPECT_EQ(session.lights[0].intensity, Eigen::Vector3d(1.0, 2.0, 3.0));
 
   EXPECT_EQ(session.sample.kind, SampleSpec::Kind::kSphere);
   EXPECT_EQ(session.sample.center, Eigen::Vector3d(0.0, 0.0, 0.25));
@@ -235,7 +236,7 @@ TEST_F(SessionTest, WrongFormatOrVersionIsAnError) {
   manifest["format"] = "colmap";
   ExpectLoadError(manifest, "/format");
   manifest = ValidManifest();
-  manifest["version"] = 2;
+  manifest["version"] = 3;
   ExpectLoadError(manifest, "/version");
 }
 
@@ -311,10 +312,10 @@ void ExpectSameFields(const Session& a, const Session& b) {
   EXPECT_EQ(a.camera.width, b.camera.width);
   EXPECT_EQ(a.camera.height, b.camera.height);
   EXPECT_EQ(a.camera.params, b.camera.params);
-  EXPECT_EQ(a.light.kind, b.light.kind);
-  EXPECT_EQ(a.light.position, b.light.position);
-  EXPECT_LT((a.light.direction - b.light.direction).norm(), 1e-15);
-  EXPECT_EQ(a.light.intensity, b.light.intensity);
+  EXPECT_EQ(a.lights[0].kind, b.lights[0].kind);
+  EXPECT_EQ(a.lights[0].position, b.lights[0].position);
+  EXPECT_LT((a.lights[0].direction - b.lights[0].direction).norm(), 1e-15);
+  EXPECT_EQ(a.lights[0].intensity, b.lights[0].intensity);
   EXPECT_EQ(a.sample.kind, b.sample.kind);
   EXPECT_EQ(a.sample.center, b.sample.center);
   EXPECT_EQ(a.sample.radius, b.sample.radius);
@@ -367,7 +368,7 @@ TEST_F(SessionTest, SaveLoadRoundTripOfVariants) {
   manifest["radiometry"] = {{"response", {{"gamma", 1.8}}}};
   WriteManifest(manifest);
   const Session gamma = Session::Load(ManifestPath());
-  EXPECT_EQ(gamma.light.kind, Light::Kind::kDirectional);
+  EXPECT_EQ(gamma.lights[0].kind, Light::Kind::kDirectional);
   EXPECT_EQ(gamma.sample.kind, SampleSpec::Kind::kCylinder);
   EXPECT_EQ(gamma.radiometry.response.kind, Response::Kind::kGamma);
   gamma.Save(Path("gamma.json"));
@@ -489,6 +490,230 @@ TEST(SampleKindName, NamesEveryKind) {
   EXPECT_STREQ(SampleKindName(SampleSpec::Kind::kSphere), "sphere");
   EXPECT_STREQ(SampleKindName(SampleSpec::Kind::kCylinder), "cylinder");
   EXPECT_STREQ(SampleKindName(SampleSpec::Kind::kMesh), "mesh");
+}
+
+// ---- Version 2: several lights, a light per photo, masks.
+
+// A version-2 manifest with three lights (a point light, a directional one, one without an
+// intensity that a white reference measures), each photo naming its light, and masks.
+json ManifestV2() {
+  json manifest = ValidManifest();
+  manifest["version"] = 2;
+  manifest.erase("light");
+  manifest["lights"] = json::parse(R"([
+    {"id": "L01", "kind": "point", "position": [0.1, 0.2, 1.5], "intensity": [1.0, 2.0, 3.0]},
+    {"id": "L02", "kind": "directional", "direction": [0.0, 0.0, 2.0], "intensity": [0.5, 0.5, 0.5]},
+    {"id": "L03", "kind": "point", "position": [-1.0, 0.0, 1.0]}
+  ])");
+  manifest["photos"][0]["light"] = "L02";
+  manifest["photos"][1]["light"] = "L01";
+  manifest["mask"] = "masks/all.png";
+  manifest["photos"][0]["mask"] = "masks/img0.png";
+  manifest["calibration"] = {{"white_reference",
+                              {{"reflectance", {0.9, 0.9, 0.9}},
+                               {"center", {0.0, 0.0, 0.0}},
+                               {"normal", {0.0, 0.0, 1.0}},
+                               {"size", 0.1},
+                               {"photos", {{{"file", "photos/img1.png"}, {"exposure_s", 0.25}, {"light", "L03"}}}}}}};
+  return manifest;
+}
+
+class SessionV2Test : public SessionTest {
+ protected:
+  void SetUp() override {
+    SessionTest::SetUp();
+    fs::create_directories(Path("masks"));
+    Image mask(kWidth, kHeight, 1);
+    WriteImage(Path("masks/all.png"), mask, PixelFormat::kUint8);
+    WriteImage(Path("masks/img0.png"), mask, PixelFormat::kUint8);
+  }
+};
+
+TEST_F(SessionV2Test, LoadsLightsPhotoLightsAndMasks) {
+  WriteManifest(ManifestV2());
+  const Session session = Session::Load(ManifestPath());
+  ASSERT_EQ(session.lights.size(), 3u);
+  EXPECT_EQ(session.lights[0].id, "L01");
+  EXPECT_EQ(session.lights[1].kind, Light::Kind::kDirectional);
+  EXPECT_EQ(session.lights[1].direction, Eigen::Vector3d::UnitZ());  // normalized on reading
+  EXPECT_TRUE(session.lights[1].has_intensity);
+  EXPECT_FALSE(session.lights[2].has_intensity);
+  EXPECT_EQ(session.LightIndex("L03"), 2);
+  EXPECT_EQ(session.LightIndex("L99"), -1);
+  EXPECT_EQ(session.photos[0].light, 1u);
+  EXPECT_EQ(session.photos[1].light, 0u);
+  EXPECT_EQ(&session.PhotoLight(0), &session.lights[1]);
+  EXPECT_EQ(session.calibration->white_reference->photos[0].light, 2u);
+  EXPECT_EQ(session.mask, "masks/all.png");
+  EXPECT_EQ(session.photos[0].mask, "masks/img0.png");
+  EXPECT_EQ(session.PhotoMaskPath(0), Path("masks/img0.png"));
+  EXPECT_EQ(session.PhotoMaskPath(1), Path("masks/all.png"));  // the session's default
+  session.CheckPhotos();
+  // Masks are inputs (the workflow's staleness rule sees them).
+  const std::vector<std::string> files = session.InputFiles();
+  EXPECT_NE(std::find(files.begin(), files.end(), fs::absolute(Path("masks/img0.png")).lexically_normal().string()),
+            files.end());
+  EXPECT_NE(std::find(files.begin(), files.end(), fs::absolute(Path("masks/all.png")).lexically_normal().string()),
+            files.end());
+}
+
+// A version-2 manifest round-trips: lights, ids, the missing intensity, photo lights and masks.
+TEST_F(SessionV2Test, SaveLoadRoundTrip) {
+  WriteManifest(ManifestV2());
+  const Session original = Session::Load(ManifestPath());
+  fs::create_directories(Path("copy"));
+  const Session copy = Session::Load(original.SaveRebased(Path("copy")));
+  ASSERT_EQ(copy.lights.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(copy.lights[k].id, original.lights[k].id);
+    EXPECT_EQ(copy.lights[k].kind, original.lights[k].kind);
+    EXPECT_EQ(copy.lights[k].has_intensity, original.lights[k].has_intensity);
+  }
+  EXPECT_EQ(copy.photos[0].light, 1u);
+  EXPECT_TRUE(fs::equivalent(copy.PhotoMaskPath(0), Path("masks/img0.png")));
+  EXPECT_TRUE(fs::equivalent(copy.PhotoMaskPath(1), Path("masks/all.png")));
+  EXPECT_EQ(copy.calibration->white_reference->photos[0].light, 2u);
+  EXPECT_EQ(copy.ToJson()["version"], 2);
+}
+
+// Version 1 still reads, unchanged: the one light, photos without a light.
+TEST_F(SessionV2Test, VersionOneStillReads) {
+  WriteManifest(ValidManifest());
+  const Session session = Session::Load(ManifestPath());
+  ASSERT_EQ(session.lights.size(), 1u);
+  EXPECT_TRUE(session.lights[0].id.empty());
+  EXPECT_EQ(session.photos[1].light, 0u);
+  EXPECT_TRUE(session.PhotoMaskPath(0).empty());
+  // Written back as version 2 with the `light` shorthand, photos naming no light.
+  const json written = session.ToJson();
+  EXPECT_EQ(written["version"], 2);
+  EXPECT_TRUE(written.contains("light"));
+  EXPECT_FALSE(written.contains("lights"));
+  EXPECT_FALSE(written["photos"][0].contains("light"));
+}
+
+// Version-2 keys in a version-1 manifest are errors that say which version they need.
+TEST_F(SessionV2Test, VersionTwoKeysNeedVersionTwo) {
+  json manifest = ValidManifest();
+  manifest["photos"][0]["light"] = "L01";
+  WriteManifest(manifest);
+  EXPECT_NE(testing::ErrorOf([&] { Session::Load(ManifestPath()); }).find("version\": 2"), std::string::npos);
+  manifest = ValidManifest();
+  manifest["photos"][0]["mask"] = "masks/img0.png";
+  ExpectLoadError(manifest, "/photos/0/mask");
+  manifest = ValidManifest();
+  manifest["lights"] = json::array();
+  ExpectLoadError(manifest, "lights");
+}
+
+// The single `light` stays as the version-2 shorthand for one light.
+TEST_F(SessionV2Test, SingleLightShorthand) {
+  json manifest = ValidManifest();
+  manifest["version"] = 2;
+  WriteManifest(manifest);
+  EXPECT_EQ(Session::Load(ManifestPath()).lights.size(), 1u);
+  manifest["light"]["id"] = "key";
+  manifest["photos"][0]["light"] = "key";
+  WriteManifest(manifest);
+  const Session named = Session::Load(ManifestPath());
+  EXPECT_EQ(named.lights[0].id, "key");
+  EXPECT_EQ(named.ToJson()["photos"][0]["light"], "key");
+  // Naming a light the shorthand does not call so.
+  manifest["photos"][0]["light"] = "other";
+  ExpectLoadError(manifest, "/photos/0/light");
+}
+
+// Bad input: a photo naming an unknown light is one clear error naming the photo, the id and the
+// lights there are.
+TEST_F(SessionV2Test, PhotoNamingAnUnknownLightIsAnError) {
+  json manifest = ManifestV2();
+  manifest["photos"][1]["light"] = "L07";
+  WriteManifest(manifest);
+  const std::string message = testing::ErrorOf([&] { Session::Load(ManifestPath()); });
+  EXPECT_NE(message.find(ManifestPath() + ": /photos/1/light"), std::string::npos) << message;
+  EXPECT_NE(message.find("\"L07\""), std::string::npos) << message;
+  EXPECT_NE(message.find("L01, L02, L03"), std::string::npos) << message;
+}
+
+// With several lights, a measurement photo must name its light; ids are unique and non-empty; a
+// light's marker block names its light too; `light` and `lights` together are an error.
+TEST_F(SessionV2Test, LightReferencesAreChecked) {
+  json manifest = ManifestV2();
+  manifest["photos"][1].erase("light");
+  ExpectLoadError(manifest, "/photos/1/light");
+  manifest = ManifestV2();
+  manifest["lights"][2]["id"] = "L01";
+  ExpectLoadError(manifest, "/lights/2/id");
+  manifest = ManifestV2();
+  manifest["lights"][1]["id"] = "";
+  ExpectLoadError(manifest, "/lights/1/id");
+  manifest = ManifestV2();
+  manifest["lights"][0].erase("id");
+  ExpectLoadError(manifest, "/lights/0/id");
+  manifest = ManifestV2();
+  manifest["light"] = manifest["lights"][0];
+  ExpectLoadError(manifest, "/light");
+  manifest = ManifestV2();
+  manifest["calibration"]["white_reference"]["photos"][0]["light"] = "nope";
+  ExpectLoadError(manifest, "/calibration/white_reference/photos/0/light");
+  manifest = ManifestV2();
+  manifest["targets"] = json::parse(R"({"dictionary": "DICT_4X4_50",
+      "reference": [{"id": 0, "corners": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]}],
+      "light": {"size": 0.06, "markers": [{"id": 20, "light_in_marker": [0, 0, 0]}]}})");
+  ExpectLoadError(manifest, "/targets/light/light");
+  manifest["targets"]["light"]["light"] = "L01";
+  WriteManifest(manifest);
+  EXPECT_EQ(Session::Load(ManifestPath()).targets->light->light, 0u);
+}
+
+// Bad input: a light without an intensity that no calibration measures is one clear error naming
+// the light.
+TEST_F(SessionV2Test, LightWithoutIntensityAndNoCalibrationIsAnError) {
+  json manifest = ManifestV2();
+  manifest.erase("calibration");
+  WriteManifest(manifest);
+  const std::string message = testing::ErrorOf([&] { Session::Load(ManifestPath()); });
+  EXPECT_NE(message.find(ManifestPath() + ": /lights/2"), std::string::npos) << message;
+  EXPECT_NE(message.find("light L03 has no intensity and no calibration measures it"), std::string::npos) << message;
+  // A white reference under another light does not measure this one.
+  manifest = ManifestV2();
+  manifest["calibration"]["white_reference"]["photos"][0]["light"] = "L01";
+  ExpectLoadError(manifest, "/lights/2");
+  // The shorthand: the same rule.
+  manifest = ValidManifest();
+  manifest["version"] = 2;
+  manifest["light"].erase("intensity");
+  ExpectLoadError(manifest, "/light");
+  // Version 1 requires the intensity as before.
+  manifest["version"] = 1;
+  ExpectLoadError(manifest, "/light/intensity");
+}
+
+// Masks: missing files are errors at load; masks on white-reference and targets photos are refused.
+TEST_F(SessionV2Test, MaskKeysAreChecked) {
+  json manifest = ManifestV2();
+  manifest["photos"][0]["mask"] = "masks/missing.png";
+  ExpectLoadError(manifest, "/photos/0/mask");
+  manifest = ManifestV2();
+  manifest["mask"] = "masks/missing.png";
+  ExpectLoadError(manifest, "/mask");
+  manifest = ManifestV2();
+  manifest["calibration"]["white_reference"]["photos"][0]["mask"] = "masks/all.png";
+  ExpectLoadError(manifest, "/calibration/white_reference/photos/0/mask");
+  manifest = ManifestV2();
+  manifest["photos"][0]["role"] = "targets";
+  ExpectLoadError(manifest, "/photos/0/mask");
+}
+
+// Bad input: a mask of the wrong size is one clear error naming both the mask and its photo.
+TEST_F(SessionV2Test, MaskOfTheWrongSizeNamesBothFiles) {
+  WriteImage(Path("masks/img0.png"), Image(kWidth + 1, kHeight, 1), PixelFormat::kUint8);
+  WriteManifest(ManifestV2());
+  const Session session = Session::Load(ManifestPath());
+  const std::string message = testing::ErrorOf([&] { session.CheckPhotos(); });
+  EXPECT_NE(message.find(Path("masks/img0.png")), std::string::npos) << message;
+  EXPECT_NE(message.find(Path("photos/img0.png")), std::string::npos) << message;
+  EXPECT_NE(message.find("9x6"), std::string::npos) << message;
 }
 
 }  // namespace

@@ -163,7 +163,7 @@ ShadowScene RenderShadowScene(const ScratchDir& dir) {
   const SphereSample sphere(Eigen::Vector3d::Zero(), 0.04);
   const Eigen::Vector3d ball_center(0.07, 0.0, 0.025);
   const SphereSample ball(ball_center, 0.012);
-  const Light& light = session.light;
+  const Light& light = session.lights[0];
   const double indirect = 0.15 * kAlbedo / M_PI * light.intensity[0] / light.position.squaredNorm();
   for (size_t i = 0; i < session.photos.size(); ++i) {
     const Rigid3d world_from_camera = session.photos[i].camera_from_world->Inverse();

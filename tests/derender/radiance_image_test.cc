@@ -199,6 +199,67 @@ TEST(RadianceImage, SamePoseAndExposureIsAnErrorNamingBothPhotos) {
   }
 }
 
+// The silent-merge case of the real-rigs issue, with lights named: two photos of one pose under two
+// lights are two measurements (two groups), whatever their exposures; the same pose, light and
+// exposure twice is an error naming both files; a real bracket (one pose, one light, two exposures)
+// still merges; an explicit bracket id across two lights is an error naming the lights.
+TEST(RadianceImage, PhotosOfOnePoseUnderTwoLightsAreTwoMeasurements) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  Light l07, l12;
+  l07.id = "L07";
+  l12.id = "L12";
+  l12.position = Eigen::Vector3d(1.0, 0.0, 0.0);
+  session.lights = {l07, l12};
+  const Rigid3d pose(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 1));
+  PhotoSpec first, second;
+  first.file = "dome-07.png";
+  second.file = "dome-12.png";
+  first.camera_from_world = second.camera_from_world = pose;
+  first.light = 0;
+  second.light = 1;
+  session.photos = {first, second};
+  std::vector<std::vector<size_t>> groups = ExposureGroups(session);
+  ASSERT_EQ(groups.size(), 2u);
+  EXPECT_EQ(groups[0], (std::vector<size_t>{0}));
+  EXPECT_EQ(groups[1], (std::vector<size_t>{1}));
+  // Same pose, same light, same exposure: an error naming both files and the light.
+  session.photos[1].light = 0;
+  try {
+    ExposureGroups(session);
+    FAIL() << "two photos of one pose, light and exposure were accepted";
+  } catch (const Error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("dome-07.png"), std::string::npos) << message;
+    EXPECT_NE(message.find("dome-12.png"), std::string::npos) << message;
+    EXPECT_NE(message.find("L07"), std::string::npos) << message;
+  }
+  // A real bracket of one pose and one light still merges.
+  session.photos[1].exposure_s = 4.0;
+  groups = ExposureGroups(session);
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0], (std::vector<size_t>{0, 1}));
+  // A third photo of the pose under the other light, exposed like the first: its own measurement.
+  PhotoSpec third = first;
+  third.file = "dome-12b.png";
+  third.light = 1;
+  session.photos.push_back(third);
+  groups = ExposureGroups(session);
+  ASSERT_EQ(groups.size(), 2u);
+  EXPECT_EQ(groups[1], (std::vector<size_t>{2}));
+  // An explicit bracket id must agree in light.
+  for (PhotoSpec& photo : session.photos) photo.bracket = 5;
+  try {
+    ExposureGroups(session);
+    FAIL() << "a bracket across two lights was accepted";
+  } catch (const Error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("/photos/2/bracket"), std::string::npos) << message;
+    EXPECT_NE(message.find("light L12"), std::string::npos) << message;
+    EXPECT_NE(message.find("light L07"), std::string::npos) << message;
+  }
+}
+
 // More than 255 exposures of one pose is an error naming the photo, not an internal check.
 TEST(RadianceImage, TooManyExposuresOfOnePoseIsAnError) {
   ScratchDir dir;

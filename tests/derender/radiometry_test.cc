@@ -63,14 +63,15 @@ TEST(Radiometry, CalibratedSrgbSessionMatchesLinearSession) {
   options.radiometry.light_unknown = true;
   const Session session = Session::Load(MakeSession(dir / "srgb", options, *material));
   ASSERT_TRUE(session.calibration && session.calibration->white_reference);
-  EXPECT_EQ(session.light.intensity, Eigen::Vector3d::Ones());
+  EXPECT_EQ(session.lights[0].intensity, Eigen::Vector3d::Ones());
   EXPECT_FALSE(session.radiometry.flat_field.empty());
 
   LightCalibrationReport report;
   const Session calibrated = ApplyLightCalibration(session, &report);
   ASSERT_TRUE(report.success && report.calibrated) << report.BriefReport();
   for (int c = 0; c < 3; ++c) {
-    EXPECT_NEAR(calibrated.light.intensity[c] / options.scene.light_intensity[c], 1.0, 0.005) << report.BriefReport();
+    EXPECT_NEAR(calibrated.lights[0].intensity[c] / options.scene.light_intensity[c], 1.0, 0.005)
+        << report.BriefReport();
   }
 
   const TruthComparison reference = Measure(linear, *material);
@@ -79,6 +80,7 @@ TEST(Radiometry, CalibratedSrgbSessionMatchesLinearSession) {
   raw.radiometry = RadiometrySpec();
   raw.radiometry.noise = session.radiometry.noise;
   raw.calibration.reset();
+  raw.lights[0].has_intensity = true;  // taking the placeholder (unit) intensity as stated
   const TruthComparison bad = Measure(raw, *material);
   for (int c = 0; c < 3; ++c) {
     SCOPED_TRACE("channel " + std::to_string(c) + ": linear " + reference.BriefReport() + "; calibrated " +
@@ -99,6 +101,7 @@ TEST(Radiometry, CalibratedSrgbSessionMatchesLinearSession) {
     if (step == 1) partial.radiometry.black_level = 0.0;
     if (step == 2) partial.radiometry.flat_field.clear();
     if (step != 3) partial = ApplyLightCalibration(partial, &report);
+    if (step == 3) partial.lights[0].has_intensity = true;  // the unit placeholder, uncalibrated
     const TruthComparison worse = Measure(partial, *material);
     EXPECT_GT(worse.overall.median.maxCoeff(), reference.overall.median.maxCoeff() + 0.02)
         << "without the " << names[step];
@@ -290,6 +293,45 @@ TEST(Radiometry, SessionKeysRoundTrip) {
   EXPECT_NEAR(copy.photos[1].exposure_s / copy.photos[0].exposure_s, 0.25, 1e-12);
   ASSERT_TRUE(copy.calibration && copy.calibration->white_reference);
   EXPECT_EQ(copy.calibration->white_reference->photos.size(), 1u);
+}
+
+// A light per photo (the real-rigs issue): a dome of 3 lights with an unknown intensity each gets a
+// white-reference photo per light, and each light's intensity is measured from its own photo (the
+// session states none); a light without white-reference photos keeps its stated intensity.
+TEST(Radiometry, WhiteReferenceCalibratesEachLightOfADome) {
+  ScratchDir dir;
+  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
+  SynthOptions options = Small();
+  options.rig.rig = SynthRig::kDome;
+  options.rig.num_photos = 3;
+  options.rig.arc_end_deg = 100.0;  // lights the one target sees well
+  options.radiometry.light_unknown = true;
+  const Session session = Session::Load(MakeSession(dir / "s", options, material));
+  ASSERT_EQ(session.lights.size(), 3u);
+  ASSERT_EQ(session.calibration->white_reference->photos.size(), 3u);
+  for (const Light& light : session.lights) EXPECT_FALSE(light.has_intensity);
+  LightCalibrationReport report;
+  const Session calibrated = ApplyLightCalibration(session, &report);
+  ASSERT_EQ(report.lights.size(), 3u) << report.BriefReport();
+  for (size_t k = 0; k < 3; ++k) {
+    EXPECT_TRUE(calibrated.lights[k].has_intensity);
+    EXPECT_EQ(report.lights[k].light, session.lights[k].id);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(calibrated.lights[k].intensity[c] / options.scene.light_intensity[c], 1.0, 0.005)
+          << report.BriefReport();
+    }
+  }
+  const TruthComparison comparison = Measure(calibrated, material);
+  for (int c = 0; c < 3; ++c) EXPECT_LT(std::abs(comparison.overall.bias[c]), 0.01) << comparison.BriefReport();
+  // Only light 1 has a white-reference photo: the others keep what the session states.
+  Session partial = session;
+  partial.calibration->white_reference->photos = {session.calibration->white_reference->photos[1]};
+  partial.lights[0].has_intensity = partial.lights[2].has_intensity = true;
+  partial.lights[0].intensity = Eigen::Vector3d(3.0, 3.0, 3.0);
+  const Session one = ApplyLightCalibration(partial, &report);
+  ASSERT_EQ(report.lights.size(), 1u);
+  EXPECT_EQ(one.lights[0].intensity, Eigen::Vector3d(3.0, 3.0, 3.0));
+  EXPECT_NEAR(one.lights[1].intensity[0] / options.scene.light_intensity[0], 1.0, 0.005);
 }
 
 }  // namespace

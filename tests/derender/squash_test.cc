@@ -152,7 +152,7 @@ TEST(Squash, DentShadowsAreRejectedWithVisibility) {
     const Eigen::Vector3d direction = (world_from_camera.rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
     SurfaceHit hit, blocker;
     if (!dent.Intersect(world_from_camera.translation, direction, &hit)) return false;
-    const Eigen::Vector3d to_light = session.light.position - hit.point;
+    const Eigen::Vector3d to_light = session.lights[0].position - hit.point;
     return dent.Intersect(hit.point + 2e-6 * hit.normal, to_light.normalized(), &blocker) &&
            blocker.t < to_light.norm();
   };

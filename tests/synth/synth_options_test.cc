@@ -84,6 +84,30 @@ TEST(SynthOptions, ConstraintsBetweenParts) {
   ExpectFailureNaming(options, "truth_mesh_spacing_m");
 }
 
+// The rigs: names round-trip; the dome reads the arc's range as angles in [0, 180]; targets only on
+// the arc.
+TEST(SynthOptions, RigsAreChecked) {
+  for (SynthRig rig : {SynthRig::kArc, SynthRig::kDome, SynthRig::kTurntable}) {
+    EXPECT_EQ(SynthRigFromName(SynthRigName(rig)), rig);
+  }
+  EXPECT_THROW(SynthRigFromName("gantry"), Error);
+  SynthOptions options;
+  options.rig.rig = SynthRig::kDome;
+  options.rig.arc_end_deg = 200.0;
+  ExpectFailureNaming(options, "arc_end_deg");
+  options = SynthOptions();
+  options.rig.rig = SynthRig::kTurntable;
+  options.rig.turntable_phase_deg = 0.0;
+  ExpectFailureNaming(options, "turntable_phase_deg");
+  options = SynthOptions();
+  options.rig.rig = SynthRig::kDome;
+  options.targets.enabled = true;
+  ExpectFailureNaming(options, "targets.enabled");
+  options.rig.rig = SynthRig::kArc;
+  std::string why;
+  EXPECT_TRUE(options.Check(&why)) << why;
+}
+
 TEST(SynthOptions, ShapeNamesRoundTrip) {
   for (SynthShape shape : {SynthShape::kNone, SynthShape::kSquash, SynthShape::kPot, SynthShape::kDent}) {
     EXPECT_EQ(SynthShapeFromName(SynthShapeName(shape)), shape);

@@ -69,7 +69,7 @@ TEST(Synth, SessionLoadsWithPosesOnTheArc) {
   options.rig.height = 120;
   const Session session = Session::Load(MakeSession(dir / "s", options, material));
   ASSERT_EQ(session.photos.size(), 5u);
-  const Eigen::Vector3d to_light = (session.light.position - session.sample.center).normalized();
+  const Eigen::Vector3d to_light = (session.lights[0].position - session.sample.center).normalized();
   for (size_t i = 0; i < session.photos.size(); ++i) {
     const PhotoSpec& photo = session.photos[i];
     ASSERT_TRUE(photo.camera_from_world.has_value());
@@ -85,6 +85,62 @@ TEST(Synth, SessionLoadsWithPosesOnTheArc) {
     EXPECT_NEAR(pixel.y(), 60.0, 1e-6);
   }
   EXPECT_TRUE(std::filesystem::exists(dir / "s/truth.json"));
+}
+
+// The dome: one camera pose for every photo, a light per photo at light_distance on the upper
+// hemisphere, within [arc_start_deg, arc_end_deg] of the camera, no two alike.
+TEST(Synth, DomeHasOnePoseAndALightPerPhoto) {
+  ScratchDir dir;
+  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
+  SynthOptions options;
+  options.rig.rig = SynthRig::kDome;
+  options.rig.num_photos = 12;
+  options.rig.width = 80;
+  options.rig.height = 60;
+  const Session session = Session::Load(MakeSession(dir / "s", options, material));
+  ASSERT_EQ(session.photos.size(), 12u);
+  ASSERT_EQ(session.lights.size(), 12u);
+  const Eigen::Vector3d camera = session.photos[0].camera_from_world->Inverse().translation;
+  const Eigen::Vector3d to_camera = (camera - session.sample.center).normalized();
+  for (size_t i = 0; i < 12; ++i) {
+    EXPECT_EQ(session.photos[i].camera_from_world->translation, session.photos[0].camera_from_world->translation);
+    EXPECT_EQ(session.photos[i].light, i);
+    const Light& light = session.PhotoLight(i);
+    const Eigen::Vector3d offset = light.position - session.sample.center;
+    EXPECT_NEAR(offset.norm(), options.scene.light_distance, 1e-9);
+    EXPECT_GE(offset.z(), options.scene.light_distance * std::sin(5.0 * M_PI / 180.0) - 1e-9);
+    const double angle = std::acos(offset.normalized().dot(to_camera)) * 180.0 / M_PI;
+    EXPECT_GE(angle, options.rig.arc_start_deg);
+    EXPECT_LE(angle, options.rig.arc_end_deg);
+    for (size_t j = 0; j < i; ++j) EXPECT_GT((session.lights[j].position - light.position).norm(), 0.05);
+  }
+}
+
+// The turntable: in the sample's frame camera and light turn together about the vertical, so every
+// photo keeps the lab's distances and the angle between them, and the light goes round.
+TEST(Synth, TurntablePosesAndLightsTurnTogether) {
+  ScratchDir dir;
+  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
+  SynthOptions options;
+  options.rig.rig = SynthRig::kTurntable;
+  options.rig.num_photos = 4;
+  options.rig.camera_elevation_deg = 20.0;
+  options.rig.width = 80;
+  options.rig.height = 60;
+  const Session session = Session::Load(MakeSession(dir / "s", options, material));
+  ASSERT_EQ(session.lights.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    const Eigen::Vector3d camera = session.photos[i].camera_from_world->Inverse().translation - session.sample.center;
+    const Eigen::Vector3d light = session.PhotoLight(i).position - session.sample.center;
+    EXPECT_NEAR(camera.norm(), options.rig.camera_distance, 1e-9);
+    EXPECT_NEAR(light.norm(), options.scene.light_distance, 1e-9);
+    EXPECT_NEAR(std::asin(camera.z() / camera.norm()) * 180.0 / M_PI, 20.0, 1e-6);
+    // Light azimuth: -90 degrees per stop (the sample turns +90).
+    EXPECT_NEAR(std::remainder(std::atan2(light.y(), light.x()) + M_PI / 2 * i, 2 * M_PI), 0.0, 1e-9);
+    // Camera azimuth stays turntable_phase_deg from the light's.
+    EXPECT_NEAR(std::remainder(std::atan2(camera.y(), camera.x()) - std::atan2(light.y(), light.x()), 2 * M_PI),
+                options.rig.turntable_phase_deg * M_PI / 180.0, 1e-9);
+  }
 }
 
 TEST(Synth, AutoExposurePutsThe99thPercentileAtTheTarget) {
