@@ -40,8 +40,7 @@ double RelativeSpread(const std::vector<double>& values) {
 std::string LightName(const Light& light) { return light.id.empty() ? std::string("light") : light.id; }
 
 // Irradiance per unit intensity at `point` with `normal`, and the cosine: E / I.
-double UnitIrradiance(const Light& light, const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
-                      double* cos_i) {
+double UnitIrradiance(const Light& light, const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double* cos_i) {
   Eigen::Vector3d wi;
   double falloff = 1.0;
   if (light.kind == Light::Kind::kDirectional) {
@@ -71,7 +70,7 @@ std::string DiffuseSphereIntensities::BriefReport() const {
   int pixels = 0;
   for (const auto& l : lights) pixels += l.pixels;
   const double k = median_cosine_exponent;
-  const std::string response = std::abs(k - 1.0) < 0.1    ? "consistent with a linear response"
+  const std::string response = std::abs(k - 1.0) < 0.1       ? "consistent with a linear response"
                                : std::abs(k - 1 / 2.2) < 0.1 ? "looks gamma-encoded (sRGB-like)"
                                                              : "neither linear nor sRGB-like";
   return "diffuse sphere: " + std::to_string(lights.size()) + " lights, " +
@@ -113,8 +112,8 @@ DiffuseSphereIntensities MeasureDiffuseSphereIntensities(const Session& diffuse,
   if (!options.Check(&why)) ThrowError("diffuse sphere options", why);
   const std::string& manifest = diffuse.manifest_path;
   if (diffuse.sample.kind != SampleSpec::Kind::kSphere) {
-    ThrowError(manifest + ": /sample/kind", "the diffuse reference must be a sphere, got " +
-                                                std::string(SampleKindName(diffuse.sample.kind)));
+    ThrowError(manifest + ": /sample/kind",
+               "the diffuse reference must be a sphere, got " + std::string(SampleKindName(diffuse.sample.kind)));
   }
   if (albedo && !((albedo->array() > 0).all() && (albedo->array() <= 1).all())) {
     ThrowError("--albedo", "each channel must be in (0, 1]");
@@ -198,7 +197,8 @@ DiffuseSphereIntensities MeasureDiffuseSphereIntensities(const Session& diffuse,
         const double unit_nominal = UnitIrradiance(nominal, p_world, n_world, &cos_nominal);
         if (cos_i < cos_i_min) continue;
         bool clipped = false;
-        for (int c = 0; c < raw.channels; ++c) clipped = clipped || raw.at(x, y, c) >= diffuse.radiometry.saturation_level;
+        for (int c = 0; c < raw.channels; ++c)
+          clipped = clipped || raw.at(x, y, c) >= diffuse.radiometry.saturation_level;
         if (clipped) {
           ++samples.saturated;
           continue;
@@ -232,9 +232,10 @@ DiffuseSphereIntensities MeasureDiffuseSphereIntensities(const Session& diffuse,
     measured.pixels = int(s.estimate[0].size());
     measured.saturated = s.saturated;
     if (measured.pixels < options.min_pixels) {
-      ThrowError(manifest, "light " + id + ": " + std::to_string(measured.pixels) + " usable pixels on the diffuse "
-                               "sphere, fewer than " + std::to_string(options.min_pixels) + " (" +
-                               std::to_string(s.saturated) + " clipped)");
+      ThrowError(manifest, "light " + id + ": " + std::to_string(measured.pixels) +
+                               " usable pixels on the diffuse "
+                               "sphere, fewer than " +
+                               std::to_string(options.min_pixels) + " (" + std::to_string(s.saturated) + " clipped)");
     }
     for (int c = 0; c < 3; ++c) {
       measured.intensity[c] = MedianOf(s.estimate[c]);
@@ -265,7 +266,10 @@ DiffuseSphereIntensities MeasureDiffuseSphereIntensities(const Session& diffuse,
     for (const auto& l : result.lights) mean += l.intensity.mean() / result.lights.size();
     for (auto& l : result.lights) l.intensity /= mean;
   }
-  for (size_t k = 0; k < lights->size(); ++k) (*lights)[k].intensity = result.lights[k].intensity;
+  for (size_t k = 0; k < lights->size(); ++k) {
+    (*lights)[k].intensity = result.lights[k].intensity;
+    (*lights)[k].has_intensity = true;
+  }
   result.median_cosine_exponent = MedianOf(exponents);
   result.median_spread = MedianOf(spreads);
   result.median_nominal_spread = MedianOf(nominal_spreads);

@@ -57,9 +57,9 @@ struct DiffuseSphereIntensities {
   bool success = false;
   bool absolute = false;  // an albedo was given; false: relative intensities (mean 1)
   Eigen::Vector3d albedo = Eigen::Vector3d::Ones();
-  SphereSilhouette silhouette;                      // of the first photo's mask (or the known sphere)
+  SphereSilhouette silhouette;                       // of the first photo's mask (or the known sphere)
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // the diffuse sphere's centre, world frame, metres
-  std::vector<DiffuseLightIntensity> lights;        // in the order of the `lights` given
+  std::vector<DiffuseLightIntensity> lights;         // in the order of the `lights` given
   double median_cosine_exponent = 0.0;
   double median_spread = 0.0;          // over lights, of the mean channel spread, calibrated directions
   double median_nominal_spread = 0.0;  // ... with the session's nominal directions

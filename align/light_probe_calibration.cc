@@ -189,14 +189,14 @@ LightProbeCalibration CalibrateLightProbe(const std::vector<Session>& placements
         SphereSilhouette silhouette;
         if (options.fit_silhouette) {
           if (mask_path.empty()) {
-            ThrowError(photo_path, "fitting the sphere's silhouette needs a mask (the session's \"mask\" or the "
-                                   "photo's); or take the session's sphere as known (--known-sphere)");
+            ThrowError(photo_path,
+                       "fitting the sphere's silhouette needs a mask (the session's \"mask\" or the "
+                       "photo's); or take the session's sphere as known (--known-sphere)");
           }
           silhouette = FitSphereSilhouette(session.camera, MaskEdgePoints(mask), options.silhouette);
           if (!silhouette.fitted) ThrowError(mask_path, "no sphere silhouette: " + silhouette.reason);
         } else {
-          silhouette =
-              SphereSilhouette::FromCenter(session.camera, camera_from_world * session.sample.center, radius);
+          silhouette = SphereSilhouette::FromCenter(session.camera, camera_from_world * session.sample.center, radius);
           if (!silhouette.fitted) ThrowError(manifest + ": /sample", silhouette.reason + " of " + photo_path);
         }
         Log(1, silhouette.BriefReport() + (mask_path.empty() ? "" : " (" + mask_path + ")"));
@@ -214,9 +214,11 @@ LightProbeCalibration CalibrateLightProbe(const std::vector<Session>& placements
       const Highlight highlight = LocateHighlight(image, silhouette, mask, options.highlight);
       const Light& light = session.PhotoLight(i);
       const std::string id = LightName(light);
-      if (!highlight.found) ThrowError(photo_path, "no highlight of " + id + " on the mirror sphere: " + highlight.reason);
+      if (!highlight.found)
+        ThrowError(photo_path, "no highlight of " + id + " on the mirror sphere: " + highlight.reason);
       const MirrorDirection direction = DirectionFromHighlight(session.camera, silhouette, radius, highlight);
-      if (!direction.valid) ThrowError(photo_path, "the highlight of " + id + " gives no direction: " + direction.reason);
+      if (!direction.valid)
+        ThrowError(photo_path, "the highlight of " + id + " gives no direction: " + direction.reason);
       const Eigen::Matrix3d world_from_camera = camera_from_world.rotation.inverse().toRotationMatrix();
       Ray ray;
       ray.origin = camera_from_world.Inverse() * direction.surface_point;
@@ -297,8 +299,8 @@ LightProbeCalibration CalibrateLightProbe(const std::vector<Session>& placements
         const Ray& ray = list[0];
         const Eigen::Vector3d oc = ray.origin - result.centers[ray.placement];
         const double b = oc.dot(ray.direction);
-        const double t = -b + std::sqrt(std::max(0.0, b * b - oc.squaredNorm() +
-                                                          options.light_distance * options.light_distance));
+        const double t =
+            -b + std::sqrt(std::max(0.0, b * b - oc.squaredNorm() + options.light_distance * options.light_distance));
         c.light.position = ray.origin + t * ray.direction;
         c.position_sigma_m = t * c.sigma_deg / kDeg;
       }
@@ -317,8 +319,9 @@ LightProbeCalibration CalibrateLightProbe(const std::vector<Session>& placements
   for (const auto& [id, list] : rays) {
     bool listed = false;
     for (const Light& light : first.lights) listed = listed || LightName(light) == id;
-    if (!listed) ThrowError(placements[list[0].placement].manifest_path, "photos of light " + id +
-                                                                           ", which the first session does not list");
+    if (!listed)
+      ThrowError(placements[list[0].placement].manifest_path,
+                 "photos of light " + id + ", which the first session does not list");
   }
   result.median_sigma_deg = MedianOf(sigmas);
   result.max_sigma_deg = *std::max_element(sigmas.begin(), sigmas.end());

@@ -40,9 +40,9 @@ struct LightProbeOptions {
 
 // One light as calibrated.
 struct CalibratedLight {
-  Light light;                  // id, kind, direction (unit, world) or position (metres, world); intensity
-  int photos = 0;               // highlights used (over all placements)
-  double sigma_deg = 0.0;       // one-sigma uncertainty of the direction, degrees (highlight + silhouette)
+  Light light;                            // id, kind, direction (unit, world) or position (metres, world); intensity
+  int photos = 0;                         // highlights used (over all placements)
+  double sigma_deg = 0.0;                 // one-sigma uncertainty of the direction, degrees (highlight + silhouette)
   double sigma_from_highlight_deg = 0.0;  // the highlight's part alone
   double position_sigma_m = 0.0;          // point lights: one-sigma uncertainty of the position, metres
   std::vector<Highlight> highlights;      // per photo used, in order

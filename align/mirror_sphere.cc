@@ -14,8 +14,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string Format(const char* format, double a, double b, double c = 0, double d = 0, double e = 0,
-                   double f = 0) {
+std::string Format(const char* format, double a, double b, double c = 0, double d = 0, double e = 0, double f = 0) {
   char buffer[256];
   std::snprintf(buffer, sizeof(buffer), format, a, b, c, d, e, f);
   return buffer;
@@ -141,9 +140,7 @@ bool SilhouetteFitOptions::Check(std::string* why) const {
   return true;
 }
 
-Eigen::Vector3d SphereSilhouette::CenterInCamera(double radius) const {
-  return axis * (radius / std::sin(half_angle));
-}
+Eigen::Vector3d SphereSilhouette::CenterInCamera(double radius) const { return axis * (radius / std::sin(half_angle)); }
 
 SphereSilhouette SphereSilhouette::FromCenter(const Camera& camera, const Eigen::Vector3d& center_in_camera,
                                               double radius) {
@@ -190,8 +187,7 @@ SphereSilhouette FitSphereSilhouette(const Camera& camera, const std::vector<Eig
   if (!options.Check(&why)) ThrowError("silhouette fit options", why);
   SphereSilhouette fit;
   if (int(edge_points.size()) < options.min_points) {
-    fit.reason = std::to_string(edge_points.size()) + " edge points, fewer than " +
-                 std::to_string(options.min_points);
+    fit.reason = std::to_string(edge_points.size()) + " edge points, fewer than " + std::to_string(options.min_points);
     return fit;
   }
   Eigen::Vector2d center_px;
@@ -329,8 +325,8 @@ Highlight LocateHighlight(const Image& image, const SphereSilhouette& sphere, co
   }
   h.blob_pixels = int(blob.size());
   if (h.blob_pixels > options.max_blob_pixels) {
-    h.reason = "the bright region exceeds " + std::to_string(options.max_blob_pixels) +
-               " pixels (no compact highlight)";
+    h.reason =
+        "the bright region exceeds " + std::to_string(options.max_blob_pixels) + " pixels (no compact highlight)";
     return h;
   }
   double sw = 0, sx = 0, sy = 0, cn = 0, cx = 0, cy = 0;

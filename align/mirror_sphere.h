@@ -46,9 +46,9 @@ struct SilhouetteFitOptions {
 // forward, core/camera.h). Reads as not fitted until a fit ran.
 struct SphereSilhouette {
   bool fitted = false;
-  std::string reason;                             // why not fitted
+  std::string reason;                               // why not fitted
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit ray through the sphere's centre
-  double half_angle = 0.0;                        // radians: sin(half_angle) = radius / distance
+  double half_angle = 0.0;                          // radians: sin(half_angle) = radius / distance
   // Covariance of (axis_x / axis_z, axis_y / axis_z, half_angle) from the fit's residuals (radians^2).
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector2d center_px = Eigen::Vector2d::Zero();  // the axis projected, pixels (COLMAP convention)
@@ -101,14 +101,14 @@ struct HighlightOptions {
 // A highlight located in one photo. Reads as not found until located.
 struct Highlight {
   bool found = false;
-  std::string reason;                                // why not found
-  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();   // intensity-weighted centroid, pixels (COLMAP)
-  Eigen::Vector2d core = Eigen::Vector2d::Zero();    // centroid of the core, pixels
-  double sigma_px = 0.0;                             // one-sigma localization error per axis, pixels
-  double peak = 0.0;                                 // brightest pixel (mean of channels), image units
-  int blob_pixels = 0;                               // pixels in the blob
-  int core_pixels = 0;                               // pixels in the core
-  double second_peak = 0.0;                          // the brightest spot outside the blob, relative to peak
+  std::string reason;                               // why not found
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // intensity-weighted centroid, pixels (COLMAP)
+  Eigen::Vector2d core = Eigen::Vector2d::Zero();   // centroid of the core, pixels
+  double sigma_px = 0.0;                            // one-sigma localization error per axis, pixels
+  double peak = 0.0;                                // brightest pixel (mean of channels), image units
+  int blob_pixels = 0;                              // pixels in the blob
+  int core_pixels = 0;                              // pixels in the core
+  double second_peak = 0.0;                         // the brightest spot outside the blob, relative to peak
   // "highlight (285.65, 118.31) px +- 0.12 px, 77 px blob, 12 px core"
   std::string BriefReport() const;
 };
@@ -136,7 +136,7 @@ struct MirrorDirection {
   // Covariance of the direction (3 x 3, rank 2, radians^2): the highlight's sigma_px and the
   // silhouette's covariance propagated by the Jacobian of ReflectedDirection.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  double sigma_deg = 0.0;                // one-sigma angular uncertainty, sqrt(trace(covariance)), degrees
+  double sigma_deg = 0.0;                 // one-sigma angular uncertainty, sqrt(trace(covariance)), degrees
   double sigma_from_highlight_deg = 0.0;  // the part from the highlight alone
 };
 

@@ -32,8 +32,8 @@ Eigen::Vector3d Vector3Option(const std::vector<double>& values, const std::stri
   return Eigen::Vector3d(values[0], values[1], values[2]);
 }
 
-void AddCalibrate(CLI::App& lights) {
-  auto* command = lights.add_subcommand(
+void AddCalibrate(CLI::App& group) {
+  auto* command = group.add_subcommand(
       "calibrate",
       "Calibrate the lights of a multi-light rig from photos of a mirror sphere: a session (version 2) whose\n"
       "sample is the chrome sphere and whose photos each name their light. The sphere's centre and size come\n"
@@ -51,9 +51,10 @@ void AddCalibrate(CLI::App& lights) {
     bool known_sphere = false, overwrite = false;
   };
   auto args = std::make_shared<Args>();
-  command->add_option("sessions", args->sessions,
-                      "Mirror-sphere session(s): one for directional lights; two placements of the sphere\n"
-                      "triangulate point lights")
+  command
+      ->add_option("sessions", args->sessions,
+                   "Mirror-sphere session(s): one for directional lights; two placements of the sphere\n"
+                   "triangulate point lights")
       ->required();
   command->add_option("--out", args->out, "The calibrated lights (.json)")->required();
   command->add_option("--kind", args->probe.kind, "What the lights are: directional or point")
@@ -68,14 +69,17 @@ void AddCalibrate(CLI::App& lights) {
   command->add_option("--albedo", args->albedo, "The diffuse sphere's albedo R,G,B (absent: relative intensities)")
       ->delimiter(',')
       ->expected(3);
-  command->add_option("--max-theta-deg", args->diffuse_options.max_theta_i_deg,
-                      "Diffuse sphere: pixels lit or seen more obliquely are not used")
+  command
+      ->add_option("--max-theta-deg", args->diffuse_options.max_theta_i_deg,
+                   "Diffuse sphere: pixels lit or seen more obliquely are not used")
       ->capture_default_str();
-  command->add_option("--blob-fraction", args->probe.highlight.blob_fraction,
-                      "Highlight: the blob is what exceeds this fraction of its peak")
+  command
+      ->add_option("--blob-fraction", args->probe.highlight.blob_fraction,
+                   "Highlight: the blob is what exceeds this fraction of its peak")
       ->capture_default_str();
-  command->add_option("--rim-margin-px", args->probe.highlight.rim_margin_px,
-                      "Highlight: not searched this close to the silhouette")
+  command
+      ->add_option("--rim-margin-px", args->probe.highlight.rim_margin_px,
+                   "Highlight: not searched this close to the silhouette")
       ->capture_default_str();
   command->add_option("--apply-to", args->apply_to,
                       "With --write-session: the session to give the calibrated lights (default: the --diffuse one)");
@@ -188,8 +192,8 @@ void AddCalibrate(CLI::App& lights) {
   });
 }
 
-void AddSynth(CLI::App& lights) {
-  auto* command = lights.add_subcommand(
+void AddSynth(CLI::App& group) {
+  auto* command = group.add_subcommand(
       "synth",
       "Render a synthetic mirror-sphere session with known lights (fixed camera, one 8-bit photo per light,\n"
       "a mask, the true lights as the nominal ones and in truth-lights.json), to check `lights calibrate`.");
@@ -202,13 +206,16 @@ void AddSynth(CLI::App& lights) {
   auto args = std::make_shared<Args>();
   command->add_option("--out", args->out, "Session folder to write")->required();
   command->add_option("--lights", args->options.lights, "Number of lights")->capture_default_str();
-  command->add_option("--max-light-angle-deg", args->options.max_light_angle_deg,
-                      "Lights within this angle of the direction to the camera")
+  command
+      ->add_option("--max-light-angle-deg", args->options.max_light_angle_deg,
+                   "Lights within this angle of the direction to the camera")
       ->capture_default_str();
   command->add_flag("--point", args->options.point_lights, "Point lights at --light-distance instead of directional");
   command->add_option("--light-distance", args->options.light_distance, "Point lights' distance, metres")
       ->capture_default_str();
-  command->add_option("--center", args->center, "The sphere's centre x,y,z, metres (world: x right, y up, z to the camera)")
+  command
+      ->add_option("--center", args->center,
+                   "The sphere's centre x,y,z, metres (world: x right, y up, z to the camera)")
       ->delimiter(',')
       ->expected(3);
   command->add_option("--radius", args->options.radius, "The sphere's radius, metres")->capture_default_str();
@@ -226,8 +233,9 @@ void AddSynth(CLI::App& lights) {
 }
 
 void AddLightsCommand(CLI::App& app) {
-  auto* lights = app.add_subcommand("lights", "Calibrate a multi-light rig's lights from a mirror sphere (calibrate);\n"
-                                              "synthetic mirror-sphere sessions (synth)");
+  auto* lights = app.add_subcommand("lights",
+                                    "Calibrate a multi-light rig's lights from a mirror sphere (calibrate);\n"
+                                    "synthetic mirror-sphere sessions (synth)");
   lights->require_subcommand(1);
   AddCalibrate(*lights);
   AddSynth(*lights);

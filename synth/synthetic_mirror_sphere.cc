@@ -64,8 +64,8 @@ bool SyntheticMirrorSphereOptions::Check(std::string* why) const {
 std::string SyntheticMirrorSphere::BriefReport() const {
   char buffer[256];
   std::snprintf(buffer, sizeof(buffer), "mirror sphere: %zu %s lights, %d x %d -> %s", lights.size(),
-                lights.empty() || lights[0].kind == Light::Kind::kDirectional ? "directional" : "point",
-                camera.width, camera.height, manifest.c_str());
+                lights.empty() || lights[0].kind == Light::Kind::kDirectional ? "directional" : "point", camera.width,
+                camera.height, manifest.c_str());
   return buffer;
 }
 
@@ -90,6 +90,7 @@ SyntheticMirrorSphere WriteSyntheticMirrorSphere(const SyntheticMirrorSphereOpti
     const double phi = phase + k * kPi * (3.0 - std::sqrt(5.0));
     Light light;
     truth.ids.push_back(LightId(k));
+    light.id = truth.ids.back();
     light.direction = Eigen::Vector3d(sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t);
     if (options.point_lights) {
       light.kind = Light::Kind::kPoint;
@@ -115,7 +116,8 @@ SyntheticMirrorSphere WriteSyntheticMirrorSphere(const SyntheticMirrorSphereOpti
   Image mask(w, h, 1);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      mask.at(x, y, 0) = HitSphere(camera_center, ray_of(x + 0.5, y + 0.5), options.center, options.radius) > 0 ? 1.0f : 0.0f;
+      mask.at(x, y, 0) =
+          HitSphere(camera_center, ray_of(x + 0.5, y + 0.5), options.center, options.radius) > 0 ? 1.0f : 0.0f;
     }
   }
   WriteImage((tmp / "mask.png").string(), mask, PixelFormat::kUint8);
@@ -141,8 +143,9 @@ SyntheticMirrorSphere WriteSyntheticMirrorSphere(const SyntheticMirrorSphereOpti
             const Eigen::Vector3d p = camera_center + t * d;
             const Eigen::Vector3d n = (p - options.center) / options.radius;
             const Eigen::Vector3d reflected = d - 2.0 * n.dot(d) * n;
-            const Eigen::Vector3d to_light =
-                light.kind == Light::Kind::kPoint ? Eigen::Vector3d((light.position - p).normalized()) : light.direction;
+            const Eigen::Vector3d to_light = light.kind == Light::Kind::kPoint
+                                                 ? Eigen::Vector3d((light.position - p).normalized())
+                                                 : light.direction;
             const double angle = std::atan2(reflected.cross(to_light).norm(), reflected.dot(to_light));
             double radiance = options.environment;
             if (angle < 6.0 * sigma) radiance += options.source_peak * std::exp(-0.5 * angle * angle / (sigma * sigma));
@@ -159,10 +162,8 @@ SyntheticMirrorSphere WriteSyntheticMirrorSphere(const SyntheticMirrorSphereOpti
     const std::string& id = truth.ids[k];
     const std::string file = "photos/" + id + ".png";
     WriteImage((tmp / file).string(), image, PixelFormat::kUint8);
-    photos.push_back({{"file", file},
-                      {"exposure_s", 1.0},
-                      {"light", id},
-                      {"camera_from_world", PoseJson(truth.camera_from_world)}});
+    photos.push_back(
+        {{"file", file}, {"exposure_s", 1.0}, {"light", id}, {"camera_from_world", PoseJson(truth.camera_from_world)}});
     nlohmann::json entry = {{"id", id}, {"kind", light.kind == Light::Kind::kPoint ? "point" : "directional"}};
     if (light.kind == Light::Kind::kPoint) {
       entry["position"] = ToJson(light.position);
@@ -180,25 +181,32 @@ SyntheticMirrorSphere WriteSyntheticMirrorSphere(const SyntheticMirrorSphereOpti
       {"description",
        "synthetic mirror sphere (ibrdf lights synth): the lights' stated directions are the truth; "
        "truth-lights.json repeats them"},
-      {"camera",
-       {{"model", "PINHOLE"}, {"width", w}, {"height", h}, {"params", camera.params}}},
+      {"camera", {{"model", "PINHOLE"}, {"width", w}, {"height", h}, {"params", camera.params}}},
       {"lights", lights},
       {"mask", "mask.png"},
       {"sample", {{"kind", "sphere"}, {"center", ToJson(options.center)}, {"radius", options.radius}}},
       {"radiometry",
        {{"response", "linear"},
-        {"noise", {{"full_well_e", options.full_well_e}, {"read_noise_e", options.read_noise * options.full_well_e},
-                   {"bits", 8}}}}},
+        {"noise",
+         {{"full_well_e", options.full_well_e},
+          {"read_noise_e", options.read_noise * options.full_well_e},
+          {"bits", 8}}}}},
       {"photos", photos}};
   WriteJsonFile((tmp / "session.json").string(), session);
-  WriteJsonFile((tmp / "truth-lights.json").string(),
-                {{"format", "ibrdf-lights"}, {"version", 1}, {"lights", lights},
-                 {"generator",
-                  {{"lights", options.lights}, {"max_light_angle_deg", options.max_light_angle_deg},
-                   {"point_lights", options.point_lights}, {"light_distance", options.light_distance},
-                   {"source_sigma_deg", options.source_sigma_deg}, {"radius", options.radius},
-                   {"center", ToJson(options.center)}, {"focal_px", options.focal_px},
-                   {"distance", options.distance}, {"seed", options.seed}}}});
+  WriteJsonFile((tmp / "truth-lights.json").string(), {{"format", "ibrdf-lights"},
+                                                       {"version", 1},
+                                                       {"lights", lights},
+                                                       {"generator",
+                                                        {{"lights", options.lights},
+                                                         {"max_light_angle_deg", options.max_light_angle_deg},
+                                                         {"point_lights", options.point_lights},
+                                                         {"light_distance", options.light_distance},
+                                                         {"source_sigma_deg", options.source_sigma_deg},
+                                                         {"radius", options.radius},
+                                                         {"center", ToJson(options.center)},
+                                                         {"focal_px", options.focal_px},
+                                                         {"distance", options.distance},
+                                                         {"seed", options.seed}}}});
   directory.Commit();
   truth.manifest = (fs::path(out_dir) / "session.json").string();
   return truth;

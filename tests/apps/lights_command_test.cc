@@ -88,7 +88,8 @@ TEST(LightsCommand, BadInputs) {
   EXPECT_NE(missing.output.find("L01 has no photo"), std::string::npos) << missing.output;
   EXPECT_FALSE(fs::exists(scratch / "l.json"));
   // --albedo without the sphere it describes.
-  const auto albedo = RunIbrdf("lights calibrate " + scratch / "m" + " --albedo 0.5,0.5,0.5 --out " + scratch / "l.json");
+  const auto albedo =
+      RunIbrdf("lights calibrate " + scratch / "m" + " --albedo 0.5,0.5,0.5 --out " + scratch / "l.json");
   EXPECT_NE(albedo.exit_code, 0);
   EXPECT_NE(albedo.output.find("--albedo"), std::string::npos) << albedo.output;
 }
