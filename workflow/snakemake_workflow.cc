@@ -69,9 +69,12 @@ std::vector<std::string> SnakemakeArguments(const SnakemakeRunOptions& o) {
   }
   if (o.profile.empty() || o.cores > 0) {
     argv.insert(argv.end(), {"--cores", o.cores > 0 ? std::to_string(o.cores) : "all"});
+  } else if (o.dry_run) {
+    // A dry run caps every job's threads at --cores (1 when absent); a cluster run does not.
+    argv.insert(argv.end(), {"--cores", "1024"});
   }
   if (o.dry_run) argv.insert(argv.end(), {"--dry-run", "--printshellcmds"});
-  if (o.quiet) argv.insert(argv.end(), {"--quiet", "progress"});
+  if (o.quiet && !o.dry_run) argv.insert(argv.end(), {"--quiet", "progress"});
   argv.insert(argv.end(), o.extra.begin(), o.extra.end());
   return argv;
 }

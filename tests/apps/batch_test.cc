@@ -81,9 +81,9 @@ TEST(BatchCommand, SixSessionsSucceedTheBrokenOneFailsAloneAndReRunsRetryOnlyIt)
   if (!HaveSnakemake()) GTEST_SKIP() << "snakemake is not installed (scripts/install-deps installs it)";
   ScratchDir dir;
   const std::string config = WriteBatch(dir);
-  const std::string photo = dir / "broken/photo_0002.png";
+  const std::string photo = dir / "broken/photos/002.png";
   ASSERT_TRUE(fs::exists(photo)) << "synth's photo names changed; adapt the test";
-  fs::rename(photo, dir / "photo_0002.png");
+  fs::rename(photo, dir / "002.png");
 
   const RunResult first = RunIbrdf("batch " + config + " --cores 2", true);
   EXPECT_EQ(first.exit_code, 1) << first.output;
@@ -107,10 +107,10 @@ TEST(BatchCommand, SixSessionsSucceedTheBrokenOneFailsAloneAndReRunsRetryOnlyIt)
   }
   const nlohmann::json& broken = index.at("broken-session");
   EXPECT_EQ(broken.at("status"), "failed");
-  EXPECT_NE(broken.at("error").get<std::string>().find("photo_0002.png"), std::string::npos) << broken.dump();
-  EXPECT_NE(Slurp(dir / "out/logs/broken-session.log").find("photo_0002.png"), std::string::npos);
+  EXPECT_NE(broken.at("error").get<std::string>().find("photos/002.png"), std::string::npos) << broken.dump();
+  EXPECT_NE(Slurp(dir / "out/logs/broken-session.log").find("photos/002.png"), std::string::npos);
   const std::string html = Slurp(dir / "out/library/index.html");
-  EXPECT_NE(html.find("photo_0002.png"), std::string::npos);
+  EXPECT_NE(html.find("photos/002.png"), std::string::npos);
   EXPECT_NE(html.find("materials/felt-sphere/felt-sphere.sphere.png"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir / "out/library/comparison.png"));
   EXPECT_EQ(ReadJson(index_path).at("comparison").at("materials").size(), 3u);
@@ -128,7 +128,7 @@ TEST(BatchCommand, SixSessionsSucceedTheBrokenOneFailsAloneAndReRunsRetryOnlyIt)
   EXPECT_NE(MTime(dir / "out/logs/broken-session.log"), broken_log);
 
   // Fixed, it runs; then a call does nothing at all.
-  fs::rename(dir / "photo_0002.png", photo);
+  fs::rename(dir / "002.png", photo);
   const RunResult third = RunIbrdf("batch " + config + " --cores 2", true);
   EXPECT_EQ(third.exit_code, 0) << third.output;
   EXPECT_EQ(ByName(ReadJson(index_path)).at("broken-session").at("status"), "ok");
