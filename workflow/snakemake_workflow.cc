@@ -62,6 +62,9 @@ std::vector<std::string> SnakemakeArguments(const SnakemakeRunOptions& o) {
       "--directory",       o.out_dir,          "--config",
       "batch=" + o.config, "ibrdf=" + o.ibrdf, "--keep-going",
       "--rerun-incomplete"};
+  // Which sessions run is ibrdf's decision (the plan); Snakemake's other triggers (a changed set of
+  // inputs, params, code) would rebuild the library on the call after every retry.
+  argv.insert(argv.end(), {"--rerun-triggers", "mtime"});
   if (!o.profile.empty()) {
     const std::string profile =
         o.profile == "slurm" ? (fs::path(o.snakemake_dir) / "profiles" / "slurm").string() : o.profile;

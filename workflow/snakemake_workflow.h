@@ -35,7 +35,8 @@ struct SnakemakeRunOptions {
 };
 
 // The snakemake command line: --snakefile, --directory, --config batch=... ibrdf=..., --keep-going
-// (a failed session fails its job alone), --rerun-incomplete, and --cores or --profile.
+// (a failed session fails its job alone), --rerun-incomplete, --rerun-triggers mtime (the plan decides
+// which sessions run), and --cores or --profile.
 std::vector<std::string> SnakemakeArguments(const SnakemakeRunOptions& options);
 
 }  // namespace ibrdf
