@@ -32,6 +32,7 @@ WorkflowRun::WorkflowRun(WorkflowOptions options) : options_(std::move(options))
   if (fs::exists(options_.run_dir) && !fs::is_directory(options_.run_dir)) {
     ThrowError(options_.run_dir, "exists and is not a folder");
   }
+  if (options_.dry_run) return;
   fs::create_directories(fs::path(options_.run_dir) / "stamps");
   RemoveStaleTemporaries(options_.run_dir);
 }
@@ -61,6 +62,12 @@ const StageOutcome& WorkflowRun::Execute(Stage stage) {
   if (stale.empty()) {
     outcome = {StageStatus::kSkipped, "up to date", Stamp::Read(stamp_path).seconds};
     Log(1, heading + ": up to date, skipped (took " + FormatSeconds(outcome.seconds) + " when it ran)");
+    return outcome;
+  }
+  if (options_.dry_run) {
+    would_run_ = stage.name + " (" + stale + ")";
+    stopped_ = "dry run: " + would_run_ + " would run first";
+    outcome = {StageStatus::kNotApplicable, stopped_, 0.0};
     return outcome;
   }
   Log(1, heading + " (" + stale + ")");

@@ -18,6 +18,9 @@ struct WorkflowOptions {
   std::string version;     // recorded in stamps for the reader, e.g. "ibrdf 0.1.0"
   bool force = false;      // re-run every stage that applies, up to date or not
   std::string stop_after;  // the last stage to run ("": all); later ones are not applicable
+  // Decide only (`ibrdf batch`'s plan): nothing is created, removed or run; the first stage that would
+  // run stops the plan there, and would_run() says which and why.
+  bool dry_run = false;
 
   bool Check(std::string* why) const;
 };
@@ -41,6 +44,9 @@ class WorkflowRun {
   // The outcome of an executed stage (an InternalError for an unknown one).
   const StageOutcome& outcome(const std::string& stage) const;
   const WorkflowOptions& options() const { return options_; }
+  // With dry_run: "" while every stage so far is up to date (or does not apply); otherwise the first
+  // stage that would run and why, "derender (an input changed)".
+  const std::string& would_run() const { return would_run_; }
   // The absolute run folder, and `name` inside it.
   const std::string& run_dir() const { return options_.run_dir; }
   std::string Path(const std::string& name) const;
@@ -48,6 +54,7 @@ class WorkflowRun {
  private:
   WorkflowOptions options_;
   std::string stopped_;  // why later stages do not run ("--stop-after NAME"), once they do not
+  std::string would_run_;  // dry_run: the first stage that would run, and why
   std::vector<Stage> stages_;
   std::map<std::string, StageOutcome> outcomes_;
 };
