@@ -50,8 +50,7 @@ struct HullDistances {
   bool valid = false;  // false when the points span no volume (fewer than 4, or coplanar)
 };
 // The convex hull of the points (CGAL quickhull, on centred coordinates) and each point's distance to
-// its surface: 0 for the hull's own vertices, an AABB tree over the hull's triangles for the points
-// inside (queried across threads).
+// its surface (an AABB tree over the hull's triangles).
 HullDistances ConvexHullDistances(const std::vector<Eigen::Vector3d>& points);
 
 }  // namespace ibrdf::scan_adapters

@@ -147,7 +147,7 @@ TEST(SessionInit, ListsWhatIsMissingThenValidates) {
   EXPECT_TRUE(session.sample.radius_known);
   EXPECT_EQ(session.sample.center, Eigen::Vector3d(0.0, 0.0, 0.02));  // on the platform's centre
   ASSERT_TRUE(session.targets && session.targets->light);
-  EXPECT_EQ(session.light.intensity, Eigen::Vector3d(1.0, 0.9, 0.8));
+  EXPECT_EQ(session.lights[0].intensity, Eigen::Vector3d(1.0, 0.9, 0.8));
   // The photos stay where they are: the manifest names them relative to the output folder.
   EXPECT_EQ(fs::path(session.PhotoPath(0)).lexically_normal(), fs::path(dir / "a.png").lexically_normal());
   // An existing session is not replaced without overwrite.

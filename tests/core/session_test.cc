@@ -684,9 +684,9 @@ TEST_F(SessionV2Test, LightWithoutIntensityAndNoCalibrationIsAnError) {
   manifest["version"] = 2;
   manifest["light"].erase("intensity");
   ExpectLoadError(manifest, "/light");
-  // Version 1 requires the intensity as before.
+  // Version 1: the same rule (a white reference may measure the one light; without one it is an error).
   manifest["version"] = 1;
-  ExpectLoadError(manifest, "/light/intensity");
+  ExpectLoadError(manifest, "/light");
 }
 
 // Masks: missing files are errors at load; masks on white-reference and targets photos are refused.
