@@ -75,6 +75,9 @@ TEST(RadianceImage, LookupTableMatchesTheResponse) {
 TEST(RadianceImage, FlagsSaturatedBelowSignalAndNonFinite) {
   ScratchDir dir;
   Session session = SmallSession(dir);
+  // Float files clip only where the session says so (core/linear_image.h SaturationLevel).
+  session.radiometry.saturation_stated = true;
+  session.radiometry.saturation_level = 1.0;
   Image image(kWidth, kHeight, 3);
   for (float& v : image.pixels) v = 0.4f;
   image.at(1, 1, 2) = 1.0f;           // one channel clipped
@@ -285,6 +288,8 @@ TEST(RadianceImage, TooManyExposuresOfOnePoseIsAnError) {
 TEST(RadianceImage, BracketMergesWhereUsable) {
   ScratchDir dir;
   Session session = SmallSession(dir);
+  session.radiometry.saturation_stated = true;  // float files: the clip level is the session's
+  session.radiometry.saturation_level = 1.0;
   session.radiometry.noise = CameraNoise{20000.0, 4.0, 0};
   // True radiance 0.5 everywhere, except 4.0 at (1, 1) and 1e-4 at (2, 2).
   auto exposure = [&](const std::string& name, double exposure_s) {

@@ -43,10 +43,12 @@ TEST(ReportInstall, TheInstalledBinaryRunsTheInstalledScript) {
   ASSERT_TRUE(fs::is_regular_file(prefix + "/bin/ibrdf")) << output;
   ASSERT_TRUE(fs::is_regular_file(prefix + "/share/ibrdf/report.py")) << output;
 
-  // A stub in place of the installed script: it writes an index.html and says where it ran from.
+  // A stub in place of the installed script: it writes index.html and explorer.html and says where it ran
+  // from.
   std::ofstream(prefix + "/share/ibrdf/report.py")
       << "import os, sys\n"
          "open(os.path.join(sys.argv[2], 'index.html'), 'w').write('<html></html>')\n"
+         "open(os.path.join(sys.argv[2], 'explorer.html'), 'w').write('<html></html>')\n"
          "print('stub report.py of share/ibrdf ran')\n";
   // The smallest run folder: samples.npy alone (no sidecar, reconstruction or truth).
   const std::string run = dir / "run";
