@@ -257,6 +257,11 @@ void CollectFiles(const LibraryEntry& entry, const fs::path& tmp, const LibraryO
     if (file.rfind(".", 0) == 0) continue;
     std::string target;
     nlohmann::json* list = nullptr;
+    if (file == "brdf.json") {  // the table's sidecar (its domain classes and any fill), not a fit
+      files["table_sidecar"] = rel + name + ".brdf.json";
+      Place(item, folder / (name + ".brdf.json"));
+      continue;
+    }
     if (ext == ".json" && file != "summary.json") {
       list = &fits;
     } else if (ext == ".pbrt" || ext == ".xml") {
@@ -434,13 +439,18 @@ nlohmann::json LibraryRecord(const LibraryEntry& entry) {
   nlohmann::json figures;
   figures["samples"] = At(summary, {"samples", "accepted"});
   figures["photos"] = At(summary, {"samples", "photos"});
+  // The table's classes (issue 14: measured / interpolated / unmeasured); older runs said "unsupported".
   const nlohmann::json measured = At(summary, {"reconstruction", "table", "cells_measured"});
-  const nlohmann::json unsupported = At(summary, {"reconstruction", "table", "cells_unsupported"});
+  const nlohmann::json interpolated = At(summary, {"reconstruction", "table", "cells_interpolated"});
+  nlohmann::json unmeasured = At(summary, {"reconstruction", "table", "cells_unmeasured"});
+  if (unmeasured.is_null()) unmeasured = At(summary, {"reconstruction", "table", "cells_unsupported"});
   figures["table_cells_measured"] = measured;
-  figures["table_cells_unsupported"] = unsupported;
+  figures["table_cells_interpolated"] = interpolated;
+  figures["table_cells_unmeasured"] = unmeasured;
   figures["table_coverage"] = nullptr;
-  if (measured.is_number() && unsupported.is_number() && measured.get<double>() + unsupported.get<double>() > 0) {
-    figures["table_coverage"] = measured.get<double>() / (measured.get<double>() + unsupported.get<double>());
+  if (measured.is_number() && unmeasured.is_number()) {
+    const double inside = measured.get<double>() + (interpolated.is_number() ? interpolated.get<double>() : 0.0);
+    if (inside + unmeasured.get<double>() > 0) figures["table_coverage"] = inside / (inside + unmeasured.get<double>());
   }
   figures["reciprocity"] = At(summary, {"consistency", "reciprocity"});
   nlohmann::json symmetry = At(summary, {"consistency", "bilateral_symmetry"});

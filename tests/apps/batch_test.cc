@@ -97,7 +97,10 @@ TEST(BatchCommand, SixSessionsSucceedTheBrokenOneFailsAloneAndReRunsRetryOnlyIt)
     EXPECT_EQ(m.at("status"), "ok") << name << ": " << m.dump();
     const nlohmann::json& f = m.at("figures");
     EXPECT_GT(f.at("samples").get<int>(), 1000) << name;
-    EXPECT_GT(f.at("table_coverage").get<double>(), 0.5) << name;
+    // Coverage counts measured and interpolated cells only (issue 14's honest table): a small session
+    // of 8 photos covers 10 to 50 % of the table.
+    EXPECT_GT(f.at("table_coverage").get<double>(), 0.05) << name;
+    EXPECT_LE(f.at("table_coverage").get<double>(), 1.0) << name;
     EXPECT_TRUE(f.at("reciprocity").is_number()) << name;
     EXPECT_LT(f.at("samples_median_rel_error").get<double>(), 0.05) << name;
     EXPECT_TRUE(m.at("timings_s").at("stages_total").is_number()) << name;
