@@ -484,7 +484,11 @@ def headline_rows(s, side, c, t, r, data, times):
                      f"{pct(e['rel_rms_error'])} over {e['cells_scored']} MERL cells (coverage {pct(e['coverage'])})"))
     if r and "fits" in r:
         for model, fit in r["fits"].items():
-            rows.append((f"{model} fit: relative RMS against the samples", pct(fit["rel_rms_vs_samples"])))
+            # Besides one block per model the summary holds "chosen", "snippet_kind", "renderer_snippets".
+            if not isinstance(fit, dict) or "rel_rms_vs_samples" not in fit:
+                continue
+            chosen = " (chosen)" if r["fits"].get("chosen") == model else ""
+            rows.append((f"{model} fit{chosen}: relative RMS against the samples", pct(fit["rel_rms_vs_samples"])))
     photo = data.get("photo")
     if photo:
         for rd in photo.get("renders", []):
