@@ -13,10 +13,8 @@ struct RunResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs `ibrdf --silent ARGUMENTS` (or `-q` when `quiet`, which keeps stage summaries) and collects
-// its output and exit code.
-inline RunResult RunIbrdf(const std::string& arguments, bool quiet = false) {
-  const std::string command = std::string(IBRDF_BINARY) + (quiet ? " -q " : " --silent ") + arguments + " 2>&1";
+// Runs a shell command and collects its standard output (append " 2>&1" for standard error too) and exit code.
+inline RunResult RunShell(const std::string& command) {
   RunResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return result;
@@ -26,6 +24,12 @@ inline RunResult RunIbrdf(const std::string& arguments, bool quiet = false) {
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// Runs `ibrdf --silent ARGUMENTS` (or `-q` when `quiet`, which keeps stage summaries) and collects
+// its output and exit code.
+inline RunResult RunIbrdf(const std::string& arguments, bool quiet = false) {
+  return RunShell(std::string(IBRDF_BINARY) + (quiet ? " -q " : " --silent ") + arguments + " 2>&1");
 }
 
 }  // namespace ibrdf::testing

@@ -19,31 +19,13 @@ using testing::ScratchDir;
 
 // Runs `ibrdf ARGUMENTS` with nothing added (RunIbrdf adds --silent or -q first).
 RunResult RunRaw(const std::string& arguments) {
-  const std::string command = std::string(IBRDF_BINARY) + " " + arguments + " 2>&1";
-  RunResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
+  return testing::RunShell(std::string(IBRDF_BINARY) + " " + arguments + " 2>&1");
 }
 
 std::string Binary(const std::string& name) { return (fs::path(IBRDF_BINARY).parent_path() / name).string(); }
 
 // The shared libraries `ldd` lists for a binary.
-std::string Ldd(const std::string& binary) {
-  std::string out;
-  FILE* pipe = popen(("ldd " + binary + " 2>&1").c_str(), "r");
-  if (!pipe) return out;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) out.append(buffer, n);
-  pclose(pipe);
-  return out;
-}
+std::string Ldd(const std::string& binary) { return testing::RunShell("ldd " + binary + " 2>&1").output; }
 
 TEST(FrontEnd, VersionAndHelpListEverySubcommand) {
   const RunResult version = RunRaw("--version");

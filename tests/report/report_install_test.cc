@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "core/sample_file.h"
+#include "tests/run_ibrdf.h"
 #include "tests/scratch_dir.h"
 
 namespace ibrdf {
@@ -21,15 +22,9 @@ namespace fs = std::filesystem;
 using testing::ScratchDir;
 
 std::string RunCommand(const std::string& command, int* exit_code) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return output;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) output.append(buffer, n);
-  const int status = pclose(pipe);
-  *exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return output;
+  const testing::RunResult result = testing::RunShell(command + " 2>&1");
+  *exit_code = result.exit_code;
+  return result.output;
 }
 
 TEST(ReportInstall, TheInstalledBinaryRunsTheInstalledScript) {

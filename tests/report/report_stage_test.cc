@@ -29,6 +29,7 @@
 #include "reconstruct/reconstruction_stage.h"
 #include "reconstruct/truth_comparison.h"
 #include "report/table_interpolation.h"
+#include "tests/run_ibrdf.h"
 #include "tests/scratch_dir.h"
 #include "tests/test_util.h"
 
@@ -59,16 +60,7 @@ std::string Chromium() {
   return "";
 }
 
-std::string Capture(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return output;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) output.append(buffer, n);
-  pclose(pipe);
-  return output;
-}
+std::string Capture(const std::string& command) { return testing::RunShell(command).output; }
 
 // A run folder made stage by stage through the libraries, as `ibrdf run` lays it out: samples.npy (with
 // its sidecar), consistency.json, truth-comparison.json, reconstruction/.
