@@ -362,6 +362,30 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     ThrowError(session.manifest_path, "no photo could be aligned (see the reasons above)");
   }
 
+  // The white reference from its card's markers: its photos' poses, its centre and normal.
+  if (options.pose_white_reference && targets.white_reference && session.calibration &&
+      session.calibration->white_reference) {
+    WhiteReferencePoseOptions white_options = options.white_reference;
+    white_options.huber_px = options.huber_px;
+    white_options.corner_sigma_px = options.corner_sigma_px;
+    result.white_reference = PoseWhiteReference(session, pose.markers, dictionary, white_options);
+    WhiteReferenceSpec& white = *result.session.calibration->white_reference;
+    white.center = result.white_reference.center;
+    white.normal = result.white_reference.normal;
+    white.posed = true;
+    std::vector<PhotoSpec> posed;
+    for (const WhiteReferencePhotoPose& photo : result.white_reference.photos) {
+      if (!photo.used) {
+        Log(1, "white-reference photo " + white.photos[photo.photo].file + " left out: " + photo.dropped_reason);
+        continue;
+      }
+      posed.push_back(white.photos[photo.photo]);
+      posed.back().camera_from_world = photo.camera_from_world;
+    }
+    white.photos = posed;
+    Log(1, result.white_reference.BriefReport());
+  }
+
   // The sphere from its silhouettes in the used measurement photos (target photos show no sample).
   if (options.fit_sphere && session.sample.kind == SampleSpec::Kind::kSphere) {
     std::vector<SilhouettePhoto> photos;
@@ -406,6 +430,7 @@ std::string AlignResult::BriefReport() const {
     report += "sample pose as given";
   }
   if (light.fitted || !light.reason.empty()) report += "; " + light.BriefReport();
+  if (white_reference.posed) report += "; " + white_reference.BriefReport();
   return report;
 }
 
@@ -486,6 +511,7 @@ nlohmann::json ToJson(const AlignResult& result) {
       json["warnings"].push_back("sphere fit: " + result.sphere.warning);
     }
   }
+  if (result.white_reference.posed) json["white_reference"] = ToJson(result.white_reference);
   if (result.light.fitted || !result.light.reason.empty()) {
     nlohmann::json light_markers = nlohmann::json::array();
     for (const LightMarkerFit& marker : result.light.markers) {

@@ -18,6 +18,7 @@
 #include "align/cylinder_fit.h"
 #include "align/light_fit.h"
 #include "align/sphere_fit.h"
+#include "align/white_reference_pose.h"
 #include "core/session.h"
 
 namespace ibrdf {
@@ -39,10 +40,14 @@ struct AlignOptions {
   bool fit_sphere = true;          // refine a sphere sample's centre and radius from silhouettes
   bool fit_cylinder = true;        // a cylinder's centre and axis from its markers (targets.sample)
   bool fit_light = true;           // the light's position from its markers, when the session has them
+  // The white reference's centre and normal from its card's markers, when the session has them
+  // (targets.white_reference) and white-reference photos (align/white_reference_pose.h).
+  bool pose_white_reference = true;
   BundleAdjustmentOptions bundle;  // huber_px is taken from above
   CylinderFitOptions cylinder;     // the cylinder fit (align/cylinder_fit.h)
   SphereFitOptions sphere;         // the sphere fit (align/sphere_fit.h)
   LightFitOptions light;           // the light fit (align/light_fit.h); huber_px is taken from above
+  WhiteReferencePoseOptions white_reference;  // huber_px and corner_sigma_px are taken from above
   bool Check(std::string* why) const;
 };
 
@@ -78,6 +83,7 @@ struct AlignResult {
   SphereFit sphere;
   CylinderFit cylinder;
   LightFit light;
+  WhiteReferencePose white_reference;  // posed only with the card's markers and white-reference photos
   BundleAdjustmentSummary bundle;
   double rms_px = 0.0;  // over all corners of used photos
   double total_s = 0.0;
@@ -89,7 +95,9 @@ struct AlignResult {
 // Every photo is posed, target photos (role "targets") included; only measurement photos serve the
 // silhouette fits. The sample's centre and radius in the session serve as the starting guess of the
 // sphere fit. In the aligned session, markers of unknown layout that were posed join the reference
-// layout with their estimated corners.
+// layout with their estimated corners. With the white reference's card markers (targets.white_reference),
+// the white-reference photos are posed and the aligned session's white reference gets the card's
+// centre and normal (replacing any stated ones).
 AlignResult AlignSession(const Session& session, const AlignOptions& options);
 
 nlohmann::json ToJson(const AlignResult& result);

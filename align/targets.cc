@@ -214,6 +214,15 @@ bool TargetSheetsOptions::Check(std::string* why) const {
   const double card_reach = ring_radius + card / std::sqrt(2.0);
   IBRDF_CHECK_OPTION_GT(card_spacing, card);
   IBRDF_CHECK_OPTION_GE(platform_radius, card_reach);
+  IBRDF_CHECK_OPTION_GT(white_marker_size, 0.0);
+  IBRDF_CHECK_OPTION_GT(white_patch_size, 0.0);
+  IBRDF_CHECK_OPTION_GE(white_patch_thickness, 0.0);
+  IBRDF_CHECK_OPTION_GE(white_marker_first_id, 0);
+  // The card's ids must not collide with the ring's or the light's.
+  IBRDF_CHECK_OPTION(!white_card || white_marker_first_id >= ring_count);
+  IBRDF_CHECK_OPTION(!white_card || light_marker_count == 0 ||
+                     white_marker_first_id >= light_marker_first_id + light_marker_count ||
+                     white_marker_first_id + 4 <= light_marker_first_id);
   return true;
 }
 
@@ -222,6 +231,23 @@ std::string TargetSheetsResult::BriefReport() const {
   out << "targets: " << (written ? std::to_string(files.size()) + " files" : "nothing written");
   for (const std::string& size : sheet_sizes) out << "; " << size;
   return out.str();
+}
+
+WhiteReferenceTargetsSpec WhiteCardLayout(int first_id, double marker_size, double patch_size, double margin,
+                                          double patch_thickness) {
+  WhiteReferenceTargetsSpec card;
+  const double half = 0.5 * marker_size;
+  const double d = 0.5 * patch_size + margin * marker_size + half;  // marker centres at (+-d, +-d)
+  const Eigen::Vector2d centres[4] = {{-d, d}, {d, d}, {d, -d}, {-d, -d}};
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d c(centres[k].x(), centres[k].y(), -patch_thickness);
+    TargetSpec target;
+    target.id = first_id + k;
+    target.corners = {c + Eigen::Vector3d(-half, half, 0), c + Eigen::Vector3d(half, half, 0),
+                      c + Eigen::Vector3d(half, -half, 0), c + Eigen::Vector3d(-half, -half, 0)};
+    card.markers.push_back(target);
+  }
+  return card;
 }
 
 TargetsSpec TargetLayout(const TargetSheetsOptions& options) {
@@ -253,6 +279,11 @@ TargetsSpec TargetLayout(const TargetSheetsOptions& options) {
     }
     targets.light = light;
   }
+  if (options.white_card) {
+    targets.white_reference =
+        WhiteCardLayout(options.white_marker_first_id, options.white_marker_size, options.white_patch_size,
+                        options.card_margin, options.white_patch_thickness);
+  }
   return targets;
 }
 
@@ -264,6 +295,15 @@ nlohmann::json TargetsToJson(const TargetsSpec& targets) {
     reference.push_back({{"id", target.id}, {"corners", corners}});
   }
   nlohmann::json json = {{"dictionary", targets.dictionary}, {"reference", reference}};
+  if (targets.white_reference) {
+    nlohmann::json markers = nlohmann::json::array();
+    for (const TargetSpec& target : targets.white_reference->markers) {
+      nlohmann::json corners = nlohmann::json::array();
+      for (const Eigen::Vector3d& c : target.corners) corners.push_back(ToJson(c));
+      markers.push_back({{"id", target.id}, {"corners", corners}});
+    }
+    json["white_reference"] = {{"markers", markers}};
+  }
   if (targets.light) {
     nlohmann::json markers = nlohmann::json::array();
     for (const LightMarkerSpec& m : targets.light->markers) {
@@ -278,8 +318,9 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
   std::string why;
   if (!options.Check(&why)) ThrowError("targets options", why);
   const MarkerDictionary dictionary(options.dictionary, "--dictionary");
-  const int last_id = options.light_marker_count > 0 ? options.light_marker_first_id + options.light_marker_count - 1
-                                                     : options.ring_count - 1;
+  int last_id = options.light_marker_count > 0 ? options.light_marker_first_id + options.light_marker_count - 1
+                                               : options.ring_count - 1;
+  if (options.white_card) last_id = std::max(last_id, options.white_marker_first_id + 3);
   if (last_id >= dictionary.size()) {
     ThrowError("--dictionary", options.dictionary + " has ids 0 to " + std::to_string(dictionary.size() - 1) +
                                    "; the layout needs id " + std::to_string(last_id));
@@ -366,6 +407,59 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
     if (options.light_offset > 0.0) readme << " and " << Mm(1e3 * options.light_offset) << " in front of the card";
     readme << ".\n  Take 3 or more photos (role \"targets\") that see it and the platform's ring: `ibrdf align` then\n"
            << "  finds the light (targets.light in targets.json: the emitter in each marker's frame).\n";
+  }
+  // The white reference's card.
+  if (result.targets.white_reference) {
+    const double side = 1e3 * options.white_marker_size, patch = 1e3 * options.white_patch_size;
+    const double card = patch + 2.0 * side * (1.0 + 2.0 * options.card_margin);
+    Sheet sheet;
+    sheet.name = "white-card";
+    sheet.width_mm = std::max(card + 20.0, 1e3 * options.scale_bar + 40.0);
+    sheet.height_mm = card + 70.0;
+    const double cx = 0.5 * sheet.width_mm, cy = 10.0 + 0.5 * card;
+    // The card's outline (cut along it), thin.
+    const double line = 0.2, h = 0.5 * card;
+    sheet.Rect(cx - h, cy - h, card, line, true);
+    sheet.Rect(cx - h, cy + h - line, card, line, true);
+    sheet.Rect(cx - h, cy - h, line, card, true);
+    sheet.Rect(cx + h - line, cy - h, line, card, true);
+    for (const TargetSpec& target : result.targets.white_reference->markers) {
+      const Eigen::Vector3d c = 0.25 * (target.corners[0] + target.corners[1] + target.corners[2] + target.corners[3]);
+      DrawMarker(dictionary, target.id, cx + 1e3 * c.x(), cy - 1e3 * c.y(), side, 0.0, &sheet);
+    }
+    // The patch's corners: small L marks 1.5 mm outside it.
+    const double p = 0.5 * patch + 1.5, arm = 4.0, w = 0.3;
+    for (const double sx : {-1.0, 1.0}) {
+      for (const double sy : {-1.0, 1.0}) {
+        // The corner at (x, y); its arms point away from the patch.
+        const double x = cx + sx * p, y = cy + sy * p;
+        sheet.Rect(std::min(x, x + sx * arm), y - 0.5 * w, arm, w, true);
+        sheet.Rect(x - 0.5 * w, std::min(y, y + sy * arm), w, arm, true);
+      }
+    }
+    const double text_y = cy + h + 12.0;
+    DrawScaleBar(10.0, text_y, std::min(1e3 * options.scale_bar, sheet.width_mm - 20.0), &sheet);
+    sheet.Text(10.0, text_y + 14.0, 3.5,
+               "white patch " + Mm(patch) + " square inside the corner marks; markers " + Mm(side) + ", ids " +
+                   std::to_string(options.white_marker_first_id) + "-" +
+                   std::to_string(options.white_marker_first_id + 3));
+    sheet.Text(10.0, text_y + 20.0, 3.5,
+               "patch surface " + Mm(1e3 * options.white_patch_thickness) + " in front of the card");
+    emit(sheet);
+    readme << "\nwhite-card.svg/.png: glue it flat to a rigid board and mount the white reference (Spectralon, "
+           << Mm(patch) << "\n  square) inside the corner marks";
+    if (options.white_patch_thickness > 0.0) {
+      readme << ", its surface " << Mm(1e3 * options.white_patch_thickness) << " in front of the card";
+    } else {
+      readme << ", its surface flush with the card (or rerun with --white-patch-thickness-mm)";
+    }
+    readme << ".\n  Stand it where the sample was, facing between the light and the camera, and photograph it so\n"
+           << "  that the card's 4 markers and 2 or more platform markers are in view: `ibrdf align` then poses it\n"
+           << "  (targets.white_reference: the markers' corners in the card's frame, origin at the patch's\n"
+           << "  centre, x right, y up, z out of the patch). Corners (mm):\n";
+    for (const TargetSpec& target : result.targets.white_reference->markers) {
+      readme << "    id " << target.id << ":" << Corners(target) << "\n";
+    }
   }
   // The ChArUco board.
   if (options.charuco) {

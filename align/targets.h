@@ -5,6 +5,8 @@
 //     of known layout on white cards, a cross where the sample rests, a scale bar and the sizes;
 //   - light card: markers in a row with a cross where the light's emitter goes, for `ibrdf align` to
 //     find the light (targets.light);
+//   - white card: a white patch framed by markers, for `ibrdf align` to pose the white reference
+//     (targets.white_reference);
 //   - ChArUco board: the calibration board `ibrdf align --calibrate` reads (with its board.json).
 // The world frame of a session aligned to the platform: origin at the platform's centre on the paper,
 // x to the right of the print, y up the print, z out of the paper (up). The defaults are the layout of
@@ -40,6 +42,16 @@ struct TargetSheetsOptions {
   double light_marker_size = 0.06;  // metres
   double light_drop = 0.08;         // metres, the row's centre line to the emitter, straight up the card
   double light_offset = 0.0;        // metres, in front of the card
+  // The white reference's card (issue 13, part 5): a white patch (Spectralon) of white_patch_size mounted
+  // at the card's centre, framed by 4 markers of white_marker_size at the corners (ids from
+  // white_marker_first_id: top-left, top-right, bottom-right, bottom-left), each card_margin marker sides
+  // clear of the patch. white_patch_thickness: how far the patch's surface stands in front of the
+  // printed card (a tile's thickness; the markers' corners then lie that far behind the patch's plane).
+  bool white_card = true;
+  int white_marker_first_id = 40;
+  double white_marker_size = 0.02;       // metres
+  double white_patch_size = 0.05;        // metres, the patch's side
+  double white_patch_thickness = 0.0;    // metres
   bool charuco = true;              // the calibration board sheet
   CharucoBoardSpec board;           // its layout (align/intrinsic_calibration.h)
   double dpi = 600.0;               // the PNGs' resolution, dots per inch
@@ -57,13 +69,22 @@ struct TargetSheetsResult {
   std::string BriefReport() const;
 };
 
-// The targets block of the layout (reference ring, light markers; no unknown layout, no sample markers).
+// The white reference's card markers: 4 markers of side `marker_size` (ids first_id ..) framing a square
+// patch of side `patch_size` at the corners, `margin` marker sides clear of it, their corners in the
+// card's frame (origin at the patch's centre on its surface, x right, y up the print, z out of the
+// patch) at z = -patch_thickness. Shared by the printed card and `ibrdf synth`'s rendered one.
+WhiteReferenceTargetsSpec WhiteCardLayout(int first_id, double marker_size, double patch_size, double margin,
+                                          double patch_thickness);
+
+// The targets block of the layout (reference ring, light markers, the white card's markers; no unknown
+// layout, no sample markers).
 TargetsSpec TargetLayout(const TargetSheetsOptions& options);
 
 // The targets block as session.json holds it.
 nlohmann::json TargetsToJson(const TargetsSpec& targets);
 
-// Writes `out_dir`: platform.svg/.png, light-card.svg/.png (with light markers), charuco.svg/.png and
+// Writes `out_dir`: platform.svg/.png, light-card.svg/.png (with light markers), white-card.svg/.png
+// (with white_card), charuco.svg/.png and
 // board.json (with charuco), targets.json ({"targets": ...}) and README.txt (how to print and check).
 // The folder appears only when complete. Throws Error for bad options (marker ids beyond the dictionary,
 // markers that overlap, a ring outside the platform).

@@ -27,7 +27,8 @@ void AddSessionCommand(CLI::App& app) {
     SessionInitOptions o;
     std::string out;
     std::vector<double> light_position, light_intensity, sample_center;
-    double sample_radius = 0.0;
+    double sample_radius = 0.0, white_size = 0.0;
+    std::vector<double> white_reflectance;
   };
   auto args = std::make_shared<Args>();
   SessionInitOptions& o = args->o;
@@ -35,6 +36,14 @@ void AddSessionCommand(CLI::App& app) {
   init->add_option("--out", args->out, "Folder for session.json (the photos stay where they are)")->required();
   init->add_option("--target-photos", o.target_photos, "Photos for the alignment only (e.g. of the light's markers)")
       ->check(CLI::ExistingFile);
+  init->add_option("--white-photos", o.white_photos,
+                   "Photos of the white reference (its card's markers pose it in `ibrdf align`); it measures the "
+                   "light's intensity")
+      ->check(CLI::ExistingFile);
+  init->add_option("--white-size", args->white_size, "The white reference's size (metres, the patch's side)");
+  init->add_option("--white-reflectance", args->white_reflectance,
+                   "The white reference's albedo R G B (default 0.99: Spectralon)")
+      ->expected(3);
   init->add_option("--targets", o.targets_file, "The markers' layout: targets.json from `ibrdf targets`")
       ->check(CLI::ExistingFile);
   init->add_option("--camera", o.camera_file, "A JSON file with a calibrated \"camera\" block (e.g. a session.json)")
@@ -64,6 +73,8 @@ void AddSessionCommand(CLI::App& app) {
     options.light_intensity = Vector(args->light_intensity);
     options.sample_center = Vector(args->sample_center);
     if (args->sample_radius > 0.0) options.sample_radius = args->sample_radius;
+    if (args->white_size != 0.0) options.white_size = args->white_size;
+    options.white_reflectance = Vector(args->white_reflectance);
     const SessionInitResult result = InitSession(options, args->out);
     for (const std::string& line : result.assumptions) std::cout << "assumed: " << line << "\n";
     for (const std::string& line : result.missing) std::cout << "missing: " << line << "\n";

@@ -72,6 +72,10 @@ void AddSynthCommand(CLI::App& app) {
   add("--bracket-step-ev", o.radiometry.bracket_step_ev, "Stops between a bracket's exposures");
   c.add_flag("--light-unknown", o.radiometry.light_unknown,
              "State no light intensity in session.json and add a white-reference photo per light that measures it");
+  c.add_flag("--white-card", o.targets.white_card,
+             "With --targets and --light-unknown: the white reference on a card framed by 4 ArUco markers\n"
+             "(`ibrdf targets`' white card, ids 40-43, 20 mm), standing where the sample was and seen with the\n"
+             "platform, so that `ibrdf align` can pose it (targets.white_reference)");
   add("--exposure-target", o.rig.exposure_target, "Auto-exposure: 99th percentile lands here");
   add("--fill-light", o.scene.fill_light,
       "Unmodelled fill light along each normal, as a fraction of the light's irradiance");

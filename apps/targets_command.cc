@@ -13,14 +13,15 @@ void AddTargetsCommand(CLI::App& app) {
   auto* command = app.add_subcommand(
       "targets",
       "Write print-ready sheets (SVG and PNG at --dpi, with a scale bar and the printed sizes): the marker\n"
-      "platform, the light's marker card and a ChArUco calibration board (with board.json), plus\n"
+      "platform, the light's marker card, the white reference's card and a ChArUco calibration board (with\n"
+      "board.json), plus\n"
       "targets.json, the session's matching \"targets\" block. Defaults: the layout of `ibrdf synth --targets`.");
   struct Args {
     TargetSheetsOptions o;
     std::string out;
     double marker_mm = 0, ring_mm = 0, platform_mm = 0, light_marker_mm = 0, light_drop_mm = 0, light_offset_mm = 0,
-           square_mm = 0, board_marker_mm = 0;
-    bool no_charuco = false;
+           square_mm = 0, board_marker_mm = 0, white_marker_mm = 0, white_patch_mm = 0, white_thickness_mm = 0;
+    bool no_charuco = false, no_white_card = false;
   };
   auto args = std::make_shared<Args>();
   TargetSheetsOptions& o = args->o;
@@ -32,6 +33,9 @@ void AddTargetsCommand(CLI::App& app) {
   args->light_offset_mm = 1e3 * o.light_offset;
   args->square_mm = 1e3 * o.board.square_size;
   args->board_marker_mm = 1e3 * o.board.marker_size;
+  args->white_marker_mm = 1e3 * o.white_marker_size;
+  args->white_patch_mm = 1e3 * o.white_patch_size;
+  args->white_thickness_mm = 1e3 * o.white_patch_thickness;
   command->add_option("--out", args->out, "Folder for the sheets and targets.json")->required();
   command->add_option("--dictionary", o.dictionary, "ArUco dictionary of the platform and light markers")
       ->capture_default_str();
@@ -48,6 +52,16 @@ void AddTargetsCommand(CLI::App& app) {
   command->add_option("--light-drop-mm", args->light_drop_mm, "The emitter's cross above the markers' centre line")
       ->capture_default_str();
   command->add_option("--light-offset-mm", args->light_offset_mm, "The emitter's distance in front of the card")
+      ->capture_default_str();
+  command->add_flag("--no-white-card", args->no_white_card, "No white-reference card sheet");
+  command->add_option("--white-marker-mm", args->white_marker_mm, "Printed side of a white card's marker")
+      ->capture_default_str();
+  command->add_option("--white-marker-first-id", o.white_marker_first_id, "Id of the white card's first marker")
+      ->capture_default_str();
+  command->add_option("--white-patch-mm", args->white_patch_mm, "Side of the white patch the card frames")
+      ->capture_default_str();
+  command->add_option("--white-patch-thickness-mm", args->white_thickness_mm,
+                      "How far the patch's surface stands in front of the card (a tile's thickness)")
       ->capture_default_str();
   command->add_flag("--no-charuco", args->no_charuco, "No calibration board sheet");
   command->add_option("--board-squares-x", o.board.squares_x, "ChArUco squares across")->capture_default_str();
@@ -68,6 +82,10 @@ void AddTargetsCommand(CLI::App& app) {
     options.board.square_size = 1e-3 * args->square_mm;
     options.board.marker_size = 1e-3 * args->board_marker_mm;
     options.charuco = !args->no_charuco;
+    options.white_card = !args->no_white_card;
+    options.white_marker_size = 1e-3 * args->white_marker_mm;
+    options.white_patch_size = 1e-3 * args->white_patch_mm;
+    options.white_patch_thickness = 1e-3 * args->white_thickness_mm;
     const TargetSheetsResult result = WriteTargetSheets(options, args->out);
     Log(1, result.BriefReport());
     for (const std::string& file : result.files) std::cout << args->out << "/" << file << "\n";

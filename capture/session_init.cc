@@ -81,6 +81,9 @@ bool SessionInitOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION(response.empty() || response == "linear" || response == "srgb");
   IBRDF_CHECK_OPTION(!sample_radius || *sample_radius > 0.0);
   IBRDF_CHECK_OPTION(!radius_known || sample_radius);
+  IBRDF_CHECK_OPTION(!white_size || *white_size > 0.0);
+  IBRDF_CHECK_OPTION(!white_reflectance ||
+                     ((white_reflectance->array() > 0.0).all() && (white_reflectance->array() <= 1.0).all()));
   return true;
 }
 
@@ -128,7 +131,7 @@ int GroupBrackets(const SessionInitOptions& options, std::vector<InitPhoto>* pho
   int direction = 0;  // +1 lengthening, -1 shortening exposures in the open bracket
   const InitPhoto* previous = nullptr;
   for (InitPhoto& photo : *photos) {
-    if (photo.target) continue;
+    if (photo.target || photo.white) continue;
     bool join = false;
     if (previous && options.bracket_size > 1) {
       join = size < options.bracket_size;
@@ -172,12 +175,13 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
   if (!options.Check(&why)) ThrowError("session init options", why);
   SessionInitResult result;
   // Every photo's metadata.
-  for (int pass = 0; pass < 2; ++pass) {
-    for (const std::string& file : pass == 0 ? options.photos : options.target_photos) {
+  for (int pass = 0; pass < 3; ++pass) {
+    for (const std::string& file : pass == 0 ? options.photos : pass == 1 ? options.target_photos : options.white_photos) {
       InitPhoto photo;
       photo.file = file;
       photo.metadata = ReadPhotoMetadata(file);
       photo.target = pass == 1;
+      photo.white = pass == 2;
       result.photos.push_back(photo);
     }
   }
@@ -285,6 +289,8 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
   }
   if (options.light_intensity) {
     light["intensity"] = ToJson(*options.light_intensity);
+  } else if (!options.white_photos.empty()) {
+    result.assumptions.push_back("light intensity: none stated; the white reference measures it (ibrdf derender)");
   } else {
     light["intensity"] = nullptr;
     result.missing.push_back(
@@ -330,15 +336,37 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
       "black level 0 and no saturation level stated (integer photos clip at full scale, float photos never; "
       "camera RAW: the file's black and white levels are applied when decoding)");
   // Photos.
-  nlohmann::json photos = nlohmann::json::array();
+  nlohmann::json photos = nlohmann::json::array(), white_photos = nlohmann::json::array();
   for (const InitPhoto& photo : result.photos) {
     nlohmann::json entry = {{"file", RelativeTo(photo.file, out_dir)}, {"exposure_s", *photo.metadata.exposure_s}};
     if (photo.gain != 1.0) entry["gain"] = photo.gain;
     if (photo.target) entry["role"] = "targets";
     if (photo.bracket >= 0) entry["bracket"] = photo.bracket;
-    photos.push_back(entry);
+    (photo.white ? white_photos : photos).push_back(entry);
   }
   json["photos"] = photos;
+  // The white reference: posed by `ibrdf align` from the white card's markers, when the targets have them.
+  if (!white_photos.empty()) {
+    nlohmann::json white = {{"photos", white_photos}};
+    white["reflectance"] = ToJson(options.white_reflectance.value_or(Eigen::Vector3d::Constant(0.99)));
+    if (!options.white_reflectance) {
+      result.assumptions.push_back("white reference reflectance 0.99 (Spectralon's); pass --white-reflectance R,G,B");
+    }
+    if (options.white_size) {
+      white["size"] = *options.white_size;
+    } else {
+      white["size"] = nullptr;
+      result.missing.push_back("the white reference's size (metres, the patch's side): pass --white-size S");
+    }
+    if (!(json.contains("targets") && json["targets"].contains("white_reference"))) {
+      white["center"] = nullptr;
+      white["normal"] = nullptr;
+      result.missing.push_back(
+          "the white reference's centre and normal: print the white card (`ibrdf targets`), mount the reference on "
+          "it and pass its targets.json with --targets (`ibrdf align` then poses it), or state them by hand");
+    }
+    json["calibration"] = {{"white_reference", white}};
+  }
   if (!json.contains("targets")) {
     result.missing.push_back(
         "the photos' poses: pass --targets FILE (the markers' layout from `ibrdf targets`) and run `ibrdf align`, "

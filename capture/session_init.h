@@ -23,6 +23,13 @@ namespace ibrdf {
 struct SessionInitOptions {
   std::vector<std::string> photos;         // measurement photos, in capture order (files)
   std::vector<std::string> target_photos;  // photos for the alignment only ("role": "targets")
+  // Photos of the white reference (calibration.white_reference), which measures the light's intensity:
+  // its pose comes from `ibrdf align` when the targets carry the white card's markers
+  // (targets.white_reference), so none is drafted; its size (metres, the patch's side) must be given, its
+  // reflectance defaults to Spectralon's 0.99 (stated as an assumption).
+  std::vector<std::string> white_photos;
+  std::optional<double> white_size;
+  std::optional<Eigen::Vector3d> white_reflectance;
   std::string name;                        // the session's name (empty: the output folder's name)
   // The camera: a JSON file holding a "camera" block (a session.json, an aligned session, or the
   // block itself: {"model": "OPENCV", "width": .., "height": .., "params": [..]}). Empty: a pinhole
@@ -60,6 +67,7 @@ struct InitPhoto {
   std::string file;  // as given
   PhotoMetadata metadata;
   bool target = false;  // role "targets"
+  bool white = false;   // a white-reference photo
   int bracket = -1;     // bracket id, -1: none
   double gain = 1.0;    // ISO / base ISO
 };

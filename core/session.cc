@@ -106,6 +106,7 @@ struct PhotoContext {
   int version = 1;
   const std::vector<Light>* lights = nullptr;
   bool white_reference = false;  // a white-reference photo (no role, no mask)
+  bool white_card = false;       // the targets carry the white reference's markers (its pose may be left out)
 };
 
 // A photo's (or a light-marker block's) `light`: the id of one of the session's lights. With one light
@@ -407,6 +408,14 @@ TargetsSpec ParseTargets(JsonObject object, const std::vector<Light>& lights) {
     sample.Finish();
     targets.sample = spec;
   }
+  if (object.Has("white_reference")) {
+    JsonObject card = object.Object("white_reference");
+    WhiteReferenceTargetsSpec spec;
+    for (JsonObject& marker : card.Objects("markers")) spec.markers.push_back(marker_corners(marker));
+    if (spec.markers.empty()) ThrowError(card.Where("markers"), "expected at least one marker on the white reference");
+    card.Finish();
+    targets.white_reference = spec;
+  }
   if (object.Has("light")) {
     JsonObject light = object.Object("light");
     LightTargetsSpec spec;
@@ -439,10 +448,14 @@ CalibrationSpec ParseCalibration(JsonObject object, const std::string& directory
     if (!((spec.reflectance.array() > 0.0).all() && (spec.reflectance.array() <= 1.0).all())) {
       ThrowError(white.Where("reflectance"), "expected an albedo in (0, 1] per channel");
     }
-    spec.center = white.Vector3("center");
-    spec.normal = white.Vector3("normal");
-    if (!(spec.normal.norm() > 0.0)) ThrowError(white.Where("normal"), "must be non-zero");
-    spec.normal.normalize();
+    // Without a stated pose the card's markers (targets.white_reference) must pose it (ibrdf align).
+    spec.posed = white.Has("center") || white.Has("normal") || !context.white_card;
+    if (spec.posed) {
+      spec.center = white.Vector3("center");
+      spec.normal = white.Vector3("normal");
+      if (!(spec.normal.norm() > 0.0)) ThrowError(white.Where("normal"), "must be non-zero");
+      spec.normal.normalize();
+    }
     spec.size = white.Number("size");
     RequirePositive(white, "size", spec.size);
     for (JsonObject& photo : white.Objects("photos")) {
@@ -546,10 +559,11 @@ Session Session::Load(const std::string& path) {
   context.lights = &session.lights;
   session.sample = ParseSample(root.Object("sample"));
   if (root.Has("radiometry")) session.radiometry = ParseRadiometry(root.Object("radiometry"), session.directory);
+  if (root.Has("targets")) session.targets = ParseTargets(root.Object("targets"), session.lights);
   if (root.Has("calibration")) {
+    context.white_card = session.targets && session.targets->white_reference;
     session.calibration = ParseCalibration(root.Object("calibration"), session.directory, context);
   }
-  if (root.Has("targets")) session.targets = ParseTargets(root.Object("targets"), session.lights);
   for (JsonObject& photo : root.Objects("photos")) {
     session.photos.push_back(ParsePhoto(photo, session.directory, context));
   }
@@ -687,6 +701,15 @@ nlohmann::json Session::ToJson() const {
       }
       json["targets"]["sample"] = {{"markers", markers}};
     }
+    if (targets->white_reference) {
+      nlohmann::json markers = nlohmann::json::array();
+      for (const TargetSpec& target : targets->white_reference->markers) {
+        nlohmann::json corners = nlohmann::json::array();
+        for (const Eigen::Vector3d& c : target.corners) corners.push_back(ibrdf::ToJson(c));
+        markers.push_back({{"id", target.id}, {"corners", corners}});
+      }
+      json["targets"]["white_reference"] = {{"markers", markers}};
+    }
     if (targets->light) {
       nlohmann::json markers = nlohmann::json::array();
       for (const LightMarkerSpec& m : targets->light->markers) {
@@ -711,11 +734,12 @@ nlohmann::json Session::ToJson() const {
       const WhiteReferenceSpec& white = *calibration->white_reference;
       nlohmann::json white_photos = nlohmann::json::array();
       for (const PhotoSpec& photo : white.photos) white_photos.push_back(photo_json(photo));
-      json["calibration"]["white_reference"] = {{"reflectance", ibrdf::ToJson(white.reflectance)},
-                                                {"center", ibrdf::ToJson(white.center)},
-                                                {"normal", ibrdf::ToJson(white.normal)},
-                                                {"size", white.size},
-                                                {"photos", white_photos}};
+      json["calibration"]["white_reference"] = {
+          {"reflectance", ibrdf::ToJson(white.reflectance)}, {"size", white.size}, {"photos", white_photos}};
+      if (white.posed) {
+        json["calibration"]["white_reference"]["center"] = ibrdf::ToJson(white.center);
+        json["calibration"]["white_reference"]["normal"] = ibrdf::ToJson(white.normal);
+      }
     }
   }
   json["photos"] = nlohmann::json::array();

@@ -119,12 +119,21 @@ struct SampleTargetsSpec {
   std::vector<TargetSpec> markers;  // corners in the sample frame, metres; each a square
 };
 
+// Markers on the white reference's card (issue 13, part 5): their corners in the card's own frame
+// (origin at the white patch's centre on its surface, x to the right and y up the print, z out of the
+// patch: its normal), in OpenCV's order. `ibrdf align` poses the card from them and writes the
+// white reference's centre and normal (align/white_reference_pose.h).
+struct WhiteReferenceTargetsSpec {
+  std::vector<TargetSpec> markers;  // corners in the card frame, metres; each a square
+};
+
 struct TargetsSpec {
   std::string dictionary;                           // OpenCV predefined dictionary name, e.g. "DICT_4X4_50"
   std::vector<TargetSpec> reference;                // markers with known layout (may be empty with unknown_layout)
   std::optional<UnknownLayoutSpec> unknown_layout;  // markers of unknown layout, if any
   std::optional<LightTargetsSpec> light;            // markers on the light, if any
   std::optional<SampleTargetsSpec> sample;          // markers on the sample, if any
+  std::optional<WhiteReferenceTargetsSpec> white_reference;  // markers on the white reference's card, if any
 };
 
 // What a photo is for: measurement photos are derendered; target photos only serve the alignment
@@ -156,7 +165,11 @@ struct WhiteReferenceSpec {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();               // the target's centre, world frame, metres
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();              // its front face's normal (unit), world frame
   double size = 0.0;              // metres: the side of a square target or the diameter of a round one
-  std::vector<PhotoSpec> photos;  // each with a camera_from_world pose
+  std::vector<PhotoSpec> photos;  // each with a camera_from_world pose (`ibrdf align` poses them)
+  // Whether center and normal are known: stated in the manifest or written by `ibrdf align` from the
+  // card's markers (targets.white_reference). A manifest may leave them out only when its targets
+  // block has the card's markers; the light calibration refuses an unposed white reference.
+  bool posed = true;
 };
 
 // Radiometric calibration steps that change the session's stated values.

@@ -211,6 +211,11 @@ Session ApplyLightCalibration(const Session& session, LightCalibrationReport* re
   std::string why;
   if (!options.Check(&why)) ThrowError("light calibration options", why);
   const WhiteReferenceSpec& white = *session.calibration->white_reference;
+  if (!white.posed) {
+    ThrowError(session.manifest_path + ": /calibration/white_reference",
+               "the white reference has no pose (center, normal): run `ibrdf align` on the session first, which "
+               "poses it from its card's markers (targets.white_reference), or state center and normal");
+  }
   for (size_t k = 0; k < session.lights.size(); ++k) {
     std::vector<size_t> photos;
     for (size_t j = 0; j < white.photos.size(); ++j) {

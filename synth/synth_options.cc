@@ -187,6 +187,16 @@ bool SynthOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GT(rig.camera_distance, 1.5 * sample_bounding_radius);
   IBRDF_CHECK_OPTION_GT(scene.light_distance, sample_bounding_radius);
   if (targets.enabled) IBRDF_CHECK_OPTION_GT(targets.ring_radius, sample_bounding_radius + targets.marker_size);
+  if (targets.white_card) {
+    // The card needs the platform (its photos' poses) and a white reference to carry.
+    IBRDF_CHECK_OPTION(targets.enabled);
+    IBRDF_CHECK_OPTION(radiometry.light_unknown);
+    IBRDF_CHECK_OPTION_GT(targets.white_marker_size, 0.0);
+    IBRDF_CHECK_OPTION_GE(targets.white_marker_first_id, targets.ring_count);
+    IBRDF_CHECK_OPTION(targets.light_photos == 0 || targets.white_marker_first_id >= targets.light_marker_first_id +
+                                                                                         targets.light_marker_count ||
+                       targets.white_marker_first_id + 4 <= targets.light_marker_first_id);
+  }
   return true;
 }
 

@@ -260,6 +260,7 @@ Session BuildSession(const SynthOptions& options) {
     if (!sample_targets.markers.empty()) targets.sample = sample_targets;
     const LightTargetsSpec light = LightTargetLayout(options, nullptr);
     if (!light.markers.empty()) targets.light = light;
+    if (options.targets.white_card) targets.white_reference = SynthWhiteCardLayout(options);
     session.targets = targets;
   }
 
@@ -374,12 +375,13 @@ class TargetScene {
   std::vector<Board> boards_;
 };
 
-// Composites the target boards into a photo's linear signal where the pixel centre misses the sample:
-// 4 x 4 rays per pixel, the boards' fraction of them averaged (sharp, anti-aliased marker edges).
-void CompositeTargets(const Session& session, size_t photo_index, const TargetScene& scene,
-                      const AnalyticSample& sample, const std::vector<uint8_t>& sample_mask, Image* signal) {
-  const Camera& camera = session.camera;
-  const Rigid3d world_from_camera = session.photos[photo_index].camera_from_world->Inverse();
+// Composites the target boards into a photo's linear signal where the pixel is not in `skip_mask`
+// (the sample's pixel centres; empty: none): 4 x 4 rays per pixel, the boards' fraction of them
+// averaged (sharp, anti-aliased marker edges). A ray that `in_front` hits before the board sees nothing
+// of it (the sample, or the white reference's card).
+void CompositeTargets(const Camera& camera, const Rigid3d& camera_from_world, const TargetScene& scene,
+                      const TargetOccluder& in_front, const std::vector<uint8_t>& skip_mask, Image* signal) {
+  const Rigid3d world_from_camera = camera_from_world.Inverse();
   const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
   const Eigen::Vector3d center = world_from_camera.translation;
   // The boards' value along a ray through an image point; 0 where it shows nothing (or the sample
@@ -390,8 +392,7 @@ void CompositeTargets(const Session& session, size_t photo_index, const TargetSc
     double t;
     const double value = scene.Trace(center, direction, &t);
     if (!(value > 0.0)) return 0.0;
-    SurfaceHit hit;
-    if (sample.Intersect(center, direction, &hit) && hit.t < t) return 0.0;
+    if (in_front && in_front(center, direction, t)) return 0.0;
     return value;
   };
   // Values at the pixel corners; a pixel whose four corners agree is uniform (one value), the others
@@ -404,7 +405,7 @@ void CompositeTargets(const Session& session, size_t photo_index, const TargetSc
   constexpr int kRays = 4;
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
-      if (sample_mask[size_t(y) * w + x]) continue;
+      if (!skip_mask.empty() && skip_mask[size_t(y) * w + x]) continue;
       const double c00 = corners[size_t(y) * (w + 1) + x], c10 = corners[size_t(y) * (w + 1) + x + 1];
       const double c01 = corners[size_t(y + 1) * (w + 1) + x], c11 = corners[size_t(y + 1) * (w + 1) + x + 1];
       double value = c00;
@@ -725,7 +726,14 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
 
     // Radiance to linear signal, then the platform (its values are already signal).
     for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
-    if (target_scene) CompositeTargets(session, i, *target_scene, *truth, mask, &image);
+    if (target_scene) {
+      const TargetOccluder sample_in_front = [&truth](const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                                      double t) {
+        SurfaceHit hit;
+        return truth->Intersect(origin, direction, &hit) && hit.t < t;
+      };
+      CompositeTargets(session.camera, *photo.camera_from_world, *target_scene, sample_in_front, mask, &image);
+    }
     ApplyVignetting(session.camera, effects.vignetting, &image);
     // The sensor (synthetic_radiometry.h): one random stream per (seed, photo, row).
     saturated += SimulateSensor(effects, options.seed, i, &image);
@@ -738,7 +746,12 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   }
   progress.Finish();
 
-  WriteSynthCalibration(options, directory.temporary_path(), &session);  // radiometry hook: flat field, white reference
+  // Radiometry hook: flat field, white reference (with the platform behind its card).
+  const TargetCompositor composite_targets = [&](const Rigid3d& camera_from_world, const TargetOccluder& card,
+                                                 Image* signal) {
+    if (target_scene) CompositeTargets(session.camera, camera_from_world, *target_scene, card, {}, signal);
+  };
+  WriteSynthCalibration(options, directory.temporary_path(), &session, composite_targets);
   // Irregular shapes: the range scan, the truth mesh, and the mesh sample's scan inputs and targets
   // (the sample's file, scan/mesh.ply, is the scan stage's output from those inputs).
   const nlohmann::json shape_truth = options.scene.shape != SynthShape::kNone

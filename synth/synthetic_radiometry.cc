@@ -4,15 +4,18 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <random>
 
 #include <tbb/parallel_for.h>
 
+#include "align/markers.h"
 #include "core/error.h"
 #include "core/light.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
 #include "synth/synthetic_exif.h"
+#include "synth/synthetic_targets.h"
 
 namespace fs = std::filesystem;
 
@@ -139,9 +142,125 @@ Image RenderWhiteReference(const Session& session, const Light& light, const Rig
   return image;
 }
 
+// The white reference's marker card (SynthTargetOptions::white_card): its pose and what it looks like.
+class WhiteCard {
+ public:
+  static constexpr double kPaper = 0.8;  // the printed card's albedo
+  static constexpr double kInk = 0.03;   // the markers' black
+
+  WhiteCard(const SynthOptions& options, const WhiteReferenceSpec& white, const Eigen::Vector3d& x_axis)
+      : white_(white), x_axis_(x_axis), y_axis_(white.normal.cross(x_axis)) {
+    const MarkerDictionary dictionary(options.targets.dictionary, "synth --target-dictionary");
+    modules_count_ = dictionary.modules();
+    markers_ = SynthWhiteCardLayout(options).markers;
+    for (const TargetSpec& marker : markers_) modules_.push_back(dictionary.Modules(marker.id));
+    half_side_ = 0.5 * white.size + options.targets.white_marker_size * (1.0 + 2.0 * options.targets.card_margin);
+  }
+
+  double half_side() const { return half_side_; }
+  const Eigen::Vector3d& y_axis() const { return y_axis_; }
+
+  // The card's albedo where the ray meets it (the hit point in `point`, its distance in `t`); < 0 where
+  // it misses the card. The patch's albedo is channel 0's (a grey reference).
+  double Trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Eigen::Vector3d* point,
+               double* t) const {
+    const double denominator = direction.dot(white_.normal);
+    if (!(denominator < 0.0)) return -1.0;
+    *t = (white_.center - origin).dot(white_.normal) / denominator;
+    if (!(*t > 0.0)) return -1.0;
+    *point = origin + *t * direction;
+    const Eigen::Vector3d offset = *point - white_.center;
+    const double x = offset.dot(x_axis_), y = offset.dot(y_axis_);
+    if (std::abs(x) > half_side_ || std::abs(y) > half_side_) return -1.0;
+    if (std::abs(x) <= 0.5 * white_.size && std::abs(y) <= 0.5 * white_.size) return white_.reflectance[0];
+    const Eigen::Vector3d p(x, y, 0.0);
+    for (size_t m = 0; m < markers_.size(); ++m) {
+      const std::array<Eigen::Vector3d, 4>& c = markers_[m].corners;
+      const Eigen::Vector3d u_axis = c[1] - c[0], v_axis = c[3] - c[0];
+      const double u = (p - c[0]).dot(u_axis) / u_axis.squaredNorm(), v = (p - c[0]).dot(v_axis) / v_axis.squaredNorm();
+      if (u < 0.0 || u >= 1.0 || v < 0.0 || v >= 1.0) continue;
+      const int n = modules_count_;
+      const int col = std::min(n - 1, int(u * n)), row = std::min(n - 1, int(v * n));
+      return modules_[m][size_t(row) * n + col] ? kPaper : kInk;
+    }
+    return kPaper;
+  }
+
+ private:
+  const WhiteReferenceSpec& white_;
+  Eigen::Vector3d x_axis_, y_axis_;
+  int modules_count_ = 0;
+  double half_side_ = 0.0;
+  std::vector<TargetSpec> markers_;  // card frame
+  std::vector<std::vector<bool>> modules_;
+};
+
+// The card's radiance image under `light` (albedo / pi x irradiance; 0 off the card): a pixel whose
+// four corners see the same albedo takes its centre's radiance, the others (edges) the mean of
+// max(4, supersample)^2 rays (anti-aliased marker edges, as the platform's). `mask` gets 1 where the
+// pixel centre sees the patch.
+Image RenderWhiteCard(const Session& session, const Light& light, const Rigid3d& camera_from_world,
+                      const WhiteCard& card, int supersample, std::vector<uint8_t>* mask) {
+  const Camera& camera = session.camera;
+  const Rigid3d world_from_camera = camera_from_world.Inverse();
+  const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
+  const Eigen::Vector3d center = world_from_camera.translation;
+  const double patch_albedo = session.calibration->white_reference->reflectance[0];
+  auto ray = [&](const Eigen::Vector2d& pixel) {
+    const Eigen::Vector2d xy = camera.CamPlaneFromImage(pixel);
+    return Eigen::Vector3d((rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized());
+  };
+  // Radiance of one ray: albedo / pi x the irradiance at its hit (the patch's per-channel albedo).
+  auto radiance_along = [&](const Eigen::Vector3d& direction, double* albedo) {
+    Eigen::Vector3d point;
+    double t;
+    *albedo = card.Trace(center, direction, &point, &t);
+    if (*albedo < 0.0) return Eigen::Vector3d(Eigen::Vector3d::Zero());
+    const Incidence incidence = IncidenceAt(light, point, session.calibration->white_reference->normal);
+    if (!incidence.lit) return Eigen::Vector3d(Eigen::Vector3d::Zero());
+    const Eigen::Vector3d rho = *albedo == patch_albedo ? session.calibration->white_reference->reflectance
+                                                        : Eigen::Vector3d::Constant(*albedo);
+    return Eigen::Vector3d(rho.cwiseProduct(incidence.irradiance) / M_PI);
+  };
+  const int w = camera.width, h = camera.height;
+  std::vector<double> corners(size_t(w + 1) * (h + 1));
+  tbb::parallel_for(0, h + 1, [&](int y) {
+    for (int x = 0; x <= w; ++x) {
+      Eigen::Vector3d point;
+      double t;
+      corners[size_t(y) * (w + 1) + x] = card.Trace(center, ray(Eigen::Vector2d(x, y)), &point, &t);
+    }
+  });
+  Image image(w, h, 3);
+  mask->assign(size_t(w) * h, 0);
+  const int rays = std::max(4, supersample);
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const double c00 = corners[size_t(y) * (w + 1) + x], c10 = corners[size_t(y) * (w + 1) + x + 1];
+      const double c01 = corners[size_t(y + 1) * (w + 1) + x], c11 = corners[size_t(y + 1) * (w + 1) + x + 1];
+      double albedo;
+      Eigen::Vector3d radiance = radiance_along(ray(Eigen::Vector2d(x + 0.5, y + 0.5)), &albedo);
+      if (albedo == patch_albedo) (*mask)[size_t(y) * w + x] = 1;
+      if (c00 != c10 || c00 != c01 || c00 != c11 || (supersample > 1 && albedo >= 0.0)) {
+        radiance.setZero();
+        for (int sy = 0; sy < rays; ++sy) {
+          for (int sx = 0; sx < rays; ++sx) {
+            double a;
+            radiance += radiance_along(ray(Eigen::Vector2d(x + (sx + 0.5) / rays, y + (sy + 0.5) / rays)), &a);
+          }
+        }
+        radiance /= double(rays * rays);
+      }
+      for (int c = 0; c < 3; ++c) image.at(x, y, c) = static_cast<float>(radiance[c]);
+    }
+  });
+  return image;
+}
+
 }  // namespace
 
-void WriteSynthCalibration(const SynthOptions& options, const std::string& directory, Session* session) {
+void WriteSynthCalibration(const SynthOptions& options, const std::string& directory, Session* session,
+                           const TargetCompositor& composite_targets) {
   const CameraEffects& effects = options.effects;
   const SynthRadiometryOptions& radiometry = options.radiometry;
   if (effects.vignetting > 0.0) {
@@ -182,15 +301,31 @@ void WriteSynthCalibration(const SynthOptions& options, const std::string& direc
                                                      : light.direction.normalized();
     }
     white.normal = (to_lights.normalized() + (camera_center - white.center).normalized()).normalized();
+    // The marker card stands on a post where the sample was, its x axis level, raised so that its
+    // lower edge clears the platform by 5 mm.
+    const Eigen::Vector3d card_x = Eigen::Vector3d::UnitZ().cross(white.normal).normalized();
+    std::unique_ptr<WhiteCard> card;
+    if (options.targets.white_card) {
+      card = std::make_unique<WhiteCard>(options, white, card_x);
+      const double lowest = PlatformHeight(options.scene) + card->half_side() * std::abs(card->y_axis().z()) + 0.005;
+      white.center.z() = std::max(white.center.z(), lowest);
+    }
     const PixelFormat format = effects.bits == 0   ? PixelFormat::kFloat
                                : effects.bits <= 8 ? PixelFormat::kUint8
                                                    : PixelFormat::kUint16;
     fs::create_directories(fs::path(directory) / "calibration");
+    CalibrationSpec calibration;
+    calibration.white_reference = white;
+    session->calibration = calibration;
+    WhiteReferenceSpec& stated = *session->calibration->white_reference;  // the card reads the pose from here
+    if (card) card = std::make_unique<WhiteCard>(options, stated, card_x);
     // One photo of the target under each light, exposed for it.
     for (size_t k = 0; k < session->lights.size(); ++k) {
       std::vector<uint8_t> mask;
-      Image image = RenderWhiteReference(*session, session->lights[k], *first->camera_from_world, white,
-                                         effects.supersample, &mask);
+      Image image = card ? RenderWhiteCard(*session, session->lights[k], *first->camera_from_world, *card,
+                                           effects.supersample, &mask)
+                         : RenderWhiteReference(*session, session->lights[k], *first->camera_from_world, white,
+                                                effects.supersample, &mask);
       std::vector<float> levels;
       for (size_t p = 0; p < mask.size(); ++p) {
         if (mask[p])
@@ -208,15 +343,22 @@ void WriteSynthCalibration(const SynthOptions& options, const std::string& direc
       photo.gain = 1.0;
       photo.light = k;
       for (float& v : image.pixels) v = static_cast<float>(v * photo.exposure_s * photo.gain);
+      if (card && composite_targets) {
+        // The platform behind the card (its ambient-lit markers pose the photo).
+        const TargetOccluder card_in_front = [&card](const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                                     double t) {
+          Eigen::Vector3d point;
+          double t_card;
+          return card->Trace(origin, direction, &point, &t_card) >= 0.0 && t_card < t;
+        };
+        composite_targets(*photo.camera_from_world, card_in_front, &image);
+      }
       ApplyVignetting(session->camera, effects.vignetting, &image);
       SimulateSensor(effects, options.seed, 0xFFFFull + k, &image);
       const PhotoMetadata exif = SyntheticPhotoMetadata(*session, photo, session->photos.size());
       WriteImage((fs::path(directory) / photo.file).string(), image, format, &exif);
-      white.photos.push_back(photo);
+      stated.photos.push_back(photo);
     }
-    CalibrationSpec calibration;
-    calibration.white_reference = white;
-    session->calibration = calibration;
     for (Light& light : session->lights) light.has_intensity = false;  // the white reference measures it
   }
 }

@@ -6,12 +6,14 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include <Eigen/Core>
 
 #include "core/camera.h"
 #include "core/image_io.h"
+#include "core/rigid3.h"
 #include "core/session.h"
 #include "synth/synth_options.h"
 
@@ -37,9 +39,20 @@ uint64_t SimulateSensor(const CameraEffects& effects, uint64_t seed, uint64_t st
 // (1, 2^-step, ...) that the auto-exposure multiplies. Nothing for 1 bracket.
 void ExpandBrackets(const SynthOptions& options, Session* session);
 
+// Whether a ray (origin, unit direction) hits something nearer than `t` (metres along it).
+using TargetOccluder =
+    std::function<bool(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double t)>;
+// Adds the session's coded targets (the platform) to a linear signal image taken from
+// `camera_from_world`, where `in_front` does not hide them.
+using TargetCompositor =
+    std::function<void(const Rigid3d& camera_from_world, const TargetOccluder& in_front, Image* signal)>;
+
 // Hook before the session is saved, in the folder being written (`directory`): writes the flat-field
 // image (flat_field.exr, when vignetting is on) and the white-reference photo (light_unknown), adds
-// them to the session, and replaces the light's intensity by (1, 1, 1) when it is to be unknown.
-void WriteSynthCalibration(const SynthOptions& options, const std::string& directory, Session* session);
+// them to the session, and replaces the light's intensity by (1, 1, 1) when it is to be unknown. With
+// targets.white_card the white reference is the marker card, raised to clear the platform, and
+// `composite_targets` (may be empty) adds the platform behind it to each white-reference photo.
+void WriteSynthCalibration(const SynthOptions& options, const std::string& directory, Session* session,
+                           const TargetCompositor& composite_targets = TargetCompositor());
 
 }  // namespace ibrdf

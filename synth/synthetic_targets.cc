@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "align/targets.h"
 #include "synth/synthetic.h"
 
 namespace ibrdf {
@@ -95,6 +96,13 @@ SampleTargetsSpec SampleTargetLayout(const SynthOptions& options, std::vector<Ta
     }
   }
   return spec;
+}
+
+WhiteReferenceTargetsSpec SynthWhiteCardLayout(const SynthOptions& options) {
+  const SynthTargetOptions& targets = options.targets;
+  if (!targets.white_card) return WhiteReferenceTargetsSpec();
+  return WhiteCardLayout(targets.white_marker_first_id, targets.white_marker_size, options.radiometry.white_size,
+                         targets.card_margin, 0.0);
 }
 
 }  // namespace ibrdf

@@ -29,4 +29,9 @@ LightTargetsSpec LightTargetLayout(const SynthOptions& options, std::vector<Targ
 // their corners in the world frame.
 SampleTargetsSpec SampleTargetLayout(const SynthOptions& options, std::vector<TargetSpec>* world_corners);
 
+// The white reference's card markers of a synthetic session (targets.white_card): align/targets.h's
+// WhiteCardLayout for the patch (radiometry.white_size), the card's markers and card_margin, the patch
+// flush with the card. Empty unless white_card.
+WhiteReferenceTargetsSpec SynthWhiteCardLayout(const SynthOptions& options);
+
 }  // namespace ibrdf

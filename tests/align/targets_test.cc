@@ -87,6 +87,53 @@ TEST(Targets, LightCardMatchesItsBlock) {
   }
 }
 
+// The white reference's card (issue 13, part 5): its 4 markers detected with the block's ids, their
+// corners where targets.json's white_reference block puts them in the card's frame (origin at the
+// patch's centre, x right, y up), within 0.1 mm.
+TEST(Targets, WhiteCardMatchesItsBlock) {
+  ScratchDir dir;
+  TargetSheetsOptions options;
+  options.dpi = 200.0;
+  options.charuco = false;
+  const TargetSheetsResult result = WriteTargetSheets(options, dir / "t");
+  ASSERT_TRUE(result.targets.white_reference);
+  const nlohmann::json block = ReadJsonFile(dir / "t/targets.json")["targets"]["white_reference"]["markers"];
+  ASSERT_EQ(block.size(), 4u);
+  const Image card = ReadImage(dir / "t/white-card.png");
+  const double mm_per_px = 25.4 / options.dpi;
+  // targets.cc: the card's centre at (width / 2, 10 mm + card / 2) on the sheet.
+  const double side = 1e3 * (options.white_patch_size +
+                             2.0 * options.white_marker_size * (1.0 + 2.0 * options.card_margin));
+  const double cx = 0.5 * card.width * mm_per_px, cy = 10.0 + 0.5 * side;
+  const std::vector<MarkerDetection> detections = DetectMarkers(card, MarkerDictionary(options.dictionary));
+  ASSERT_EQ(detections.size(), 4u);
+  for (const MarkerDetection& d : detections) {
+    const int k = d.id - options.white_marker_first_id;
+    ASSERT_GE(k, 0);
+    ASSERT_LT(k, 4);
+    ASSERT_EQ(block[k]["id"].get<int>(), d.id);
+    for (int c = 0; c < 4; ++c) {
+      const double x_mm = d.corners[c].x() * mm_per_px - cx, y_mm = cy - d.corners[c].y() * mm_per_px;
+      EXPECT_NEAR(x_mm, 1e3 * block[k]["corners"][c][0].get<double>(), 0.1) << "marker " << d.id << " corner " << c;
+      EXPECT_NEAR(y_mm, 1e3 * block[k]["corners"][c][1].get<double>(), 0.1) << "marker " << d.id << " corner " << c;
+      EXPECT_EQ(block[k]["corners"][c][2].get<double>(), 0.0);
+    }
+  }
+  // The patch stays clear: no marker reaches into it.
+  for (const TargetSpec& marker : result.targets.white_reference->markers) {
+    for (const Eigen::Vector3d& corner : marker.corners) {
+      EXPECT_GT(std::max(std::abs(corner.x()), std::abs(corner.y())), 0.5 * options.white_patch_size);
+    }
+  }
+  // A thicker patch puts the markers behind its plane; ids colliding with the light's are refused.
+  options.white_patch_thickness = 0.012;
+  EXPECT_NEAR(TargetLayout(options).white_reference->markers[0].corners[0].z(), -0.012, 1e-15);
+  options.white_marker_first_id = 19;  // 19..22 overlaps the light's 20, 21
+  std::string why;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("white_marker_first_id"), std::string::npos) << why;
+}
+
 TEST(Targets, IdsBeyondTheDictionaryAreAnError) {
   ScratchDir dir;
   TargetSheetsOptions options;
