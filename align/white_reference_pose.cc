@@ -175,9 +175,9 @@ WhiteReferencePose PoseWhiteReference(const Session& session, const std::map<int
     RefineMarkerCorners(image, camera, &detections);
     std::map<int, int> seen;
     for (const MarkerDetection& d : detections) ++seen[d.id];
-    detections.erase(std::remove_if(detections.begin(), detections.end(),
-                                    [&](const MarkerDetection& d) { return seen[d.id] > 1; }),
-                     detections.end());
+    detections.erase(
+        std::remove_if(detections.begin(), detections.end(), [&](const MarkerDetection& d) { return seen[d.id] > 1; }),
+        detections.end());
     BundleImage world_image = ImageOf(detections, platform, &pose.platform_markers);
     BundleImage card_image = ImageOf(detections, card, &pose.card_markers);
     char buffer[200];
@@ -211,8 +211,7 @@ WhiteReferencePose PoseWhiteReference(const Session& session, const std::map<int
     Rigid3d alternative;
     pose.card_alternative_rms_px = AlternativePoseRms(camera, card_image, card, options.huber_px, &alternative);
     if (pose.card_alternative_rms_px >= 0.0 &&
-        pose.card_alternative_rms_px <
-            options.ambiguity_ratio * std::max(pose.card_rms_px, options.corner_sigma_px)) {
+        pose.card_alternative_rms_px < options.ambiguity_ratio * std::max(pose.card_rms_px, options.corner_sigma_px)) {
       std::snprintf(buffer, sizeof(buffer),
                     "ambiguous card pose: a second pose, %.1f deg away, explains its corners with RMS %.3f px (own "
                     "%.3f px); photograph the card less head-on or closer",
@@ -277,9 +276,8 @@ WhiteReferencePose PoseWhiteReference(const Session& session, const std::map<int
   result.center_covariance /= double(used) * used;
   result.normal_covariance /= double(used) * used;
   result.normal_sigma_deg =
-      std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(result.normal_covariance)
-                                  .eigenvalues()
-                                  .maxCoeff())) *
+      std::sqrt(std::max(
+          0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(result.normal_covariance).eigenvalues().maxCoeff())) *
       180.0 / M_PI;
 
   // The intensity's sensitivity: I ~ 1 / E(centre, normal) for a unit light; numerical gradient.
@@ -296,12 +294,12 @@ WhiteReferencePose PoseWhiteReference(const Session& session, const std::map<int
     Eigen::Vector3d center_gradient, normal_gradient;
     for (int j = 0; j < 3; ++j) {
       const Eigen::Vector3d step = 1e-6 * Eigen::Vector3d::Unit(j);
-      center_gradient[j] = (log_irradiance(result.center + step, result.normal) -
-                            log_irradiance(result.center - step, result.normal)) /
-                           2e-6;
-      normal_gradient[j] = (log_irradiance(result.center, result.normal + step) -
-                            log_irradiance(result.center, result.normal - step)) /
-                           2e-6;
+      center_gradient[j] =
+          (log_irradiance(result.center + step, result.normal) - log_irradiance(result.center - step, result.normal)) /
+          2e-6;
+      normal_gradient[j] =
+          (log_irradiance(result.center, result.normal + step) - log_irradiance(result.center, result.normal - step)) /
+          2e-6;
     }
     const double variance = center_gradient.dot(result.center_covariance * center_gradient) +
                             normal_gradient.dot(result.normal_covariance * normal_gradient);

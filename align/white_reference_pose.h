@@ -37,9 +37,9 @@ struct WhiteReferencePoseOptions {
 struct WhiteReferencePhotoPose {
   size_t photo = 0;  // index into calibration.white_reference.photos
   bool used = false;
-  std::string dropped_reason;   // empty when used
-  int platform_markers = 0;     // posed platform markers detected
-  int card_markers = 0;         // card markers detected
+  std::string dropped_reason;  // empty when used
+  int platform_markers = 0;    // posed platform markers detected
+  int card_markers = 0;        // card markers detected
   double platform_rms_px = 0.0;
   double card_rms_px = 0.0;
   double card_alternative_rms_px = -1.0;  // the card's planar second pose; < 0: none
@@ -52,7 +52,7 @@ struct WhiteReferencePhotoPose {
 struct WhiteReferencePose {
   bool posed = false;
   std::vector<WhiteReferencePhotoPose> photos;
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // the patch's centre, world frame, metres
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();   // the patch's centre, world frame, metres
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // its front face's unit normal, world frame
   // Predicted covariance of the centre (3 x 3, m^2, world axes), and of the normal (3 x 3, in the
   // world; rank 2), from the corners' geometry (sigma^2 (J^T J)^-1 of both poses per photo,

@@ -89,9 +89,10 @@ TEST_F(WhiteCard, SynthUsesThePrintedLayout) {
   for (size_t m = 0; m < printed.white_reference->markers.size(); ++m) {
     EXPECT_EQ(printed.white_reference->markers[m].id, truth_->targets->white_reference->markers[m].id);
     for (int k = 0; k < 4; ++k) {
-      EXPECT_LT((printed.white_reference->markers[m].corners[k] - truth_->targets->white_reference->markers[m].corners[k])
-                    .norm(),
-                1e-12);
+      EXPECT_LT(
+          (printed.white_reference->markers[m].corners[k] - truth_->targets->white_reference->markers[m].corners[k])
+              .norm(),
+          1e-12);
     }
   }
 }
@@ -129,8 +130,8 @@ TEST_F(WhiteCard, AlignPosesTheCardAndTheLightIsWithinHalfAPercent) {
   const double normal_error_deg = std::acos(std::min(1.0, white.normal.dot(truth.normal))) * 180.0 / M_PI;
   RecordProperty("center_error_mm", std::to_string(1e3 * center_error));
   RecordProperty("normal_error_deg", std::to_string(normal_error_deg));
-  std::cout << aligned.white_reference.BriefReport() << "\ncentre error " << 1e3 * center_error
-            << " mm, normal error " << normal_error_deg << " deg\n";
+  std::cout << aligned.white_reference.BriefReport() << "\ncentre error " << 1e3 * center_error << " mm, normal error "
+            << normal_error_deg << " deg\n";
   EXPECT_LT(center_error, 1e-3);
   EXPECT_LT(normal_error_deg, 0.2);
   // The predicted uncertainty is finite, positive and not wildly off the actual error.
