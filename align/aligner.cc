@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/json_reader.h"
+#include "core/light.h"
 #include "core/linear_image.h"
 #include "core/logging.h"
 
@@ -381,6 +382,16 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
       }
       posed.push_back(white.photos[photo.photo]);
       posed.back().camera_from_world = photo.camera_from_world;
+    }
+    // A light that only the left-out photos measured would lose its intensity: refuse, with the reason.
+    for (const WhiteReferencePhotoPose& photo : result.white_reference.photos) {
+      const size_t light = white.photos[photo.photo].light;
+      const bool measured = std::any_of(posed.begin(), posed.end(), [&](const PhotoSpec& p) { return p.light == light; });
+      if (!photo.used && !measured && !session.lights[light].has_intensity) {
+        ThrowError(session.manifest_path + ": /calibration/white_reference/photos/" + std::to_string(photo.photo),
+                   white.photos[photo.photo].file + " cannot be posed (" + photo.dropped_reason + ") and no other " +
+                       "white-reference photo measures " + LightLabel(session.lights[light]) + "'s intensity");
+      }
     }
     white.photos = posed;
     Log(1, result.white_reference.BriefReport());

@@ -155,6 +155,44 @@ TEST(SessionInit, ListsWhatIsMissingThenValidates) {
   EXPECT_THROW(InitSession(options, dir / "out"), Error);
 }
 
+// White-reference photos (issue 13, part 5): with the white card's markers in the targets nothing of
+// its pose is drafted or missing (`ibrdf align` poses it), the light needs no intensity; without them
+// its centre and normal are listed as missing, and so is its size when not given.
+TEST(SessionInit, WhiteReferencePhotosNeedNoPoseWithTheCardsMarkers) {
+  ScratchDir dir;
+  SessionInitOptions options;
+  options.photos = {Photo(dir, "a.png", 0.02, 100, 0), Photo(dir, "b.png", 0.025, 100, 20)};
+  options.white_photos = {Photo(dir, "white.png", 0.004, 100, 60)};
+  options.targets_file = TargetsFile(dir);
+  options.sample_radius = 0.02;
+  const SessionInitResult draft = InitSession(options, dir / "out");
+  EXPECT_FALSE(draft.complete);
+  std::string missing;
+  for (const std::string& line : draft.missing) missing += line + "\n";
+  EXPECT_NE(missing.find("--white-size"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("centre and normal"), std::string::npos) << missing;
+  EXPECT_EQ(missing.find("--light-intensity"), std::string::npos) << missing;
+
+  nlohmann::json targets = ReadJsonFile(options.targets_file);
+  targets["targets"]["white_reference"] = {
+      {"markers", {{{"id", 40}, {"corners", {{-0.05, 0.05, 0}, {-0.03, 0.05, 0}, {-0.03, 0.03, 0}, {-0.05, 0.03, 0}}}}}}}};
+  WriteJsonFile(options.targets_file, targets);
+  options.white_size = 0.05;
+  options.overwrite = true;
+  const SessionInitResult done = InitSession(options, dir / "out");
+  ASSERT_TRUE(done.complete) << (done.missing.empty() ? "" : done.missing.front());
+  const Session session = Session::Load(done.path);
+  ASSERT_EQ(session.photos.size(), 2u);  // the white photo is no measurement photo
+  ASSERT_TRUE(session.calibration && session.calibration->white_reference);
+  const WhiteReferenceSpec& white = *session.calibration->white_reference;
+  EXPECT_FALSE(white.posed);
+  ASSERT_EQ(white.photos.size(), 1u);
+  EXPECT_NEAR(white.photos[0].exposure_s, 0.004, 1e-7);
+  EXPECT_EQ(white.size, 0.05);
+  EXPECT_EQ(white.reflectance, Eigen::Vector3d::Constant(0.99));
+  EXPECT_FALSE(session.lights[0].has_intensity);
+}
+
 TEST(SessionInit, PhotoWithoutExposureIsAnErrorNamingIt) {
   ScratchDir dir;
   Image image(40, 30, 3);
