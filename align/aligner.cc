@@ -386,7 +386,8 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
     // A light that only the left-out photos measured would lose its intensity: refuse, with the reason.
     for (const WhiteReferencePhotoPose& photo : result.white_reference.photos) {
       const size_t light = white.photos[photo.photo].light;
-      const bool measured = std::any_of(posed.begin(), posed.end(), [&](const PhotoSpec& p) { return p.light == light; });
+      const bool measured =
+          std::any_of(posed.begin(), posed.end(), [&](const PhotoSpec& p) { return p.light == light; });
       if (!photo.used && !measured && !session.lights[light].has_intensity) {
         ThrowError(session.manifest_path + ": /calibration/white_reference/photos/" + std::to_string(photo.photo),
                    white.photos[photo.photo].file + " cannot be posed (" + photo.dropped_reason + ") and no other " +

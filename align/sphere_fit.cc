@@ -97,8 +97,8 @@ bool PixelPairEdge(const Image& image, const Eigen::Vector2d& center_px, const E
                    double edge_px, bool lit, Eigen::Vector2d* point) {
   const Eigen::Vector2d p = center_px + edge_px * direction;
   const Eigen::Vector2d inner = p - 1.5 * direction, outer = p + 2.0 * direction;
-  const double level = 0.5 * (BilinearLuminance(image, inner.x(), inner.y()) +
-                              BilinearLuminance(image, outer.x(), outer.y()));
+  const double level =
+      0.5 * (BilinearLuminance(image, inner.x(), inner.y()) + BilinearLuminance(image, outer.x(), outer.y()));
   if (!std::isfinite(level)) return false;
   auto sphere = [&](int x, int y) {
     const double v = BilinearLuminance(image, x + 0.5, y + 0.5);

@@ -49,9 +49,9 @@ struct TargetSheetsOptions {
   // printed card (a tile's thickness; the markers' corners then lie that far behind the patch's plane).
   bool white_card = true;
   int white_marker_first_id = 40;
-  double white_marker_size = 0.02;       // metres
-  double white_patch_size = 0.05;        // metres, the patch's side
-  double white_patch_thickness = 0.0;    // metres
+  double white_marker_size = 0.02;     // metres
+  double white_patch_size = 0.05;      // metres, the patch's side
+  double white_patch_thickness = 0.0;  // metres
   bool charuco = true;              // the calibration board sheet
   CharucoBoardSpec board;           // its layout (align/intrinsic_calibration.h)
   double dpi = 600.0;               // the PNGs' resolution, dots per inch

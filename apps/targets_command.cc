@@ -60,8 +60,9 @@ void AddTargetsCommand(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--white-patch-mm", args->white_patch_mm, "Side of the white patch the card frames")
       ->capture_default_str();
-  command->add_option("--white-patch-thickness-mm", args->white_thickness_mm,
-                      "How far the patch's surface stands in front of the card (a tile's thickness)")
+  command
+      ->add_option("--white-patch-thickness-mm", args->white_thickness_mm,
+                   "How far the patch's surface stands in front of the card (a tile's thickness)")
       ->capture_default_str();
   command->add_flag("--no-charuco", args->no_charuco, "No calibration board sheet");
   command->add_option("--board-squares-x", o.board.squares_x, "ChArUco squares across")->capture_default_str();

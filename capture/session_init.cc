@@ -176,7 +176,9 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
   SessionInitResult result;
   // Every photo's metadata.
   for (int pass = 0; pass < 3; ++pass) {
-    for (const std::string& file : pass == 0 ? options.photos : pass == 1 ? options.target_photos : options.white_photos) {
+    for (const std::string& file : pass == 0   ? options.photos
+                                   : pass == 1 ? options.target_photos
+                                               : options.white_photos) {
       InitPhoto photo;
       photo.file = file;
       photo.metadata = ReadPhotoMetadata(file);

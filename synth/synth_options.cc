@@ -193,8 +193,8 @@ bool SynthOptions::Check(std::string* why) const {
     IBRDF_CHECK_OPTION(radiometry.light_unknown);
     IBRDF_CHECK_OPTION_GT(targets.white_marker_size, 0.0);
     IBRDF_CHECK_OPTION_GE(targets.white_marker_first_id, targets.ring_count);
-    IBRDF_CHECK_OPTION(targets.light_photos == 0 || targets.white_marker_first_id >= targets.light_marker_first_id +
-                                                                                         targets.light_marker_count ||
+    IBRDF_CHECK_OPTION(targets.light_photos == 0 ||
+                       targets.white_marker_first_id >= targets.light_marker_first_id + targets.light_marker_count ||
                        targets.white_marker_first_id + 4 <= targets.light_marker_first_id);
   }
   return true;

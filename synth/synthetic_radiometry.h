@@ -40,8 +40,7 @@ uint64_t SimulateSensor(const CameraEffects& effects, uint64_t seed, uint64_t st
 void ExpandBrackets(const SynthOptions& options, Session* session);
 
 // Whether a ray (origin, unit direction) hits something nearer than `t` (metres along it).
-using TargetOccluder =
-    std::function<bool(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double t)>;
+using TargetOccluder = std::function<bool(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double t)>;
 // Adds the session's coded targets (the platform) to a linear signal image taken from
 // `camera_from_world`, where `in_front` does not hide them.
 using TargetCompositor =

@@ -102,8 +102,8 @@ TEST(Targets, WhiteCardMatchesItsBlock) {
   const Image card = ReadImage(dir / "t/white-card.png");
   const double mm_per_px = 25.4 / options.dpi;
   // targets.cc: the card's centre at (width / 2, 10 mm + card / 2) on the sheet.
-  const double side = 1e3 * (options.white_patch_size +
-                             2.0 * options.white_marker_size * (1.0 + 2.0 * options.card_margin));
+  const double side =
+      1e3 * (options.white_patch_size + 2.0 * options.white_marker_size * (1.0 + 2.0 * options.card_margin));
   const double cx = 0.5 * card.width * mm_per_px, cy = 10.0 + 0.5 * side;
   const std::vector<MarkerDetection> detections = DetectMarkers(card, MarkerDictionary(options.dictionary));
   ASSERT_EQ(detections.size(), 4u);

@@ -29,9 +29,9 @@ TEST(CaptureCli, TargetsMatchTheSyntheticLayout) {
   ScratchDir dir;
   const RunResult targets = RunIbrdf("targets --out " + dir / "targets" + " --dpi 100");
   ASSERT_EQ(targets.exit_code, 0) << targets.output;
-  for (const char* file : {"platform.svg", "platform.png", "light-card.svg", "light-card.png", "white-card.svg",
-                           "white-card.png", "charuco.svg",
-                           "charuco.png", "board.json", "targets.json", "README.txt"}) {
+  for (const char* file :
+       {"platform.svg", "platform.png", "light-card.svg", "light-card.png", "white-card.svg", "white-card.png",
+        "charuco.svg", "charuco.png", "board.json", "targets.json", "README.txt"}) {
     EXPECT_TRUE(fs::is_regular_file(dir / ("targets/" + std::string(file)))) << file;
   }
   // The SVG states its printed size in millimetres; the PNG is that size at the DPI.
