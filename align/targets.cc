@@ -218,8 +218,8 @@ bool TargetSheetsOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GT(white_patch_size, 0.0);
   IBRDF_CHECK_OPTION_GE(white_patch_thickness, 0.0);
   IBRDF_CHECK_OPTION_GE(white_marker_first_id, 0);
-  // The card's ids must not collide with the ring's or the light's.
-  IBRDF_CHECK_OPTION(!white_card || white_marker_first_id >= ring_count);
+  // The card's ids must not collide with the light's (the ring's: WriteTargetSheets, after the
+  // dictionary's range, which a large ring misses first).
   IBRDF_CHECK_OPTION(!white_card || light_marker_count == 0 ||
                      white_marker_first_id >= light_marker_first_id + light_marker_count ||
                      white_marker_first_id + 4 <= light_marker_first_id);
@@ -324,6 +324,12 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
   if (last_id >= dictionary.size()) {
     ThrowError("--dictionary", options.dictionary + " has ids 0 to " + std::to_string(dictionary.size() - 1) +
                                    "; the layout needs id " + std::to_string(last_id));
+  }
+  if (options.white_card && options.white_marker_first_id < options.ring_count) {
+    ThrowError("--white-marker-first-id",
+               "the white card's ids " + std::to_string(options.white_marker_first_id) + " to " +
+                   std::to_string(options.white_marker_first_id + 3) + " collide with the ring's 0 to " +
+                   std::to_string(options.ring_count - 1) + " (pass another first id, or --no-white-card)");
   }
   if (options.charuco) {
     const CharucoBoardSpec& board = options.board;
