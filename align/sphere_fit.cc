@@ -83,49 +83,6 @@ double UnlitLimbEdge(const std::vector<double>& profile, double step) {
   return -1.0;
 }
 
-// The limb from pixel classification near a profile's edge `edge_px` (pixels from `center_px` along the
-// unit `direction`): the photo's pixels in the row (or column, for a mostly vertical direction) through
-// the edge are classified as sphere or background against the mid level between the limb's level
-// 1.5 px inside and the background's 2 px outside; the limb lies between the two adjacent pixel centres
-// where the class changes, and their midpoint is unbiased wherever the edge falls between them (its
-// offset is uniform over the rows a silhouette crosses). A pixel-centre-sampled (aliased) limb and an
-// anti-aliased one (a pixel is sphere when it is more than half covered) give the same point; the
-// profile's own crossing is biased inwards where the shading falls steeply just inside a lit limb
-// (docs/decisions.md). `lit`: the sphere is brighter than the background. False where the class does not
-// change once near the edge.
-bool PixelPairEdge(const Image& image, const Eigen::Vector2d& center_px, const Eigen::Vector2d& direction,
-                   double edge_px, bool lit, Eigen::Vector2d* point) {
-  const Eigen::Vector2d p = center_px + edge_px * direction;
-  const Eigen::Vector2d inner = p - 1.5 * direction, outer = p + 2.0 * direction;
-  const double level =
-      0.5 * (BilinearLuminance(image, inner.x(), inner.y()) + BilinearLuminance(image, outer.x(), outer.y()));
-  if (!std::isfinite(level)) return false;
-  auto sphere = [&](int x, int y) {
-    const double v = BilinearLuminance(image, x + 0.5, y + 0.5);
-    return lit ? v >= level : v <= level;
-  };
-  const bool along_x = std::abs(direction.x()) >= std::abs(direction.y());
-  const int sign = (along_x ? direction.x() : direction.y()) >= 0.0 ? 1 : -1;
-  // The row (column) whose centre line is nearest the edge point, and the pixel holding it.
-  const int line = static_cast<int>(std::floor(along_x ? p.y() : p.x()));
-  const int at = static_cast<int>(std::floor(along_x ? p.x() : p.y()));
-  auto is_sphere = [&](int k) { return along_x ? sphere(k, line) : sphere(line, k); };
-  // The change of class nearest the edge point, inner pixel a, outer pixel a + sign.
-  bool found = false;
-  int best = 0;
-  for (const int a : {at, at - sign, at + sign, at - 2 * sign, at + 2 * sign, at - 3 * sign}) {
-    if (is_sphere(a) && !is_sphere(a + sign)) {
-      found = true;
-      best = a;
-      break;
-    }
-  }
-  if (!found) return false;
-  const double mid = best + 0.5 + 0.5 * sign;  // between the two pixel centres
-  *point = along_x ? Eigen::Vector2d(mid, line + 0.5) : Eigen::Vector2d(line + 0.5, mid);
-  return true;
-}
-
 // The unit vector from the closest point of `ray` to `center`: the derivative of the ray's distance to
 // the centre with respect to the centre (minus the limb's outward normal at the tangent point).
 Eigen::Vector3d TowardsCenter(const TangentRay& ray, const Eigen::Vector3d& center) {
@@ -236,12 +193,10 @@ std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& 
       profile.push_back(BilinearLuminance(image, center_px.x() + s * direction.x(), center_px.y() + s * direction.y()));
     if (std::any_of(profile.begin(), profile.end(), [](double v) { return !std::isfinite(v); })) continue;
     double edge = LitLimbEdge(profile, step);
-    const bool lit = edge >= 0.0;
-    if (!lit) edge = UnlitLimbEdge(profile, step);
+    if (edge < 0.0) edge = UnlitLimbEdge(profile, step);
     if (edge < 0.0) continue;
     edge += s0;
-    Eigen::Vector2d point;
-    if (PixelPairEdge(image, center_px, direction, edge, lit, &point)) points.push_back(point);
+    points.push_back(center_px + edge * direction);
   }
   return points;
 }

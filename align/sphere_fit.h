@@ -85,12 +85,9 @@ struct SphereFit {
 
 // Silhouette edge points of a sphere (centre `center`, radius `radius`, world frame) in one photo:
 // along `lines` radial lines from the sphere's projected centre, within `band_px` of its predicted
-// silhouette, the sharpest drop from a lit limb to the dark background (or rise from a dark limb to a
-// bright background); the point is then the midpoint of the two adjacent pixel centres in the row (or
-// column) through that edge where the pixels change from sphere to background against the mid level of
-// the two (unbiased for pixel-centre-sampled and anti-aliased limbs alike).
-// Edges against anything bright (the platform) or on the unlit side (no contrast) are skipped. Pixels,
-// COLMAP convention.
+// silhouette, the sharpest drop from a lit limb to the dark background, located at sub-pixel precision
+// where the profile crosses the mid level. Edges against anything bright (the platform) or on the unlit
+// side (no contrast) are skipped. Pixels, COLMAP convention.
 std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& camera,
                                               const Rigid3d& camera_from_world, const Eigen::Vector3d& center,
                                               double radius, int lines, double band_px);
