@@ -174,25 +174,24 @@ TEST(SessionInit, WhiteReferencePhotosNeedNoPoseWithTheCardsMarkers) {
   EXPECT_EQ(missing.find("--light-intensity"), std::string::npos) << missing;
 
   nlohmann::json targets = ReadJsonFile(options.targets_file);
-  targets["targets"]["white_reference"] = {
-    {"markers", {{{"id", 40}, {"corners", {{-0.05, 0.05, 0}, {-0.03, 0.05, 0}, {-0.03, 0.03, 0}, {-0.05, 0.03, 0}}}}}}
-  }
-};
-WriteJsonFile(options.targets_file, targets);
-options.white_size = 0.05;
-options.overwrite = true;
-const SessionInitResult done = InitSession(options, dir / "out");
-ASSERT_TRUE(done.complete) << (done.missing.empty() ? "" : done.missing.front());
-const Session session = Session::Load(done.path);
-ASSERT_EQ(session.photos.size(), 2u);  // the white photo is no measurement photo
-ASSERT_TRUE(session.calibration&& session.calibration->white_reference);
-const WhiteReferenceSpec& white = *session.calibration->white_reference;
-EXPECT_FALSE(white.posed);
-ASSERT_EQ(white.photos.size(), 1u);
-EXPECT_NEAR(white.photos[0].exposure_s, 0.004, 1e-7);
-EXPECT_EQ(white.size, 0.05);
-EXPECT_EQ(white.reflectance, Eigen::Vector3d::Constant(0.99));
-EXPECT_FALSE(session.lights[0].has_intensity);
+  const nlohmann::json corners = {{-0.05, 0.05, 0}, {-0.03, 0.05, 0}, {-0.03, 0.03, 0}, {-0.05, 0.03, 0}};
+  nlohmann::json marker = {{"id", 40}, {"corners", corners}};
+  targets["targets"]["white_reference"] = {{"markers", nlohmann::json::array({marker})}};
+  WriteJsonFile(options.targets_file, targets);
+  options.white_size = 0.05;
+  options.overwrite = true;
+  const SessionInitResult done = InitSession(options, dir / "out");
+  ASSERT_TRUE(done.complete) << (done.missing.empty() ? "" : done.missing.front());
+  const Session session = Session::Load(done.path);
+  ASSERT_EQ(session.photos.size(), 2u);  // the white photo is no measurement photo
+  ASSERT_TRUE(session.calibration && session.calibration->white_reference);
+  const WhiteReferenceSpec& white = *session.calibration->white_reference;
+  EXPECT_FALSE(white.posed);
+  ASSERT_EQ(white.photos.size(), 1u);
+  EXPECT_NEAR(white.photos[0].exposure_s, 0.004, 1e-7);
+  EXPECT_EQ(white.size, 0.05);
+  EXPECT_EQ(white.reflectance, Eigen::Vector3d::Constant(0.99));
+  EXPECT_FALSE(session.lights[0].has_intensity);
 }
 
 TEST(SessionInit, PhotoWithoutExposureIsAnErrorNamingIt) {
