@@ -19,6 +19,9 @@ void AddSynthCommand(CLI::App& app) {
     std::string out, material;
     bool overwrite = false;
     SynthRequest request;
+    std::vector<double> camera_matrix;  // 9 values, row-major
+    bool chart_detect = false;
+    std::string colour_space = "linear_srgb";
   };
   auto args = std::make_shared<Args>();
   CLI::App& c = *command;
@@ -77,6 +80,20 @@ void AddSynthCommand(CLI::App& app) {
              "(`ibrdf targets`' white card, ids 40-43, 20 mm), standing where the sample was and seen with the\n"
              "platform, so that `ibrdf align` can pose it (targets.white_reference)");
   add("--exposure-target", o.rig.exposure_target, "Auto-exposure: 99th percentile lands here");
+  c.add_option("--camera-matrix", args->camera_matrix,
+               "The camera's colour: camera RGB = M * linear sRGB in every photo, M as 9 numbers row by row\n"
+               "(the session then states the light's intensity in camera RGB)")
+      ->expected(9);
+  c.add_flag("--colour-chart", o.colour.chart,
+             "Also photograph a ColorChecker Classic (reference linear-sRGB albedos) at the sample's place under\n"
+             "the first light, from the first camera: the session's colour_chart block, for `ibrdf colour`");
+  c.add_flag("--colour-chart-detect", args->chart_detect,
+             "With --colour-chart: leave the corner patches out of the session (`ibrdf colour` must detect the chart)");
+  add("--colour-chart-pitch", o.colour.chart_pitch, "With --colour-chart: patch centre to centre, metres");
+  add("--colour-chart-exposure", o.colour.chart_exposure_scale,
+      "With --colour-chart: the chart photo's exposure relative to its auto-exposure (> 1.25 clips the white)");
+  add("--colour-space", args->colour_space, "With --colour-chart: the colour_chart block's target space")
+      ->check(CLI::IsMember({"linear_srgb", "xyz"}));
   add("--fill-light", o.scene.fill_light,
       "Unmodelled fill light along each normal, as a fraction of the light's irradiance");
   add("--seed", o.seed, "Random seed (output is reproducible)");
@@ -107,6 +124,12 @@ void AddSynthCommand(CLI::App& app) {
     SynthRequest& request = args->request;
     request.camera_elevation_given = elevation->count() > 0;
     request.light_photos_given = light_photos->count() > 0;
+    if (!args->camera_matrix.empty()) {
+      request.options.colour.camera_matrix =
+          Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(args->camera_matrix.data());
+    }
+    request.options.colour.chart_corners = !args->chart_detect;
+    ColourSpaceFromName(args->colour_space, &request.options.colour.space);
     const SynthOptions options = SynthOptionsFromRequest(request);
     StageLog stage("synth");
     RequireWritableOutput(args->out, args->overwrite, {args->material});

@@ -472,6 +472,85 @@ CalibrationSpec ParseCalibration(JsonObject object, const std::string& directory
   return calibration;
 }
 
+// The colour_chart block (docs/session-format.md): the chart, its photos, optional corner patches and
+// the fitted matrix with its per-patch residuals.
+ColourChartSpec ParseColourChart(JsonObject object, const std::string& directory, PhotoContext context) {
+  context.white_reference = true;  // like a white-reference photo: no role, no mask, no pose needed
+  ColourChartSpec chart;
+  chart.chart = object.String("chart", kColorCheckerClassic24);
+  if (chart.chart != kColorCheckerClassic24) {
+    ThrowError(object.Where("chart"), "unknown chart \"" + chart.chart + "\" (expected \"" +
+                                          std::string(kColorCheckerClassic24) + "\")");
+  }
+  const std::string space = object.String("space", ColourSpaceName(ColourSpace::kLinearSrgb));
+  if (!ColourSpaceFromName(space, &chart.space)) {
+    ThrowError(object.Where("space"), "unknown colour space \"" + space + "\" (expected linear_srgb or xyz)");
+  }
+  for (JsonObject& photo : object.Objects("photos")) {
+    chart.photos.push_back(ParsePhoto(photo, directory, context));
+    if (chart.photos.back().light != chart.photos.front().light) {
+      ThrowError(photo.Where("light"), "every photo of the colour chart must be under the same light");
+    }
+  }
+  if (chart.photos.empty()) ThrowError(object.Where("photos"), "expected at least one photo of the colour chart");
+  auto matrix_rows = [&](const std::string& key, size_t rows, size_t columns, const std::string& expected) {
+    const nlohmann::json& value = object.Raw(key);
+    std::vector<std::vector<double>> out;
+    if (!value.is_array() || value.size() != rows) ThrowError(object.Where(key), "expected " + expected);
+    for (size_t r = 0; r < rows; ++r) {
+      const nlohmann::json& row = value[r];
+      if (!row.is_array() || row.size() != columns) ThrowError(object.Where(key), "expected " + expected);
+      out.emplace_back();
+      for (const nlohmann::json& v : row) {
+        if (!v.is_number() || !std::isfinite(v.get<double>())) {
+          ThrowError(object.Where(key) + "/" + std::to_string(r), "expected finite numbers");
+        }
+        out.back().push_back(v.get<double>());
+      }
+    }
+    return out;
+  };
+  if (object.Has("corners")) {
+    const auto rows = matrix_rows("corners", 4, 2,
+                                  "4 pixel positions [[x, y] x 4]: the centres of patches 1, 6, 24 and 19 "
+                                  "(top-left, top-right, bottom-right, bottom-left)");
+    std::array<Eigen::Vector2d, 4> corners;
+    for (int k = 0; k < 4; ++k) corners[k] = Eigen::Vector2d(rows[k][0], rows[k][1]);
+    chart.corners = corners;
+  }
+  if (object.Has("matrix")) {
+    const auto rows = matrix_rows("matrix", 3, 3, "a 3x3 matrix [[a, b, c] x 3], rows of space_from_camera");
+    Eigen::Matrix3d matrix;
+    for (int r = 0; r < 3; ++r) matrix.row(r) << rows[r][0], rows[r][1], rows[r][2];
+    if (!(std::abs(matrix.determinant()) > 1e-12 * std::pow(matrix.cwiseAbs().maxCoeff(), 3))) {
+      ThrowError(object.Where("matrix"), "the matrix is singular");
+    }
+    chart.matrix = matrix;
+  }
+  if (object.Has("patches")) {
+    if (!chart.matrix) ThrowError(object.Where("patches"), "a patch fit needs its \"matrix\"");
+    for (JsonObject& patch : object.Objects("patches")) {
+      ColourPatchFit fit;
+      fit.name = patch.String("name");
+      if (patch.Has("excluded")) {
+        fit.excluded = patch.String("excluded");
+        if (fit.excluded.empty()) ThrowError(patch.Where("excluded"), "must say why");
+      } else {
+        fit.residual = patch.Number("residual");
+        if (!(fit.residual >= 0.0)) ThrowError(patch.Where("residual"), "must be non-negative");
+      }
+      patch.Finish();
+      chart.patches.push_back(fit);
+    }
+    if (chart.patches.size() != kColorCheckerPatches) {
+      ThrowError(object.Where("patches"), "expected " + std::to_string(kColorCheckerPatches) + " patches, got " +
+                                              std::to_string(chart.patches.size()));
+    }
+  }
+  object.Finish();
+  return chart;
+}
+
 nlohmann::json PoseToJson(const Rigid3d& pose) {
   const Eigen::Quaterniond& q = pose.rotation;
   return {{"rotation", {q.w(), q.x(), q.y(), q.z()}}, {"translation", ToJson(pose.translation)}};
@@ -563,6 +642,9 @@ Session Session::Load(const std::string& path) {
   if (root.Has("calibration")) {
     context.white_card = session.targets && session.targets->white_reference;
     session.calibration = ParseCalibration(root.Object("calibration"), session.directory, context);
+  }
+  if (root.Has("colour_chart")) {
+    session.colour_chart = ParseColourChart(root.Object("colour_chart"), session.directory, context);
   }
   for (JsonObject& photo : root.Objects("photos")) {
     session.photos.push_back(ParsePhoto(photo, session.directory, context));
@@ -742,6 +824,22 @@ nlohmann::json Session::ToJson() const {
       }
     }
   }
+  if (colour_chart) {
+    const ColourChartSpec& chart = *colour_chart;
+    nlohmann::json& c = json["colour_chart"];
+    c = {{"chart", chart.chart}, {"space", ColourSpaceName(chart.space)}, {"photos", nlohmann::json::array()}};
+    for (const PhotoSpec& photo : chart.photos) c["photos"].push_back(photo_json(photo));
+    if (chart.corners) {
+      for (const Eigen::Vector2d& p : *chart.corners) c["corners"].push_back({p.x(), p.y()});
+    }
+    if (chart.matrix) {
+      for (int row = 0; row < 3; ++row) c["matrix"].push_back({(*chart.matrix)(row, 0), (*chart.matrix)(row, 1), (*chart.matrix)(row, 2)});
+    }
+    for (const ColourPatchFit& fit : chart.patches) {
+      c["patches"].push_back(fit.excluded.empty() ? nlohmann::json{{"name", fit.name}, {"residual", fit.residual}}
+                                                  : nlohmann::json{{"name", fit.name}, {"excluded", fit.excluded}});
+    }
+  }
   json["photos"] = nlohmann::json::array();
   for (const PhotoSpec& photo : photos) json["photos"].push_back(photo_json(photo));
   return json;
@@ -771,6 +869,9 @@ Session Session::Rebased(const std::string& dir, PathStyle style) const {
   if (rebased.calibration && rebased.calibration->white_reference) {
     for (PhotoSpec& photo : rebased.calibration->white_reference->photos) rebase(&photo.file);
   }
+  if (rebased.colour_chart) {
+    for (PhotoSpec& photo : rebased.colour_chart->photos) rebase(&photo.file);
+  }
   if (rebased.sample.kind == SampleSpec::Kind::kMesh) {
     rebase(&rebased.sample.mesh_file);
     for (ScanInputSpec& input : rebased.sample.scan_inputs) rebase(&input.file);
@@ -796,6 +897,9 @@ std::vector<std::string> Session::InputFiles() const {
   if (!radiometry.flat_field.empty()) files.push_back(AbsolutePath(radiometry.flat_field));
   if (calibration && calibration->white_reference) {
     for (const PhotoSpec& photo : calibration->white_reference->photos) files.push_back(AbsolutePath(photo.file));
+  }
+  if (colour_chart) {
+    for (const PhotoSpec& photo : colour_chart->photos) files.push_back(AbsolutePath(photo.file));
   }
   if (sample.kind == SampleSpec::Kind::kMesh) {
     files.push_back(AbsolutePath(sample.mesh_file));

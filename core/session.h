@@ -12,6 +12,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "core/camera.h"
+#include "core/colour.h"
 #include "core/light.h"
 #include "core/radiometry.h"
 #include "core/rigid3.h"
@@ -177,6 +178,35 @@ struct CalibrationSpec {
   std::optional<WhiteReferenceSpec> white_reference;
 };
 
+// One patch of a colour chart fit (ColourChartSpec::patches): its relative residual, or why the fit
+// left it out.
+struct ColourPatchFit {
+  std::string name;        // the patch's name (ColorCheckerPatchNames)
+  double residual = 0.0;   // |M c - r| / |r| of the fitted matrix M, camera RGB c and reference r; used patches
+  std::string excluded;    // why it was left out ("clipped", "too dark", ...); empty: used in the fit
+};
+
+// An optional colour chart (docs/session-format.md, "colour_chart"): photos of a ColorChecker under
+// one of the session's lights, read through the same radiometric chain as the measurement photos.
+// `ibrdf colour` locates the chart (OpenCV's mcc detector, or the four corner patches given here),
+// fits a 3x3 matrix from camera RGB to `space` and writes it back as `matrix` with the per-patch fit;
+// the derenderer then applies it to every sample (derender/colour_chart.h).
+struct ColourChartSpec {
+  std::string chart = kColorCheckerClassic24;  // the chart type (the only one for now)
+  ColourSpace space = ColourSpace::kLinearSrgb;  // what the samples are corrected into
+  // The exposures of one view of the chart (one photo, or a bracket merged like the measurement
+  // photos'), all under the same light and from the same place; no pose needed.
+  std::vector<PhotoSpec> photos;
+  // Optional: the pixel positions (docs/conventions.md) of the centres of patches 1 (dark skin),
+  // 6 (bluish green), 24 (black) and 19 (white), in that order (the chart's top-left, top-right,
+  // bottom-right and bottom-left patch). Absent: the chart is detected (OpenCV mcc).
+  std::optional<std::array<Eigen::Vector2d, 4>> corners;
+  // Written by `ibrdf colour`: the fitted matrix, space_from_camera (least squares over the used
+  // patches, on camera RGB radiance of the chart), and each patch's fit. Absent: not yet fitted.
+  std::optional<Eigen::Matrix3d> matrix;
+  std::vector<ColourPatchFit> patches;
+};
+
 struct Session {
   std::string name;
   std::string description;    // free text, optional
@@ -193,6 +223,7 @@ struct Session {
   std::vector<PhotoSpec> photos;
   std::optional<TargetsSpec> targets;
   std::optional<CalibrationSpec> calibration;
+  std::optional<ColourChartSpec> colour_chart;  // a colour chart, if any
 
   // Reads and validates a manifest (a session.json path, or a folder holding session.json). Unknown
   // keys, missing fields, wrong types, missing photo files and impossible values are Errors naming the
@@ -211,7 +242,7 @@ struct Session {
   };
   // A copy of the session whose manifest lives in folder `dir`: `directory` and `manifest_path` name
   // `dir` and `dir`/session.json, and every path field (photos, the flat field, the white-reference
-  // photos, the mesh file, the raw scans) is rewritten, field by field, to name the same file from
+  // photos, the colour chart's photos, the mesh file, the raw scans) is rewritten, field by field, to name the same file from
   // there. For a caller that writes the manifest elsewhere first (e.g. into a temporary folder that
   // becomes `dir`): `session.Rebased(dir).Save(temporary_manifest)`.
   Session Rebased(const std::string& dir, PathStyle style = PathStyle::kRelative) const;
@@ -222,7 +253,7 @@ struct Session {
   // A path field of the manifest (relative to `directory`, or absolute) as an absolute, normalized path.
   std::string AbsolutePath(const std::string& file) const;
   // Every file the session references, absolute and normalized, in manifest order: the photos, the
-  // flat field, the white-reference photos, and for a mesh sample the mesh file and its raw scans.
+  // flat field, the white-reference photos, the colour chart's photos, and for a mesh sample the mesh file and its raw scans.
   // Not the manifest itself. The mesh file need not exist yet (the scan stage writes it).
   std::vector<std::string> InputFiles() const;
 

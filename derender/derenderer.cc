@@ -24,6 +24,7 @@
 #include "core/logging.h"
 #include "core/sample_file.h"
 #include "derender/analytic_sample.h"
+#include "derender/colour_chart.h"
 #include "derender/light_calibration.h"
 #include "derender/mesh_sample.h"
 #include "derender/photo_mask.h"
@@ -717,15 +718,22 @@ DerenderResult Derender(const Session& measured_session, const DerenderOptions& 
   calibration_options.min_signal = options.min_signal;
   const Session session = ApplyLightCalibration(measured_session, &calibration, calibration_options);
   if (calibration.calibrated) Log(1, calibration.BriefReport());
-  if (session.sample.kind != SampleSpec::Kind::kMesh) return DerenderAnalytic(session, options);
-  const Timer setup;
-  const MeshPath path = PrepareMeshPath(session, options);
-  const double setup_s = setup.ElapsedSeconds();
-  char seconds[32];
-  std::snprintf(seconds, sizeof(seconds), "%.2f s", setup_s);
-  Log(1, std::string("mesh set-up (read, ray-tracing scene, convexity): ") + seconds);
-  DerenderResult result = RunDerender(session, options, *path.mesh, &path);
-  result.summary.mesh_setup_s = setup_s;
+  DerenderResult result;
+  if (session.sample.kind != SampleSpec::Kind::kMesh) {
+    result = DerenderAnalytic(session, options);
+  } else {
+    const Timer setup;
+    const MeshPath path = PrepareMeshPath(session, options);
+    const double setup_s = setup.ElapsedSeconds();
+    char seconds[32];
+    std::snprintf(seconds, sizeof(seconds), "%.2f s", setup_s);
+    Log(1, std::string("mesh set-up (read, ray-tracing scene, convexity): ") + seconds);
+    result = RunDerender(session, options, *path.mesh, &path);
+    result.summary.mesh_setup_s = setup_s;
+  }
+  // The colour chart's matrix, per sample by its photo's light (colour_chart.h), after the light's calibration.
+  result.summary.colour_matrices = ApplyColourCorrection(session, &result.samples);
+  if (!result.summary.colour_matrices.empty()) Log(1, ColourCorrectionReport(session, result.summary.colour_matrices));
   return result;
 }
 
@@ -746,7 +754,7 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
         {"angles", "radians"},
         {"directions",
          "unit vectors in the local frame, z = surface normal; wi towards the light, wo towards the camera"}}},
-      {"colour_space", "camera RGB, linear (the session's response inverted, black level subtracted)"},
+      {"colour_space", ColourSpaceDescription(session)},
       {"uncertainty", session.radiometry.noise ? "sigma: one standard deviation from the session's camera noise model"
                                                : "none: the session has no camera noise model; sigma is 0"},
       {"counts",
@@ -761,6 +769,7 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
         {"pixel_stride", options.pixel_stride}}},
       {"timings_s", {{"total", summary.total_s}, {"decode_cpu", summary.decode_s}}},
   };
+  if (session.colour_chart) sidecar["colour"] = ColourSidecar(session, summary.colour_matrices);
   if (session.sample.kind == SampleSpec::Kind::kMesh) {
     sidecar["timings_s"]["mesh_setup"] = summary.mesh_setup_s;
     sidecar["mesh"] = {

@@ -77,6 +77,8 @@ struct DerenderSummary {
   double decode_s = 0.0;              // summed over threads: time to decode the photos
   double total_s = 0.0;               // wall clock
   double mesh_setup_s = 0.0;          // mesh: reading it, the ray-tracing scene, the convexity verdict
+  // With a colour chart: the matrix applied to the samples' brdf, per light (derender/colour_chart.h).
+  std::vector<Eigen::Matrix3d> colour_matrices;
   // "derender: 1234567 samples from 20 photos in 2.1 s; rejected: off_sample 10, saturated 3"
   std::string BriefReport() const;
 };

@@ -181,7 +181,9 @@ void TabulateAndScore(const LocalRegression& regression, const ReconstructOption
                                           ? "-1 (MERL's no data)"
                                           : std::string("filled by ") + FillModeName(options.tabulate.fill) +
                                                 " where possible (domain.npy 0 with a value >= 0: invented), else -1"},
-                 {"table", table_json}});
+                 {"table", table_json},
+                 {"colour_space", summary.value("colour_space", nlohmann::json())},
+                 {"colour", summary.value("colour", nlohmann::json())}});
   (*timings)["write_s"] = timer.ElapsedSeconds();
   summary["regression"]["reliability"] = ToJson(tabulated.reliability);
   summary["table"] = table_json;
@@ -286,6 +288,16 @@ nlohmann::json RegressionJson(const ReconstructOptions& options, const LocalRegr
           {"samples_skipped", regression.skipped_samples()}};
 }
 
+// The samples' colour space and colour-chart correction, as their sidecar states them (the derenderer's
+// "colour_space" and "colour"), carried into summary.json and brdf.json; "unknown" without a sidecar.
+void CopySampleColour(const std::string& samples_file, nlohmann::json* summary) {
+  (*summary)["colour_space"] = "unknown (the samples have no sidecar)";
+  if (samples_file.empty() || !std::filesystem::is_regular_file(SidecarPath(samples_file))) return;
+  const nlohmann::json sidecar = ReadJsonFile(SidecarPath(samples_file));
+  if (sidecar.contains("colour_space")) (*summary)["colour_space"] = sidecar["colour_space"];
+  if (sidecar.contains("colour")) (*summary)["colour"] = sidecar["colour"];
+}
+
 // The stage after its inputs are read; `total` started before they were.
 ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructOptions& options,
                       const StageInputs& inputs, const std::string& out_dir, const std::string& samples_file,
@@ -295,6 +307,7 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
   result.samples = samples.size();
   result.summary = {
       {"format", "ibrdf-reconstruction"}, {"version", 1}, {"samples_file", samples_file}, {"samples", samples.size()}};
+  CopySampleColour(samples_file, &result.summary);
   AtomicDirectory dir(out_dir, options.overwrite);
   const std::string tmp = dir.temporary_path();
   nlohmann::json timings;

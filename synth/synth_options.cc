@@ -169,7 +169,8 @@ bool SynthScanOptions::Check(std::string* why) const {
 
 bool SynthOptions::Check(std::string* why) const {
   if (!CheckPart("scene", scene, why) || !CheckPart("rig", rig, why) || !CheckPart("effects", effects, why) ||
-      !CheckPart("radiometry", radiometry, why) || !CheckPart("targets", targets, why)) {
+      !CheckPart("radiometry", radiometry, why) || !CheckPart("targets", targets, why) ||
+      !CheckPart("colour", colour, why)) {
     return false;
   }
   const double sample_bounding_radius = SampleBoundingRadius(scene);

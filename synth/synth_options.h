@@ -199,6 +199,29 @@ struct SynthScanOptions {
   bool Check(std::string* why) const;
 };
 
+// Colour (synth/synthetic_colour_chart.h): the camera's own RGB and a photo of a colour chart. The
+// renderer works in linear sRGB (materials, light intensity); the sensor sees camera RGB =
+// camera_matrix * linear sRGB in every photo (measurement, white reference, chart; the platform's
+// grey markers are left as they are), and the session states the light's intensity in camera RGB,
+// as a calibration of that camera would.
+struct SynthColourOptions {
+  Eigen::Matrix3d camera_matrix = Eigen::Matrix3d::Identity();  // camera RGB from linear sRGB
+  // A photo of a ColorChecker Classic (24 Lambertian patches of the reference linear-sRGB albedo,
+  // core/colour.h, on a black card of albedo chart_card_albedo) at the sample's centre (the sample
+  // taken away), facing between the light and the first camera, from the first camera's pose, under
+  // the first light: the session's colour_chart block, with the corner patches' pixel centres unless
+  // chart_corners is off (then `ibrdf colour` must detect the chart).
+  bool chart = false;
+  bool chart_corners = true;
+  double chart_pitch = 0.017;        // metres, patch centre to centre (a ColorChecker Mini's)
+  double chart_patch_fraction = 0.85;  // printed patch side / pitch
+  double chart_card_albedo = 0.03;   // the card around the patches
+  double chart_exposure_scale = 1.0;  // relative to the auto-exposure (the white patch's brightest channel at exposure_target)
+  ColourSpace space = ColourSpace::kLinearSrgb;  // the colour_chart block's target space
+
+  bool Check(std::string* why) const;
+};
+
 // Everything a synthetic session is made from. Defaults: a 4 cm sphere, 20 photos of 800 x 600 on an
 // arc from 8 to 172 degrees, a 12-bit sensor with noise, no targets.
 struct SynthOptions {
@@ -208,6 +231,7 @@ struct SynthOptions {
   SynthRadiometryOptions radiometry;
   SynthTargetOptions targets;
   SynthScanOptions scan;  // used only for an irregular shape (scene.shape != kNone)
+  SynthColourOptions colour;  // camera colour matrix and colour-chart photo
   uint64_t seed = 1;      // every random stream (noise, scan) derives from it: output is reproducible
 
   // Each part's Check (the scan's only for an irregular shape; messages start with the part's name, e.g.

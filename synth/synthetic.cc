@@ -22,6 +22,7 @@
 #include "core/statistics.h"
 #include "derender/analytic_sample.h"
 #include "scan/ply_io.h"
+#include "synth/synthetic_colour_chart.h"
 #include "synth/synthetic_exif.h"
 #include "synth/synthetic_radiometry.h"
 #include "synth/synthetic_targets.h"
@@ -719,6 +720,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
     Image image =
         RenderRadianceImpl(session, i, *truth, shadow_rays, material, effects.supersample, &mask,
                            session.photos[i].role == PhotoRole::kMeasurement ? &shadowed : nullptr, fill_irradiance(i));
+    ApplyCameraMatrix(options.colour.camera_matrix, &image);  // colour hook: the camera's RGB
     PhotoSpec& photo = session.photos[i];
     photo.exposure_s *= options.rig.exposure_target /
                         AutoExposureReference(image, mask);  // exposure_s holds the bracket's factor (1 without)
@@ -752,6 +754,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
     if (target_scene) CompositeTargets(session.camera, camera_from_world, *target_scene, card, {}, signal);
   };
   WriteSynthCalibration(options, directory.temporary_path(), &session, composite_targets);
+  const nlohmann::json colour_truth = WriteSynthColour(options, directory.temporary_path(), &session);  // colour hook
   // Irregular shapes: the range scan, the truth mesh, and the mesh sample's scan inputs and targets
   // (the sample's file, scan/mesh.ply, is the scan stage's output from those inputs).
   const nlohmann::json shape_truth = options.scene.shape != SynthShape::kNone
@@ -768,6 +771,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
       {"generator", GeneratorJson(options)},
   };
   if (!shape_truth.is_null()) truth_json["generator"]["geometry"] = shape_truth;
+  if (!colour_truth.is_null()) truth_json["generator"]["colour"] = colour_truth;
   WriteJsonFile((fs::path(directory.temporary_path()) / "truth.json").string(), truth_json);
   directory.Commit();
   summary.photos = options.rig.num_photos;

@@ -14,6 +14,7 @@
 #include "core/light.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
+#include "synth/synthetic_colour_chart.h"
 #include "synth/synthetic_exif.h"
 #include "synth/synthetic_targets.h"
 
@@ -326,6 +327,7 @@ void WriteSynthCalibration(const SynthOptions& options, const std::string& direc
                                            effects.supersample, &mask)
                          : RenderWhiteReference(*session, session->lights[k], *first->camera_from_world, white,
                                                 effects.supersample, &mask);
+      ApplyCameraMatrix(options.colour.camera_matrix, &image);  // the camera's RGB (synthetic_colour_chart.h)
       std::vector<float> levels;
       for (size_t p = 0; p < mask.size(); ++p) {
         if (mask[p])

@@ -54,6 +54,7 @@ class Planner {
   void Synth(const Recipe& recipe);
   void Scan();
   void Align();
+  void Colour();
   void Derender();
   void SampleStages();  // check, compare, reconstruct, report
 
@@ -126,6 +127,21 @@ void Planner::Align() {
   const bool applies = align.not_applicable.empty();
   Execute(align);
   if (applies) current = At("align/session.json");
+}
+
+// Sessions with a colour chart: `ibrdf colour` fits its matrix into DIR/colour/session.json, which the
+// derenderer applies.
+void Planner::Colour() {
+  const std::optional<Session> session = SessionAt(current);
+  Stage colour = MakeStage("colour", {"colour", current, "--out", At("colour"), "--overwrite"}, {current},
+                           {At("colour/session.json"), At("colour/colour.json")});
+  if (session) {
+    for (const std::string& file : session->InputFiles()) colour.inputs.push_back(file);
+  }
+  if (!session || !session->colour_chart) colour.not_applicable = "the session has no colour_chart";
+  const bool applies = colour.not_applicable.empty();
+  Execute(colour);
+  if (applies) current = At("colour/session.json");
 }
 
 void Planner::Derender() {
@@ -203,7 +219,7 @@ void Planner::SampleStages() {
 }  // namespace
 
 const std::vector<std::string>& MeasurementStageNames() {
-  static const std::vector<std::string> kStages = {"synth", "scan",    "align",       "derender",
+  static const std::vector<std::string> kStages = {"synth", "scan",    "align",       "colour", "derender",
                                                    "check", "compare", "reconstruct", "report"};
   return kStages;
 }
@@ -224,7 +240,7 @@ bool MeasurementOptions::Check(std::string* why) const {
   const std::vector<std::string>& stages = MeasurementStageNames();
   if (!stop_after.empty() && std::find(stages.begin(), stages.end(), stop_after) == stages.end()) {
     *why = "--stop-after: unknown stage \"" + stop_after +
-           "\" (synth, scan, align, derender, check, compare, reconstruct, report)";
+           "\" (synth, scan, align, colour, derender, check, compare, reconstruct, report)";
     return false;
   }
   return true;
@@ -263,6 +279,7 @@ std::string RunMeasurement(const MeasurementInput& input, const MeasurementOptio
   plan.current = plan.manifest_path;
   plan.Scan();
   plan.Align();
+  plan.Colour();
   plan.Derender();
   plan.SampleStages();
   return plan.truth_path;

@@ -1,0 +1,102 @@
+// ibrdf colour: the colour chart's matrix from camera RGB to linear sRGB or XYZ (derender/colour_chart.h;
+// the chart found by its corner patches or by OpenCV's mcc, align/colour_chart_detector.h) behind flags.
+#include <cstdio>
+#include <limits>
+
+#include "align/colour_chart_detector.h"
+#include "apps/commands.h"
+#include "core/error.h"
+#include "core/logging.h"
+#include "core/session.h"
+#include "derender/colour_chart.h"
+
+namespace ibrdf {
+namespace {
+
+void AddColourCommand(CLI::App& app) {
+  auto* command = app.add_subcommand(
+      "colour",
+      "Fit a 3x3 matrix from the camera's RGB to linear sRGB (or XYZ) on the session's colour-chart photo\n"
+      "(a ColorChecker Classic; colour_chart block): the 24 patches read through the session's radiometric\n"
+      "chain, clipped and too dark ones left out, least squares against the chart's published reference\n"
+      "values. The chart is located by the block's corner patches, else detected (OpenCV mcc). Writes\n"
+      "OUT/session.json (the session with the matrix: `ibrdf derender` applies it to every sample),\n"
+      "OUT/colour.json (matrix and per-patch residuals) and OUT/chart.png (the patches read).");
+  struct Args {
+    std::string session, out;
+    ColourChartOptions options;
+    bool detect = false, overwrite = false;
+  };
+  auto args = std::make_shared<Args>();
+  ColourChartOptions& o = args->options;
+  command->add_option("session", args->session, "Session folder or session.json with a colour_chart block")->required();
+  command->add_option("--out", args->out, "Folder for the session with the colour matrix")->required();
+  command->add_option("--patch-fraction", o.patch_fraction, "Read-out square of each patch, in patch pitches")
+      ->capture_default_str();
+  command
+      ->add_option("--min-patch-signal", o.min_patch_signal,
+                   "Leave out patches whose brightest channel's mean signal is below this (normalized units)")
+      ->capture_default_str();
+  command->add_option("--min-patches", o.min_patches, "Usable patches the fit needs")->capture_default_str();
+  command->add_flag("--detect", args->detect, "Detect the chart (OpenCV mcc) even where the session gives its corners");
+  command->add_flag("--overwrite", args->overwrite, "Replace an existing output folder");
+  command->callback([args] {
+    StageLog stage("colour");
+    const Session session = Session::Load(args->session);
+    if (!session.colour_chart) {
+      ThrowError(session.manifest_path, "has no colour_chart block (docs/session-format.md): nothing to fit");
+    }
+    std::vector<std::string> inputs = session.InputFiles();
+    inputs.push_back(session.manifest_path);
+    inputs.push_back(session.directory);
+    RequireWritableOutput(args->out, args->overwrite, inputs);
+    ColourChartFit fit;
+    if (session.colour_chart->corners && !args->detect) {
+      fit = FitColourChart(session, *session.colour_chart->corners, args->options, "corner patches (session)");
+    } else {
+      const ColourChartDetection detection = DetectColorChecker(ColourChartDisplayImage(session));
+      if (!detection.found) {
+        ThrowError(session.AbsolutePath(session.colour_chart->photos.front().file),
+                   detection.why + "; give the centres of patches 1, 6, 24 and 19 in colour_chart.corners "
+                                   "(docs/session-format.md)");
+      }
+      char cost[64];
+      std::snprintf(cost, sizeof(cost), "%.3g", detection.cost);
+      Log(1, std::string("OpenCV mcc found a chart (cost ") + cost + "); choosing its orientation by the fit");
+      std::string last_error;
+      for (const auto& corners : CornerPatchCandidates(detection.box)) {
+        try {
+          ColourChartFit candidate = FitColourChart(session, corners, args->options, "OpenCV mcc detector");
+          if (!fit.success || candidate.rms_residual < fit.rms_residual) fit = candidate;
+        } catch (const Error& error) {
+          last_error = error.what();
+        }
+      }
+      if (!fit.success) ThrowError(session.manifest_path, "the detected chart gives no usable fit: " + last_error);
+    }
+    Log(1, fit.BriefReport());
+    for (const ColourPatch& patch : fit.patches) {
+      char line[200];
+      if (patch.excluded.empty()) {
+        std::snprintf(line, sizeof(line), "  %2d %-14s camera (%.4g, %.4g, %.4g) -> (%.4f, %.4f, %.4f), reference "
+                      "(%.4f, %.4f, %.4f): %.2f %%", patch.index + 1, patch.name.c_str(), patch.camera_rgb[0],
+                      patch.camera_rgb[1], patch.camera_rgb[2], patch.corrected[0], patch.corrected[1],
+                      patch.corrected[2], patch.reference[0], patch.reference[1], patch.reference[2],
+                      100.0 * patch.residual);
+        Log(1, line);
+      } else {
+        std::snprintf(line, sizeof(line), "  %2d %-14s left out: ", patch.index + 1, patch.name.c_str());
+        Log(1, line + patch.excluded);
+      }
+    }
+    WriteColourStage(session, fit, args->out, args->overwrite);
+    Log(1, "session with the colour matrix written to " + args->out + "/session.json (fit in " + args->out +
+               "/colour.json)");
+  });
+}
+
+}  // namespace
+
+IBRDF_REGISTER_COMMAND(35, AddColourCommand);
+
+}  // namespace ibrdf
