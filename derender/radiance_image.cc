@@ -225,7 +225,13 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
   // neighbours (kFloorRing*), by separable box sums over the window (5x5 minus 3x3).
   const int width = window.x1 - window.x0, height = window.y1 - window.y0;
   const size_t area = size_t(std::max(width, 0)) * std::max(height, 0);
-  std::vector<float> linear(3 * area * m), expected(3 * area * m), outer(3 * area), inner(3 * area);
+  // Every element is written before it is read, so the scratch memory is only grown, never cleared.
+  std::vector<float>& scratch = out.scratch;
+  if (scratch.size() < 3 * area * (2 * m + 2)) scratch.resize(3 * area * (2 * m + 2));
+  float* const linear = scratch.data();
+  float* const expected = linear + 3 * area * m;
+  float* const outer = expected + 3 * area * m;
+  float* const inner = outer + 3 * area;
   for (size_t e = 0; e < m; ++e) {
     const Image& image = images[e];
     float* lin = &linear[3 * area * e];

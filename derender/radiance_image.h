@@ -55,6 +55,9 @@ struct RadianceImage {
   std::vector<uint8_t> exposures_used;
   // Per pixel, 0 where the photos' masks exclude it, 1 where usable (photo_mask.h); empty: no mask.
   std::vector<uint8_t> mask;
+  // Working memory of RadianceReader::ReadWindow (the expected-signal pass), kept so that a buffer
+  // reused from photo to photo allocates it once; holds nothing a caller reads.
+  std::vector<float> scratch;
 
   size_t Index(int x, int y) const { return size_t(y) * width + x; }
 };
