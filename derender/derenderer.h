@@ -85,7 +85,7 @@ struct DerenderSummary {
   double mesh_setup_s = 0.0;          // mesh: reading it, the ray-tracing scene, the convexity verdict
   // Accepted samples whose channel c (R, G, B) is not measured (valid 0).
   std::array<uint64_t, 3> channels_not_measured{};
-  ExposureTally exposure;                        // per theta_h band and channel, what was lost
+  ExposureTally exposure;                          // per theta_h band and channel, what was lost
   std::vector<ExposureWarning> exposure_warnings;  // AdviseExposure of `exposure`
   // "derender: 1234567 samples from 20 photos in 2.1 s; rejected: off_sample 10, saturated 3"
   std::string BriefReport() const;

@@ -26,8 +26,9 @@ std::string Remedy(const std::string& cause, int channel, bool bracketed) {
                      : "take exposure brackets (the same pose at shorter exposures, `bracket` in session.json; "
                        "`ibrdf synth --brackets 3` for synthetic sessions) or shorten the exposure";
   }
-  std::string remedy = bracketed ? "add longer exposures to each pose's bracket" : "expose longer, or take exposure "
-                                                                                    "brackets with longer exposures";
+  std::string remedy = bracketed ? "add longer exposures to each pose's bracket"
+                                 : "expose longer, or take exposure "
+                                   "brackets with longer exposures";
   remedy += ", or use a brighter light";
   if (channel == 2) remedy += " or a bluer one (the blue channel is the weak one)";
   if (channel == 0) remedy += " or a redder one (the red channel is the weak one)";

@@ -47,8 +47,8 @@ struct ExposureTally {
 
 // One warning: a channel that lost a contiguous range of theta_h bands to one cause.
 struct ExposureWarning {
-  int channel = 0;          // 0 red, 1 green, 2 blue
-  std::string cause;        // "saturated" or "below_signal"
+  int channel = 0;    // 0 red, 1 green, 2 blue
+  std::string cause;  // "saturated" or "below_signal"
   double theta_h_min_deg = 0.0, theta_h_max_deg = 0.0;
   double worst_fraction = 0.0;  // the largest fraction lost in one band of the range
   uint64_t pixels_lost = 0;     // over the range

@@ -266,7 +266,9 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
       }
     });
     float* exp = &expected[3 * area * e];
-    const auto span = [](int k, int half, int size) { return std::min(k + half, size - 1) - std::max(k - half, 0) + 1; };
+    const auto span = [](int k, int half, int size) {
+      return std::min(k + half, size - 1) - std::max(k - half, 0) + 1;
+    };
     tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
       for (int j = rows.begin(); j < rows.end(); ++j) {
         for (int i = 0; i < width; ++i) {

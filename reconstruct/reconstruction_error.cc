@@ -128,9 +128,12 @@ ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfMode
 
 nlohmann::json ToJson(const ReconstructionError& error) {
   auto rgb = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
-  return {{"cells_scored", error.points},           {"cells_outside", error.outside},
-          {"coverage", error.coverage()},           {"rel_rms_error", rgb(error.rel_rms)},
-          {"rel_rms_error_all", error.rel_rms_all}, {"median_abs_rel_error", rgb(error.median)},
+  return {{"cells_scored", error.points},
+          {"cells_outside", error.outside},
+          {"coverage", error.coverage()},
+          {"rel_rms_error", rgb(error.rel_rms)},
+          {"rel_rms_error_all", error.rel_rms_all},
+          {"median_abs_rel_error", rgb(error.median)},
           {"p95_abs_rel_error", rgb(error.p95)},
           {"theta_h_bands", [&] {
              nlohmann::json bands = nlohmann::json::array();

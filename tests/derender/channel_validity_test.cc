@@ -55,9 +55,8 @@ TEST(ChannelValidity, GoldPaintBlueChannelUnbiased) {
     if (band.points < 200) continue;
     ++bands;
     for (int c = 0; c < 3; ++c) {
-      EXPECT_LT(std::abs(band.mean_rel[c]), 0.02)
-          << "channel " << c << " theta_h " << band.theta_h_min_deg << "-" << band.theta_h_max_deg << " deg, "
-          << band.points << " cells";
+      EXPECT_LT(std::abs(band.mean_rel[c]), 0.02) << "channel " << c << " theta_h " << band.theta_h_min_deg << "-"
+                                                  << band.theta_h_max_deg << " deg, " << band.points << " cells";
     }
   }
   EXPECT_GE(bands, 7);

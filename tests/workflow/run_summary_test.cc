@@ -167,9 +167,10 @@ TEST_F(SummaryTest, ExposureWarningsReachTheHeadline) {
   EXPECT_TRUE(Build()["samples"]["exposure_warnings"].empty());
   json sidecar = Sidecar();
   sidecar["exposure"] = {{"warnings", json::array({{{"channel", "red"},
-                                                     {"cause", "saturated"},
-                                                     {"message", "exposure: the red channel is clipped; remedy: "
-                                                                 "take exposure brackets"}}})}};
+                                                    {"cause", "saturated"},
+                                                    {"message",
+                                                     "exposure: the red channel is clipped; remedy: "
+                                                     "take exposure brackets"}}})}};
   WriteJson(dir_ / "run/samples.npy.json", sidecar);
   const json summary = Build();
   ASSERT_EQ(summary["samples"]["exposure_warnings"].size(), 1u);
