@@ -1,14 +1,34 @@
 #include "core/sample_file.h"
 
 #include <cmath>
+#include <cstddef>
+#include <cstring>
+#include <exception>
 #include <string>
 
 #include "core/error.h"
 #include "core/npy.h"
 
 namespace ibrdf {
+namespace {
+
+// A row of a version 1 sample file: BrdfSample without `valid` and `exposures`.
+#pragma pack(push, 1)
+struct BrdfSampleVersion1 {
+  unsigned char bytes[72];
+};
+#pragma pack(pop)
+static_assert(offsetof(BrdfSample, valid) == sizeof(BrdfSampleVersion1), "version 1 rows are BrdfSample's prefix");
+
+}  // namespace
 
 const char* BrdfSampleDtype() {
+  return "[('wi', '<f4', (3,)), ('wo', '<f4', (3,)), ('theta_i', '<f4'), ('theta_e', '<f4'), "
+         "('delta_phi', '<f4'), ('brdf', '<f4', (3,)), ('sigma', '<f4', (3,)), ('image', '<u4'), "
+         "('pixel', '<u4', (2,)), ('valid', '|u1', (3,)), ('exposures', '|u1')]";
+}
+
+const char* BrdfSampleDtypeVersion1() {
   return "[('wi', '<f4', (3,)), ('wo', '<f4', (3,)), ('theta_i', '<f4'), ('theta_e', '<f4'), "
          "('delta_phi', '<f4'), ('brdf', '<f4', (3,)), ('sigma', '<f4', (3,)), ('image', '<u4'), "
          "('pixel', '<u4', (2,))]";
@@ -52,12 +72,32 @@ std::string InvalidSampleReason(const BrdfSample& s) {
              " is not a finite, non-negative value";
     }
   }
+  if (s.valid[0] > 1 || s.valid[1] > 1 || s.valid[2] > 1) return "a valid flag is not 0 or 1";
+  if (!(s.valid[0] || s.valid[1] || s.valid[2])) return "no channel is valid";
   return "";
 }
 
 std::vector<BrdfSample> ReadSamples(const std::string& path) {
   std::vector<size_t> shape;
-  std::vector<BrdfSample> samples = ReadNpy<BrdfSample>(path, BrdfSampleDtype(), &shape);
+  std::vector<BrdfSample> samples;
+  try {
+    samples = ReadNpy<BrdfSample>(path, BrdfSampleDtype(), &shape);
+  } catch (const Error&) {
+    // A version 1 file (no per-channel validity): every channel valid, exposures not recorded. Any
+    // other dtype gets the message of the current format.
+    const std::exception_ptr current = std::current_exception();
+    std::vector<BrdfSampleVersion1> old;
+    try {
+      old = ReadNpy<BrdfSampleVersion1>(path, BrdfSampleDtypeVersion1(), &shape);
+    } catch (const Error&) {
+      std::rethrow_exception(current);
+    }
+    samples.resize(old.size());
+    for (size_t i = 0; i < old.size(); ++i) {
+      std::memcpy(static_cast<void*>(&samples[i]), &old[i], sizeof(BrdfSampleVersion1));
+      samples[i].exposures = 0;
+    }
+  }
   if (shape.size() != 1) ThrowError(path, "sample files are one-dimensional arrays");
   for (size_t i = 0; i < samples.size(); ++i) {
     const std::string reason = InvalidSampleReason(samples[i]);

@@ -105,13 +105,21 @@ PixelBox SampleBox(const Camera& camera, const Rigid3d& camera_from_world, const
   return box;
 }
 
-// The radiometric tests of a pixel (flags from radiance_image.h) in RejectionReasons() order;
-// kNumReasons when measurable.
-inline Reason RadiometricReason(uint8_t flags) {
-  if (flags & kPixelNonFinite) return kNonFinite;
-  if (flags & kPixelSaturated) return kSaturated;
-  if (flags & kPixelBelowSignal) return kBelow;
-  return kNumReasons;
+// The radiometric tests of a pixel (per-channel flags from radiance_image.h): kNumReasons when any
+// channel is measured (the sample keeps a per-channel `valid` flag), else the first reason in
+// RejectionReasons() order that a channel has.
+inline Reason RadiometricReason(const uint8_t* channel_flags) {
+  if (channel_flags[0] == 0 || channel_flags[1] == 0 || channel_flags[2] == 0) return kNumReasons;
+  const uint8_t any = channel_flags[0] | channel_flags[1] | channel_flags[2];
+  if (any & kPixelNonFinite) return kNonFinite;
+  if (any & kPixelSaturated) return kSaturated;
+  return kBelow;
+}
+
+// theta_h, the angle between the normal and the half vector of wi and wo (world directions), radians.
+inline double HalfAngle(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo, const Eigen::Vector3d& normal) {
+  const Eigen::Vector3d h = (wi + wo).normalized();
+  return std::acos(std::clamp(h.dot(normal), -1.0, 1.0));
 }
 
 // f = L / E per channel, in the local frame of `normal`.
@@ -127,9 +135,13 @@ inline BrdfSample MakeSample(const RadianceImage& image, size_t p, const Eigen::
     s.wi[c] = static_cast<float>(wi[c]);
     s.wo[c] = static_cast<float>(wo[c]);
     const double irradiance = incidence.irradiance[c];
-    s.brdf[c] = static_cast<float>(image.radiance[3 * p + c] / irradiance);
-    s.sigma[c] = static_cast<float>(image.sigma[3 * p + c] / irradiance);
+    const bool valid = image.channel_flags[3 * p + c] == 0;
+    // A channel not measured keeps its (clipped or noisy) value, at least 0, with sigma 0 and valid 0.
+    s.brdf[c] = static_cast<float>(std::max(0.0, image.radiance[3 * p + c] / irradiance));
+    s.sigma[c] = valid ? static_cast<float>(image.sigma[3 * p + c] / irradiance) : 0.0f;
+    s.valid[c] = valid ? 1 : 0;
   }
+  s.exposures = image.exposures_used.empty() ? 1 : image.exposures_used[p];
   s.theta_i = static_cast<float>(angles.theta_i);
   s.theta_e = static_cast<float>(angles.theta_e);
   s.delta_phi = static_cast<float>(angles.delta_phi);
@@ -157,6 +169,7 @@ struct MeshPhotoStats {
   ReasonCounts counts{};
   uint64_t shadow_rays = 0;
   uint64_t shadow_tests_skipped = 0;
+  ExposureTally exposure;
 };
 
 // Whether the light reaches `point` (on the surface, normal `normal`, fit residual `fit_rms_m`):
@@ -327,7 +340,8 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
           ++local.shadow_tests_skipped;
         }
         const size_t p = image.Index(x, y);
-        const Reason radiometric = RadiometricReason(image.flags[p]);
+        local.exposure.Add(HalfAngle(incidence.wi, wo_world, hit.normal), &image.channel_flags[3 * p]);
+        const Reason radiometric = RadiometricReason(&image.channel_flags[3 * p]);
         if (radiometric != kNumReasons) {
           ++local.counts[radiometric];
           continue;
@@ -344,6 +358,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
     for (int r = 0; r < kNumReasons; ++r) stats->counts[r] += block_stats[b].counts[r];
     stats->shadow_rays += block_stats[b].shadow_rays;
     stats->shadow_tests_skipped += block_stats[b].shadow_tests_skipped;
+    stats->exposure.Merge(block_stats[b].exposure);
   }
 }
 
@@ -479,6 +494,7 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     std::vector<BrdfSample> samples;
     RejectionCounts rejected;
     MeshPhotoStats mesh_stats;
+    ExposureTally exposure;  // analytic path
     double decode_s = 0.0;
   };
   const size_t tokens = size_t(std::max(2, 2 * tbb::this_task_arena::max_concurrency()));
@@ -518,6 +534,7 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
         w->samples.clear();
         w->rejected.clear();
         w->mesh_stats = MeshPhotoStats();
+        w->exposure = ExposureTally();
         w->decode_s = 0.0;
         reader.ReadWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1}, &w->decoded,
                           &w->image, &w->decode_s);
@@ -530,7 +547,8 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
           // Room for every examined pixel: reserved once per buffer (regrowth copies and page
           // faults cost more than the per-pixel geometry).
           w->samples.reserve(PixelsPerImage(session.camera, options.pixel_stride));
-          DerenderPhoto(session, groups[g].front(), w->image, rays, sample, options, &w->samples, &w->rejected);
+          DerenderPhoto(session, groups[g].front(), w->image, rays, sample, options, &w->samples, &w->rejected,
+                        &w->exposure);
         }
         return w;
       }) & tbb::make_filter<PhotoWork*, void>(tbb::filter_mode::serial_in_order, [&](PhotoWork* w) {
@@ -539,6 +557,8 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
         result.summary.decode_s += w->decode_s;
         result.summary.shadow_rays += w->mesh_stats.shadow_rays;
         result.summary.shadow_tests_skipped += w->mesh_stats.shadow_tests_skipped;
+        result.summary.exposure.Merge(w->exposure);
+        result.summary.exposure.Merge(w->mesh_stats.exposure);
         idle.push(w);
         progress.Add(1);
       }));
@@ -547,6 +567,12 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   result.summary.photos = measured;
   result.summary.pixels_examined = PixelsPerImage(session.camera, options.pixel_stride) * measured;
   result.summary.accepted = result.samples.size();
+  for (const BrdfSample& s : result.samples) {
+    for (int c = 0; c < 3; ++c) result.summary.channels_not_measured[c] += s.valid[c] == 0;
+  }
+  bool bracketed = false;
+  for (const auto& group : groups) bracketed = bracketed || group.size() > 1;
+  result.summary.exposure_warnings = AdviseExposure(result.summary.exposure, options.exposure_advice, bracketed);
   if (measured > 0 && result.summary.rejected["off_sample"] == result.summary.pixels_examined) {
     ThrowError(session.manifest_path,
                "no photo sees the sample: every pixel's ray misses it (check the sample's "
@@ -585,6 +611,7 @@ bool DerenderOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GE(shadow_edge_deg, 0.0);
   IBRDF_CHECK_OPTION_LT(shadow_edge_deg, 45.0);
   IBRDF_CHECK_OPTION_RANGE(shadow_edge_rays, 0, 64);
+  if (!exposure_advice.Check(why)) return false;
   return true;
 }
 
@@ -603,8 +630,8 @@ const std::vector<std::pair<std::string, std::string>>& RejectionReasons() {
       {"shadowed", "mesh, shadow rays on: the sample itself blocks the light"},
       {"shadow_edge", "mesh, shadow rays on: lit, but within shadow_edge_deg of a shadow edge"},
       {"non_finite", "a pixel value is NaN or infinite"},
-      {"saturated", "a channel reaches the saturation level"},
-      {"below_signal", "the darkest channel's linear signal is below min_signal"},
+      {"saturated", "every channel is unmeasured and one reaches the saturation level"},
+      {"below_signal", "every channel's expected linear signal is below min_signal"},
   };
   return kReasons;
 }
@@ -614,7 +641,12 @@ std::string DerenderSummary::BriefReport() const {
   std::snprintf(buffer, sizeof(buffer), "derender: %llu samples from %llu photos (%llu pixels) in %.2f s; rejected: ",
                 static_cast<unsigned long long>(accepted), static_cast<unsigned long long>(photos),
                 static_cast<unsigned long long>(pixels_examined), total_s);
-  return buffer + FormatCounts(rejected);
+  std::string brief = buffer + FormatCounts(rejected);
+  if (channels_not_measured[0] + channels_not_measured[1] + channels_not_measured[2] > 0) {
+    brief += "; samples with a channel not measured (R, G, B): " + std::to_string(channels_not_measured[0]) + ", " +
+             std::to_string(channels_not_measured[1]) + ", " + std::to_string(channels_not_measured[2]);
+  }
+  return brief;
 }
 
 std::vector<Eigen::Vector2f> PixelRays(const Camera& camera) {
@@ -644,7 +676,8 @@ std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera) {
 
 void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
                    const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
-                   const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected) {
+                   const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
+                   ExposureTally* exposure) {
   const PhotoSpec& photo = session.photos[photo_index];
   const Light& light = session.PhotoLight(photo_index);
   const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
@@ -690,7 +723,8 @@ void DerenderPhoto(const Session& session, size_t photo_index, const RadianceIma
         continue;
       }
       const size_t p = image.Index(x, y);
-      const Reason radiometric = RadiometricReason(image.flags[p]);
+      if (exposure) exposure->Add(HalfAngle(incidence.wi, wo_world, hit.normal), &image.channel_flags[3 * p]);
+      const Reason radiometric = RadiometricReason(&image.channel_flags[3 * p]);
       if (radiometric != kNumReasons) {
         ++counts[radiometric];
         continue;
@@ -761,12 +795,20 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
        {{"photos", summary.photos},
         {"pixels_examined", summary.pixels_examined},
         {"accepted", summary.accepted},
-        {"rejected", rejected}}},
+        {"rejected", rejected},
+        {"channels_not_measured", summary.channels_not_measured}}},
+      {"validity",
+       "per channel, in the samples' `valid` field: 1 measured, 0 clipped, below the signal floor (tested on the "
+       "expected signal, the mean of the ring of 16 neighbours at distance 2) or not finite; a pixel is kept while "
+       "any channel is measured"},
+      {"exposure", ExposureJson(summary.exposure, summary.exposure_warnings)},
       {"options",
        {{"max_theta_i_deg", options.max_theta_i_deg},
         {"max_theta_e_deg", options.max_theta_e_deg},
         {"min_signal", options.min_signal},
-        {"pixel_stride", options.pixel_stride}}},
+        {"pixel_stride", options.pixel_stride},
+        {"max_saturated_fraction", options.exposure_advice.max_saturated_fraction},
+        {"max_below_signal_fraction", options.exposure_advice.max_below_signal_fraction}}},
       {"timings_s", {{"total", summary.total_s}, {"decode_cpu", summary.decode_s}}},
   };
   if (session.colour_chart) sidecar["colour"] = ColourSidecar(session, summary.colour_matrices);
@@ -803,6 +845,7 @@ DerenderResult DerenderToFile(const Session& session, const DerenderOptions& opt
   WriteJsonFile(sidecar_file.temporary_path(), DerenderSidecar(session, options, result.summary));
   CommitWithManifest(&samples_file, &sidecar_file);
   Log(1, result.summary.BriefReport());
+  for (const ExposureWarning& warning : result.summary.exposure_warnings) Log(0, "warning: " + warning.message);
   return result;
 }
 

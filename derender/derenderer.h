@@ -7,6 +7,7 @@
 // and, where the sample is not convex, shadows (docs/derender.md).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -18,6 +19,7 @@
 #include "core/logging.h"
 #include "core/sample_file.h"
 #include "core/session.h"
+#include "derender/exposure_advice.h"
 
 namespace ibrdf {
 
@@ -26,9 +28,13 @@ struct DerenderOptions {
   // pixel covers a large, strongly foreshortened patch and tiny normal errors swing cos(theta).
   double max_theta_i_deg = 80.0;
   double max_theta_e_deg = 80.0;
-  // Signal floor: a pixel whose darkest channel has a linear signal below this (normalized file
-  // units, after the black level) is rejected as below the noise floor.
+  // Signal floor, per channel: a channel whose expected linear signal (normalized file units, after
+  // the black level; the mean of the ring of neighbours around the pixel, radiance_image.h) is below
+  // this is not measured there (the sample's `valid` flag is 0); a pixel is kept while any channel is
+  // measured, and rejected as below_signal when none is.
   double min_signal = 0.002;
+  // When clipping or the floor removes a region of theta_h in a channel: warn and name the remedy.
+  ExposureAdviceOptions exposure_advice;
   // Use every n-th pixel in x and in y (1 = all pixels).
   int pixel_stride = 1;
 
@@ -79,6 +85,10 @@ struct DerenderSummary {
   double mesh_setup_s = 0.0;          // mesh: reading it, the ray-tracing scene, the convexity verdict
   // With a colour chart: the matrix applied to the samples' brdf, per light (derender/colour_chart.h).
   std::vector<Eigen::Matrix3d> colour_matrices;
+  // Accepted samples whose channel c (R, G, B) is not measured (valid 0).
+  std::array<uint64_t, 3> channels_not_measured{};
+  ExposureTally exposure;                          // per theta_h band and channel, what was lost
+  std::vector<ExposureWarning> exposure_warnings;  // AdviseExposure of `exposure`
   // "derender: 1234567 samples from 20 photos in 2.1 s; rejected: off_sample 10, saturated 3"
   std::string BriefReport() const;
 };
@@ -102,14 +112,16 @@ DerenderResult Derender(const Session& session, const DerenderOptions& options);
 DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& options);
 
 // The per-pixel core of the analytic path, for one photo's radiance image (radiance_image.h;
-// photo_index gives the pose): appends accepted samples and counts rejections. `rays` holds the
+// photo_index gives the pose): appends accepted samples and counts rejections (and, when `exposure`
+// is given, tallies the pixels that reach the radiometric tests by theta_h band). `rays` holds the
 // undistorted image-plane point (x, y) of every pixel centre, row-major. Any SampleSurface works;
 // a mesh gets none of the mesh path's masks here.
 class SampleSurface;
 struct RadianceImage;
 void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
                    const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
-                   const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected);
+                   const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
+                   ExposureTally* exposure = nullptr);
 
 // Undistorted image-plane points of every pixel centre of the session's camera, row-major.
 std::vector<Eigen::Vector2f> PixelRays(const Camera& camera);

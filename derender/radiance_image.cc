@@ -217,24 +217,95 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
   } else {
     out.exposures_used.clear();
   }
+  out.channel_flags.resize(3 * n);
   const bool noise = radiometry.noise.has_value();
   const float* inverse_flat = impl.flat ? impl.flat->inverse.data() : nullptr;
+
+  // The expected signal of every channel in every exposure: the mean linear signal over the ring of
+  // neighbours (kFloorRing*), by separable box sums over the window (5x5 minus 3x3).
+  const int width = window.x1 - window.x0, height = window.y1 - window.y0;
+  const size_t area = size_t(std::max(width, 0)) * std::max(height, 0);
+  // Every element is written before it is read, so the scratch memory is only grown, never cleared.
+  std::vector<float>& scratch = out.scratch;
+  if (scratch.size() < 3 * area * (2 * m + 2)) scratch.resize(3 * area * (2 * m + 2));
+  float* const linear = scratch.data();
+  float* const expected = linear + 3 * area * m;
+  float* const outer = expected + 3 * area * m;
+  float* const inner = outer + 3 * area;
+  for (size_t e = 0; e < m; ++e) {
+    const Image& image = images[e];
+    float* lin = &linear[3 * area * e];
+    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+      for (int j = rows.begin(); j < rows.end(); ++j) {
+        for (int i = 0; i < width; ++i) {
+          const size_t p = size_t(j + window.y0) * impl.width + (i + window.x0);
+          const float* values = &image.pixels[p * image.channels];
+          for (int c = 0; c < 3; ++c) {
+            const double v = values[image.channels == 1 ? 0 : c];
+            const double l = std::isfinite(v) ? impl.ToLinear(v) - radiometry.black_level : 0.0;
+            lin[3 * (size_t(j) * width + i) + c] = static_cast<float>(l);
+          }
+        }
+      }
+    });
+    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+      for (int j = rows.begin(); j < rows.end(); ++j) {
+        for (int i = 0; i < width; ++i) {
+          for (int c = 0; c < 3; ++c) {
+            double sum_outer = 0.0, sum_inner = 0.0;
+            for (int d = -kFloorRingOuter; d <= kFloorRingOuter; ++d) {
+              if (i + d < 0 || i + d >= width) continue;
+              const double l = lin[3 * (size_t(j) * width + i + d) + c];
+              sum_outer += l;
+              if (std::abs(d) <= kFloorRingInner) sum_inner += l;
+            }
+            outer[3 * (size_t(j) * width + i) + c] = static_cast<float>(sum_outer);
+            inner[3 * (size_t(j) * width + i) + c] = static_cast<float>(sum_inner);
+          }
+        }
+      }
+    });
+    float* exp = &expected[3 * area * e];
+    const auto span = [](int k, int half, int size) {
+      return std::min(k + half, size - 1) - std::max(k - half, 0) + 1;
+    };
+    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+      for (int j = rows.begin(); j < rows.end(); ++j) {
+        for (int i = 0; i < width; ++i) {
+          const int count = span(i, kFloorRingOuter, width) * span(j, kFloorRingOuter, height) -
+                            span(i, kFloorRingInner, width) * span(j, kFloorRingInner, height);
+          for (int c = 0; c < 3; ++c) {
+            double ring = 0.0;
+            for (int d = -kFloorRingOuter; d <= kFloorRingOuter; ++d) {
+              if (j + d < 0 || j + d >= height) continue;
+              ring += outer[3 * (size_t(j + d) * width + i) + c];
+              if (std::abs(d) <= kFloorRingInner) ring -= inner[3 * (size_t(j + d) * width + i) + c];
+            }
+            // A window too small for any ring pixel (a 1x1 window): the pixel's own value.
+            exp[3 * (size_t(j) * width + i) + c] =
+                count > 0 ? static_cast<float>(ring / count) : lin[3 * (size_t(j) * width + i) + c];
+          }
+        }
+      }
+    });
+  }
 
   tbb::parallel_for(tbb::blocked_range<int>(window.y0, window.y1), [&](const tbb::blocked_range<int>& rows) {
     // Per exposure of the pixel being worked on.
     std::vector<double> encoded(3 * m), radiance(3 * m);
-    std::vector<uint8_t> flags(m);
+    std::vector<uint8_t> flags(m), channel(3 * m);
     for (int y = rows.begin(); y < rows.end(); ++y) {
       for (int x = window.x0; x < window.x1; ++x) {
         const size_t p = size_t(y) * impl.width + x;
+        const size_t q = size_t(y - window.y0) * width + (x - window.x0);
         double inverse[3] = {1.0, 1.0, 1.0};
         if (inverse_flat) {
           for (int c = 0; c < 3; ++c) inverse[c] = inverse_flat[3 * p + c];
         }
-        // Each exposure on its own: flags and radiance. `best` is the usable exposure with the most
-        // signal (the longest), the reference for the noise model's weights.
-        int best = -1;
+        // Each exposure on its own: the pixel's flags (every channel, own values), each channel's flags
+        // (the floor on the expected signal) and the radiance.
         uint8_t all_flags = 0xff;
+        bool any_clean = false;
         for (size_t e = 0; e < m; ++e) {
           const Image& image = images[e];
           const float* values = &image.pixels[p * image.channels];
@@ -243,11 +314,18 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
           for (int c = 0; c < 3; ++c) {
             const double v = values[image.channels == 1 ? 0 : c];
             encoded[3 * e + c] = v;
-            finite = finite && std::isfinite(v);
-            saturated = saturated || v >= saturation[e];
-            const double linear = impl.ToLinear(v) - radiometry.black_level;
-            darkest = std::min(darkest, linear);
-            radiance[3 * e + c] = linear / scale[e] * inverse[c];
+            const bool finite_c = std::isfinite(v);
+            const bool saturated_c = v >= saturation[e];
+            finite = finite && finite_c;
+            saturated = saturated || saturated_c;
+            const double linear_c = impl.ToLinear(v) - radiometry.black_level;
+            darkest = std::min(darkest, linear_c);
+            radiance[3 * e + c] = linear_c / scale[e] * inverse[c];
+            uint8_t fc = 0;
+            if (!finite_c) fc |= kPixelNonFinite;
+            if (saturated_c) fc |= kPixelSaturated;
+            if (!(expected[3 * (area * e + q) + c] >= min_signal)) fc |= kPixelBelowSignal;
+            channel[3 * e + c] = fc;
           }
           uint8_t f = 0;
           if (!finite) f |= kPixelNonFinite;
@@ -255,11 +333,13 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
           if (!(darkest >= min_signal)) f |= kPixelBelowSignal;
           flags[e] = f;
           all_flags &= f;
-          if (f == 0 && (best < 0 || scale[e] > scale[best])) best = int(e);
+          any_clean = any_clean || f == 0;
         }
-        if (best < 0) {
-          // No usable exposure: the reasons every exposure shares, or for mixed reasons the one a
-          // longer exposure would not fix (clipping) before the one it would (the floor).
+        if (any_clean) {
+          out.flags[p] = 0;
+        } else {
+          // No exposure with every channel usable: the reasons every exposure shares, or for mixed
+          // reasons the one a longer exposure would not fix (clipping) before the one it would (the floor).
           uint8_t f = all_flags;
           if (f == 0) {
             bool any_saturated = false;
@@ -267,21 +347,35 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
             f = any_saturated ? kPixelSaturated : kPixelBelowSignal;
           }
           out.flags[p] = f;
-          for (int c = 0; c < 3; ++c) {
-            out.radiance[3 * p + c] = static_cast<float>(radiance[c]);
-            out.sigma[3 * p + c] = 0.0f;
-          }
-          if (m > 1) out.exposures_used[p] = 0;
-          continue;
         }
         int used = 0;
         for (int c = 0; c < 3; ++c) {
+          // `best` is the exposure usable in this channel with the most signal (the longest), the
+          // reference for the noise model's weights.
+          int best = -1, longest = 0;
+          uint8_t shared = 0xff;
+          bool any_saturated = false;
+          for (size_t e = 0; e < m; ++e) {
+            const uint8_t fc = channel[3 * e + c];
+            shared &= fc;
+            any_saturated = any_saturated || (fc & kPixelSaturated);
+            if (scale[e] > scale[longest]) longest = int(e);
+            if (fc == 0 && (best < 0 || scale[e] > scale[best])) best = int(e);
+          }
+          if (best < 0) {
+            const uint8_t mixed = any_saturated ? kPixelSaturated : kPixelBelowSignal;
+            out.channel_flags[3 * p + c] = shared != 0 ? shared : mixed;
+            out.radiance[3 * p + c] = static_cast<float>(radiance[3 * longest + c]);
+            out.sigma[3 * p + c] = 0.0f;
+            continue;
+          }
           // Inverse-variance weights, the variance predicted from the reference radiance (not from
           // each exposure's own noisy value, which would favour exposures that happened to read low).
           const double reference = radiance[3 * best + c];
           double weight_sum = 0.0, weighted = 0.0;
+          int used_c = 0;
           for (size_t e = 0; e < m; ++e) {
-            if (flags[e] != 0) continue;
+            if (channel[3 * e + c] != 0) continue;
             double weight;
             if (noise) {
               const double to_radiance = inverse[c] / scale[e];
@@ -292,12 +386,16 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
             }
             weight_sum += weight;
             weighted += weight * radiance[3 * e + c];
-            used += c == 0;
+            ++used_c;
           }
-          out.radiance[3 * p + c] = static_cast<float>(weighted / weight_sum);
+          const double merged = weighted / weight_sum;
+          out.radiance[3 * p + c] = static_cast<float>(merged);
           out.sigma[3 * p + c] = noise ? static_cast<float>(1.0 / std::sqrt(weight_sum)) : 0.0f;
+          // A negative radiance (noise around a tiny signal after the black level) is no measurement of
+          // a non-negative BRDF: flagged as below the floor (rare where the expected signal passes it).
+          out.channel_flags[3 * p + c] = merged >= 0.0 ? uint8_t(0) : uint8_t(kPixelBelowSignal);
+          if (merged >= 0.0) used = std::max(used, used_c);
         }
-        out.flags[p] = 0;
         if (m > 1) out.exposures_used[p] = static_cast<uint8_t>(used);
       }
     }

@@ -19,12 +19,22 @@
 
 namespace ibrdf {
 
-// Per-pixel flags of a RadianceImage (bits; 0 = measurable).
+// Per-pixel flags of a RadianceImage (bits; 0 = measurable). As per-pixel flags (`flags`) they tell
+// whether all three channels are measurable, each tested on the pixel's own values; as per-channel
+// flags (`channel_flags`) they tell one channel's reason, the floor tested on the expected signal
+// (RadianceReader::ReadWindow).
 enum PixelFlag : uint8_t {
   kPixelNonFinite = 1,    // a channel is NaN or infinite in the file (in every exposure of a bracket)
   kPixelSaturated = 2,    // a channel reached the saturation level (in every exposure of a bracket)
   kPixelBelowSignal = 4,  // the darkest channel's linear signal is below the floor (in every exposure)
 };
+
+// Neighbourhood of the expected signal behind the per-channel signal floor: the ring of the 5x5 pixels
+// around a pixel without its inner 3x3 (16 pixels, fewer at the photo's edge), whose noise is
+// independent of the pixel's own (even after a bilinear demosaic), so selecting on it does not bias
+// the kept values (docs/decisions.md, "Per-channel validity").
+constexpr int kFloorRingOuter = 2;  // half-width of the outer square
+constexpr int kFloorRingInner = 1;  // half-width of the inner square left out
 
 struct RadianceImage {
   int width = 0;
@@ -34,12 +44,20 @@ struct RadianceImage {
   std::vector<float> radiance;
   // 3 floats per pixel: one standard deviation of radiance from the camera noise model (0 without one).
   std::vector<float> sigma;
-  std::vector<uint8_t> flags;  // one per pixel, PixelFlag bits
+  std::vector<uint8_t> flags;  // one per pixel, PixelFlag bits (all three channels, own values)
+  // 3 per pixel, PixelFlag bits of each channel alone (0: the channel is measured). The signal floor
+  // is tested on the channel's expected signal, the mean over the kFloorRing* ring around the pixel in
+  // the same exposure, not on its own noisy value; a merged radiance below 0 is flagged below the floor.
+  // radiance and sigma of a flagged channel are not measurements (sigma 0).
+  std::vector<uint8_t> channel_flags;
   // Per pixel, how many exposures of the bracket were merged (0 where flagged). Filled for brackets of
   // more than one photo only (empty otherwise).
   std::vector<uint8_t> exposures_used;
   // Per pixel, 0 where the photos' masks exclude it, 1 where usable (photo_mask.h); empty: no mask.
   std::vector<uint8_t> mask;
+  // Working memory of RadianceReader::ReadWindow (the expected-signal pass), kept so that a buffer
+  // reused from photo to photo allocates it once; holds nothing a caller reads.
+  std::vector<float> scratch;
 
   size_t Index(int x, int y) const { return size_t(y) * width + x; }
 };

@@ -262,6 +262,7 @@ ConsistencyReport CheckConsistency(const std::vector<BrdfSample>& samples, const
     if (!(std::isfinite(s.theta_i) && std::isfinite(s.theta_e) && std::isfinite(s.delta_phi))) continue;
     if (!(s.theta_i >= 0.0f && s.theta_i <= max_theta && s.theta_e >= 0.0f && s.theta_e <= max_theta)) continue;
     if (!(std::isfinite(s.brdf[0]) && std::isfinite(s.brdf[1]) && std::isfinite(s.brdf[2]))) continue;
+    if (!s.AllValid()) continue;  // a channel not measured (clipped, below the floor): no pair figure
     usable.push_back(uint32_t(i));
   }
   ConsistencyReport report;

@@ -204,6 +204,7 @@ bool LocalRegressionOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_RANGE(bin_fraction_h, 0.0, 1.0);
   IBRDF_CHECK_OPTION_RANGE(bin_fraction_d, 0.0, 1.0);
   if (log_space) IBRDF_CHECK_OPTION_GT(log_floor, 0.0);
+  IBRDF_CHECK_OPTION_GE(max_log_noise_correction, 0.0);
   return true;
 }
 
@@ -277,10 +278,59 @@ Eigen::Vector3d RegressionCoordinates(const Eigen::Vector3d& wi, const Eigen::Ve
   return RegressionCoordinates(angles);
 }
 
-LocalRegression::LocalRegression(const std::vector<BrdfSample>& samples, const LocalRegressionOptions& options)
+namespace {
+
+// The samples a channel's own regression uses: those that measured channel c, with its value in all
+// three channels (so the regression's three channels are one).
+std::vector<BrdfSample> ChannelSamples(const std::vector<BrdfSample>& samples, int c) {
+  std::vector<BrdfSample> out;
+  for (const BrdfSample& s : samples) {
+    if (!s.valid[c]) continue;
+    BrdfSample t = s;
+    for (int k = 0; k < 3; ++k) {
+      t.brdf[k] = s.brdf[c];
+      t.sigma[k] = s.sigma[c];
+      t.valid[k] = 1;
+    }
+    out.push_back(t);
+  }
+  return out;
+}
+
+}  // namespace
+
+LocalRegression::LocalRegression(const std::vector<BrdfSample>& all_samples, const LocalRegressionOptions& options)
     : impl_(std::make_unique<Impl>()), options_(options) {
   std::string why;
   if (!options.Check(&why)) ThrowError("local regression options", why);
+  // Per-channel validity: channels some samples did not measure get their own regression; in the shared
+  // one their values are replaced by a fully measured channel's (so an unmeasured value cannot sway the
+  // shared fit's degree or range checks), or left as they are when no channel is fully measured.
+  uint64_t unmeasured[3] = {0, 0, 0};
+  for (const BrdfSample& s : all_samples) {
+    for (int c = 0; c < 3; ++c) unmeasured[c] += s.valid[c] == 0;
+  }
+  int full = -1;
+  for (int c = 0; c < 3; ++c) {
+    if (unmeasured[c] == 0 && full < 0) full = c;
+  }
+  std::vector<BrdfSample> replaced;
+  if (unmeasured[0] + unmeasured[1] + unmeasured[2] > 0) {
+    for (int c = 0; c < 3; ++c) {
+      if (unmeasured[c] > 0) {
+        channel_regressions_[c] = std::make_unique<LocalRegression>(ChannelSamples(all_samples, c), options);
+      }
+    }
+    if (full >= 0) {
+      replaced = all_samples;
+      for (BrdfSample& s : replaced) {
+        for (int c = 0; c < 3; ++c) {
+          if (unmeasured[c] > 0) s.brdf[c] = s.brdf[full];
+        }
+      }
+    }
+  }
+  const std::vector<BrdfSample>& samples = replaced.empty() ? all_samples : replaced;
   Impl& impl = *impl_;
   impl.fold_reciprocity = options.fold_reciprocity;
   impl.fold_bilateral = options.fold_bilateral;
@@ -308,7 +358,16 @@ LocalRegression::LocalRegression(const std::vector<BrdfSample>& samples, const L
       xyz[3 * i + 1] = static_cast<float>(uvw[1] * impl.scale_h);
       xyz[3 * i + 2] = static_cast<float>(uvw[2] * impl.scale_d);
       for (int c = 0; c < 3; ++c) {
-        values[3 * i + c] = options.log_space ? std::log(std::max<float>(f[c], float(options.log_floor))) : f[c];
+        if (!options.log_space) {
+          values[3 * i + c] = f[c];
+          continue;
+        }
+        double value = std::log(std::max<float>(f[c], float(options.log_floor)));
+        if (options.log_noise_correction && s.sigma[c] > 0.0f && f[c] > 0.0f) {
+          const double relative = double(s.sigma[c]) / f[c];
+          value += std::min(0.5 * relative * relative, options.max_log_noise_correction);
+        }
+        values[3 * i + c] = static_cast<float>(value);
       }
       valid[i] = 1;
     }
@@ -400,6 +459,32 @@ size_t LocalRegression::points() const { return impl_->counts.size(); }
 double LocalRegression::theta_d_min() const { return impl_->theta_d_min; }
 
 double LocalRegression::theta_d_max() const { return impl_->theta_d_max; }
+
+int LocalRegression::separate_channels() const {
+  int bits = 0;
+  for (int c = 0; c < 3; ++c) bits |= channel_regressions_[c] ? 1 << c : 0;
+  return bits;
+}
+
+Estimate LocalRegression::EvaluateAt(const Eigen::Vector3d& uvw, int64_t exclude) const {
+  Estimate estimate = Fit(uvw, exclude, -1, nullptr);
+  for (int c = 0; c < 3; ++c) {
+    if (!channel_regressions_[c]) continue;
+    const Estimate e = channel_regressions_[c]->EvaluateAt(uvw);
+    estimate.value[c] = e.value[c];
+    // The least favourable reliability over the channels.
+    estimate.effective_samples = std::min(estimate.effective_samples, e.effective_samples);
+    estimate.rcond = std::min(estimate.rcond, e.rcond);
+    estimate.growth = std::max(estimate.growth, e.growth);
+    estimate.centroid_offset = std::max(estimate.centroid_offset, e.centroid_offset);
+    estimate.nearest = std::max(estimate.nearest, e.nearest);
+    estimate.neighbors = std::min(estimate.neighbors, e.neighbors);
+    estimate.degree = std::min(estimate.degree, e.degree);
+    estimate.status = std::max(estimate.status, e.status);
+    estimate.clamped = estimate.clamped || e.clamped;
+  }
+  return estimate;
+}
 
 Estimate LocalRegression::Evaluate(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const {
   return EvaluateAt(RegressionCoordinates(wi, wo));
@@ -548,6 +633,31 @@ std::vector<Estimate> LocalRegression::EvaluateMany(const std::vector<Eigen::Vec
 }
 
 CrossValidationScore LocalRegression::CrossValidate(size_t count, uint64_t seed) const {
+  if (separate_channels() == 0) return CrossValidateShared(count, seed);
+  // Each channel scored by the regression that serves it, weighted by the channels it serves.
+  CrossValidationScore score;
+  int shared_channels = 0;
+  for (int c = 0; c < 3; ++c) shared_channels += channel_regressions_[c] ? 0 : 1;
+  std::vector<std::pair<CrossValidationScore, double>> parts;
+  if (shared_channels > 0) parts.push_back({CrossValidateShared(count, seed), shared_channels / 3.0});
+  for (int c = 0; c < 3; ++c) {
+    if (channel_regressions_[c]) parts.push_back({channel_regressions_[c]->CrossValidate(count, seed), 1.0 / 3.0});
+  }
+  double loo = 0.0, residual = 0.0, gcv = 0.0;
+  for (const auto& [part, weight] : parts) {
+    score.points = std::max(score.points, part.points);
+    loo += weight * part.loo_rms * part.loo_rms;
+    residual += weight * part.residual_rms * part.residual_rms;
+    gcv += weight * part.gcv_rms * part.gcv_rms;
+    score.mean_leverage += weight * part.mean_leverage;
+  }
+  score.loo_rms = std::sqrt(loo);
+  score.residual_rms = std::sqrt(residual);
+  score.gcv_rms = std::sqrt(gcv);
+  return score;
+}
+
+CrossValidationScore LocalRegression::CrossValidateShared(size_t count, uint64_t seed) const {
   CrossValidationScore score;
   const size_t n = size();
   if (n == 0) return score;

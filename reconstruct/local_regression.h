@@ -51,6 +51,12 @@ struct LocalRegressionOptions {
   // clamped to `log_floor` first. On by default: 0.84 % against 1.63 % RMS on noise-free bluepaint.
   bool log_space = true;
   double log_floor = 1e-6;  // 1/sr
+  // In log space, correct each sample's log value for the noise's curvature bias: E[log f] falls short
+  // of log E[f] by about (sigma / f)^2 / 2, so 0.5 (sigma / f)^2 is added (capped at
+  // max_log_noise_correction); samples without sigma are left as they are. A dim channel kept with its
+  // noise (per-channel validity) would otherwise come out low: -2 % at 20 % noise per sample.
+  bool log_noise_correction = true;
+  double max_log_noise_correction = 0.125;  // the correction at sigma / f = 0.5
   // A degree is used only if the normal matrix's reciprocal condition (LDLT estimate) is above this and
   // the effective sample count is at least `min_samples_per_coefficient` times the coefficient count;
   // otherwise the next lower degree is tried.
@@ -150,7 +156,10 @@ Eigen::Vector3d RegressionCoordinates(const Eigen::Vector3d& wi, const Eigen::Ve
 class LocalRegression {
  public:
   // Converts and folds the samples and builds the kd-tree (TBB-parallel conversion). Samples with a
-  // non-finite value or direction are skipped and counted.
+  // non-finite value or direction are skipped and counted. Per-channel validity (BrdfSample::valid):
+  // a channel that some samples did not measure is regressed on its own from the samples that did
+  // (a second regression per such channel, built the same way), so an unmeasured value never enters
+  // a fit; the channels every sample measured share this one.
   LocalRegression(const std::vector<BrdfSample>& samples, const LocalRegressionOptions& options);
   ~LocalRegression();
   LocalRegression(const LocalRegression&) = delete;
@@ -160,18 +169,22 @@ class LocalRegression {
   Estimate Evaluate(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const;
   Estimate Evaluate(const HalfDiffAngles& angles) const;
   // At regression coordinates (u, v, w); `exclude` is a sample index left out of the fit (for
-  // leave-one-out), or -1.
-  Estimate EvaluateAt(const Eigen::Vector3d& uvw, int64_t exclude = -1) const { return Fit(uvw, exclude, -1, nullptr); }
+  // leave-one-out), or -1 (it indexes the shared regression; per-channel ones leave nothing out). With
+  // per-channel regressions the reliability fields are the least favourable over the channels.
+  Estimate EvaluateAt(const Eigen::Vector3d& uvw, int64_t exclude = -1) const;
   // Many points, TBB-parallel; `counts` (optional) gets their reliability counts.
   std::vector<Estimate> EvaluateMany(const std::vector<Eigen::Vector3d>& uvw, ReliabilityCounts* counts) const;
 
   // Cross-validation scores at `count` samples chosen with a fixed seed (for bandwidth selection,
-  // reconstruct/bandwidth_selection.h); the left-out sample is taken out of its bin exactly.
+  // reconstruct/bandwidth_selection.h); the left-out sample is taken out of its bin exactly. With
+  // per-channel regressions: the mean of their scores, weighted by the channels each serves.
   CrossValidationScore CrossValidate(size_t count, uint64_t seed = 1) const;
 
-  size_t size() const;    // samples used
+  size_t size() const;    // samples used (by the shared regression)
   size_t points() const;  // points in the kd-tree: occupied bins (or samples without binning)
   uint64_t skipped_samples() const { return skipped_; }
+  // Channels regressed on their own because some samples did not measure them (bit c for channel c).
+  int separate_channels() const;
   // The range of theta_d (radians) the samples cover; both 0 without samples.
   double theta_d_min() const;
   double theta_d_max() const;
@@ -182,10 +195,14 @@ class LocalRegression {
   // `self` in the estimate (0 when it is not in the kernel).
   Estimate Fit(const Eigen::Vector3d& uvw, int64_t exclude, int64_t self, double* leverage) const;
 
+  CrossValidationScore CrossValidateShared(size_t count, uint64_t seed) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   LocalRegressionOptions options_;
   uint64_t skipped_ = 0;
+  // Per-channel validity: channel c's regression from the samples that measured it (null: shared).
+  std::unique_ptr<LocalRegression> channel_regressions_[3];
 };
 
 }  // namespace ibrdf

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -20,6 +21,8 @@
 namespace ibrdf {
 namespace {
 
+// A channel the sample did not measure (BrdfSample::valid 0) has an infinite sigma: it adds no
+// residual (Lafortune skips it, GGX weighs it by 1 / sigma = 0) and no start value.
 struct FitSample {
   Eigen::Vector3d wi, wo, value, sigma;
 };
@@ -49,6 +52,7 @@ std::vector<FitSample> PickSamples(const std::vector<BrdfSample>& samples, const
       f.value[c] = s.brdf[c];
       f.sigma[c] =
           std::max({double(s.sigma[c]), options.relative_floor * std::abs(f.value[c]), options.absolute_floor});
+      if (!s.valid[c]) f.sigma[c] = std::numeric_limits<double>::infinity();
     }
     picked.push_back(f);
   }
@@ -72,6 +76,7 @@ double RelativeRms(const BrdfModel& model, const std::vector<FitSample>& samples
   for (const FitSample& s : samples) {
     const Eigen::Vector3d f = model.Eval(s.wi, s.wo);
     for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(s.sigma[c])) continue;  // not measured
       const double rel = (f[c] - s.value[c]) / std::max(std::abs(s.value[c]), 1e-6);
       sum += rel * rel;
       ++count;
@@ -117,8 +122,11 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
   Eigen::Vector3d minimum = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d maximum = Eigen::Vector3d::Zero();
   for (const FitSample& s : samples) {
-    minimum = minimum.cwiseMin(s.value);
-    maximum = maximum.cwiseMax(s.value);
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(s.sigma[c])) continue;  // not measured
+      minimum[c] = std::min(minimum[c], s.value[c]);
+      maximum[c] = std::max(maximum[c], s.value[c]);
+    }
   }
   std::array<std::array<double, kParameters>, 3 * kStarts> solutions;
   std::array<double, 3 * kStarts> costs;
@@ -131,6 +139,7 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
     }
     ceres::Problem problem;
     for (const FitSample& s : samples) {
+      if (!std::isfinite(s.sigma[c])) continue;  // not measured
       problem.AddResidualBlock(new LafortuneAnalyticResidual<kLobes>(s.wi, s.wo, s.value[c], s.sigma[c]),
                                new ceres::HuberLoss(options.huber_scale), p);
     }
@@ -281,7 +290,11 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
   result.samples_used = picked.size();
   if (picked.size() < 7) ThrowError("ggx fit", "only " + std::to_string(picked.size()) + " usable samples");
   Eigen::Vector3d minimum = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  for (const FitSample& s : picked) minimum = minimum.cwiseMin(s.value);
+  for (const FitSample& s : picked) {
+    for (int c = 0; c < 3; ++c) {
+      if (std::isfinite(s.sigma[c])) minimum[c] = std::min(minimum[c], s.value[c]);
+    }
+  }
   const double alpha_starts[3] = {0.05, 0.2, 0.5};
   std::array<std::array<double, 7>, 3> solutions;
   std::array<double, 3> costs;

@@ -38,11 +38,25 @@ std::vector<Cell> Cells(double max_theta_deg, int stride) {
   return cells;
 }
 
+constexpr int kThetaHBands = 9;
+constexpr double kThetaHBandDeg = 10.0;
+
 class Accumulator {
  public:
-  void Add(const Eigen::Vector3d& f, const Eigen::Vector3d& truth) {
+  Accumulator() {
+    for (int b = 0; b < kThetaHBands; ++b) {
+      ThetaHBandBias band;
+      band.theta_h_min_deg = b * kThetaHBandDeg;
+      band.theta_h_max_deg = (b + 1) * kThetaHBandDeg;
+      error_.theta_h_bands.push_back(band);
+    }
+  }
+  void Add(const Eigen::Vector3d& f, const Eigen::Vector3d& truth, double theta_h) {
     if (!(truth.array() > 0.0).all()) return;
     const Eigen::Vector3d rel = (f - truth).cwiseQuotient(truth);
+    const int band = std::clamp(static_cast<int>(theta_h * 180.0 / M_PI / kThetaHBandDeg), 0, kThetaHBands - 1);
+    ++error_.theta_h_bands[band].points;
+    error_.theta_h_bands[band].mean_rel += rel;
     sum_ += rel.cwiseAbs2();
     for (int c = 0; c < 3; ++c) abs_[c].push_back(std::abs(rel[c]));
     ++error_.points;
@@ -56,6 +70,9 @@ class Accumulator {
         error_.median[c] = PercentileInPlace(&abs_[c], 0.5);
         error_.p95[c] = PercentileInPlace(&abs_[c], 0.95);
       }
+    }
+    for (ThetaHBandBias& band : error_.theta_h_bands) {
+      if (band.points > 0) band.mean_rel /= double(band.points);
     }
     return error_;
   }
@@ -89,7 +106,7 @@ ReconstructionError CompareRegressionWithTruth(const LocalRegression& regression
       accumulator.Outside();
       continue;
     }
-    accumulator.Add(e.value, truth.Eval(cells[i].wi, cells[i].wo));
+    accumulator.Add(e.value, truth.Eval(cells[i].wi, cells[i].wo), cells[i].angles.theta_h);
   }
   return accumulator.Finish();
 }
@@ -104,17 +121,29 @@ ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfMode
       accumulator.Outside();
       continue;
     }
-    accumulator.Add(table.Cell(cell.flat), truth.Eval(cell.wi, cell.wo));
+    accumulator.Add(table.Cell(cell.flat), truth.Eval(cell.wi, cell.wo), cell.angles.theta_h);
   }
   return accumulator.Finish();
 }
 
 nlohmann::json ToJson(const ReconstructionError& error) {
   auto rgb = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
-  return {{"cells_scored", error.points},           {"cells_outside", error.outside},
-          {"coverage", error.coverage()},           {"rel_rms_error", rgb(error.rel_rms)},
-          {"rel_rms_error_all", error.rel_rms_all}, {"median_abs_rel_error", rgb(error.median)},
-          {"p95_abs_rel_error", rgb(error.p95)}};
+  return {{"cells_scored", error.points},
+          {"cells_outside", error.outside},
+          {"coverage", error.coverage()},
+          {"rel_rms_error", rgb(error.rel_rms)},
+          {"rel_rms_error_all", error.rel_rms_all},
+          {"median_abs_rel_error", rgb(error.median)},
+          {"p95_abs_rel_error", rgb(error.p95)},
+          {"theta_h_bands", [&] {
+             nlohmann::json bands = nlohmann::json::array();
+             for (const ThetaHBandBias& band : error.theta_h_bands) {
+               bands.push_back({{"theta_h_deg", {band.theta_h_min_deg, band.theta_h_max_deg}},
+                                {"cells_scored", band.points},
+                                {"mean_signed_rel_error", rgb(band.mean_rel)}});
+             }
+             return bands;
+           }()}};
 }
 
 std::string MerlLookupCheck::Brief() const {

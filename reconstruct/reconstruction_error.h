@@ -18,6 +18,14 @@
 
 namespace ibrdf {
 
+// The signed relative error of one band of theta_h (the bias, which averaging over the whole domain
+// hides: a channel reconstructed high where it was dim).
+struct ThetaHBandBias {
+  double theta_h_min_deg = 0.0, theta_h_max_deg = 0.0;
+  size_t points = 0;                                   // cells scored in the band
+  Eigen::Vector3d mean_rel = Eigen::Vector3d::Zero();  // mean of (f - f_true) / f_true per channel
+};
+
 struct ReconstructionError {
   size_t points = 0;   // cells scored
   size_t outside = 0;  // cells within the theta limit left out (no samples within the kernel)
@@ -25,6 +33,7 @@ struct ReconstructionError {
   double rel_rms_all = 0.0;                           // over channels
   Eigen::Vector3d median = Eigen::Vector3d::Zero();   // of |f - f_true| / f_true
   Eigen::Vector3d p95 = Eigen::Vector3d::Zero();      // 95th percentile of |f - f_true| / f_true
+  std::vector<ThetaHBandBias> theta_h_bands;          // 10-degree bands of theta_h, 0 to 90
   double coverage() const { return points + outside ? double(points) / double(points + outside) : 0.0; }
   std::string Brief() const;
 };

@@ -20,21 +20,27 @@ struct Accumulator {
   std::vector<double> abs_rel[3];
   double sum_rel[3] = {0, 0, 0};
 
-  void Add(const Eigen::Vector3d& rel) {
+  size_t count = 0;  // samples added (each with at least one valid channel)
+
+  // Adds the channels of a sample that are measurements (valid[c]); the others are left out.
+  void Add(const Eigen::Vector3d& rel, const uint8_t valid[3]) {
+    ++count;
     for (int c = 0; c < 3; ++c) {
+      if (!valid[c]) continue;
       abs_rel[c].push_back(std::abs(rel[c]));
       sum_rel[c] += rel[c];
     }
   }
   ErrorStats Finish() {
     ErrorStats stats;
-    stats.count = abs_rel[0].size();
+    stats.count = count;
     if (stats.count == 0) return stats;
     for (int c = 0; c < 3; ++c) {
       std::vector<double>& v = abs_rel[c];
+      if (v.empty()) continue;
       stats.median[c] = PercentileInPlace(&v, 0.5);
       stats.p95[c] = PercentileInPlace(&v, 0.95);
-      stats.bias[c] = sum_rel[c] / stats.count;
+      stats.bias[c] = sum_rel[c] / double(v.size());
     }
     return stats;
   }
@@ -66,13 +72,13 @@ TruthComparison CompareWithTruth(const std::vector<BrdfSample>& samples, const B
     }
     const Eigen::Vector3d f(s.brdf[0], s.brdf[1], s.brdf[2]);
     const Eigen::Vector3d rel = (f - f_true).cwiseQuotient(f_true);
-    overall.Add(rel);
+    overall.Add(rel, s.valid);
     const double theta_deg = std::max(s.theta_i, s.theta_e) * 180.0 / M_PI;
     for (size_t b = 0; b + 1 < band_edges_deg.size(); ++b) {
       const bool last = b + 2 == band_edges_deg.size();
       if (theta_deg >= band_edges_deg[b] &&
           (theta_deg < band_edges_deg[b + 1] || (last && theta_deg <= band_edges_deg[b + 1]))) {
-        bands[b].Add(rel);
+        bands[b].Add(rel, s.valid);
         break;
       }
     }

@@ -25,6 +25,15 @@ void AddSamples(const fs::path& dir, nlohmann::json* summary) {
                            {"pixels_examined", side->Count("/counts/pixels_examined", 0)},
                            {"accepted", side->Count("/counts/accepted", 0)},
                            {"rejected", side->ObjectOr("/counts/rejected", nlohmann::json::object())}};
+  // Exposure advice (issue 13, part 8): the sentences of derender's warnings, when it had any.
+  nlohmann::json warnings = nlohmann::json::array();
+  const nlohmann::json list = side->ValueOr("/exposure/warnings", nlohmann::json::array());
+  if (list.is_array()) {
+    for (const nlohmann::json& w : list) {
+      if (w.is_object() && w.contains("message") && w["message"].is_string()) warnings.push_back(w["message"]);
+    }
+  }
+  (*summary)["samples"]["exposure_warnings"] = warnings;
 }
 
 // consistency.json: `ibrdf check`'s figures (null where a figure is not valid).
@@ -129,6 +138,12 @@ std::vector<std::string> RunHeadline(const nlohmann::json& summary_json) {
     }
     lines.push_back("samples: " + std::to_string(summary.Count("/samples/accepted")) +
                     " accepted; rejected: " + (rejected.empty() ? "none" : rejected));
+    const nlohmann::json warnings = summary.ValueOr("/samples/exposure_warnings", nlohmann::json::array());
+    if (warnings.is_array()) {
+      for (const nlohmann::json& w : warnings) {
+        if (w.is_string()) lines.push_back("warning: " + w.get<std::string>());
+      }
+    }
   }
   if (summary.Has("/consistency")) {
     lines.push_back("consistency: reciprocity " + Percent(summary.ValueOr("/consistency/reciprocity", nullptr)) +

@@ -48,7 +48,9 @@ std::vector<BrdfSample> TestSamples() {
     s.image = static_cast<uint32_t>(7 * r + 1);
     s.pixel[0] = static_cast<uint32_t>(640 + r);
     s.pixel[1] = static_cast<uint32_t>(480 + 2 * r);
+    s.exposures = static_cast<uint8_t>(r + 1);
   }
+  samples[1].valid[2] = 0;  // a blue channel below the signal floor
   return samples;
 }
 
@@ -103,7 +105,9 @@ void ExpectSameSamples(const std::vector<BrdfSample>& a, const std::vector<BrdfS
 }
 
 TEST(BrdfSample, LayoutMatchesTheDtype) {
-  EXPECT_EQ(sizeof(BrdfSample), 72u);
+  EXPECT_EQ(sizeof(BrdfSample), 76u);
+  EXPECT_EQ(offsetof(BrdfSample, valid), 72u);
+  EXPECT_EQ(offsetof(BrdfSample, exposures), 75u);
   EXPECT_EQ(offsetof(BrdfSample, theta_i), 24u);
   EXPECT_EQ(offsetof(BrdfSample, brdf), 36u);
   EXPECT_EQ(offsetof(BrdfSample, image), 60u);
@@ -238,7 +242,8 @@ TEST_F(SampleFileTest, NumpyLoadsTheFile) {
       "import sys, numpy\n"
       "s = numpy.load(sys.argv[1])\n"
       "assert s.shape == (3,), s.shape\n"
-      "assert s.dtype.itemsize == 72, s.dtype\n"
+      "assert s.dtype.itemsize == 76, s.dtype\n"
+      "assert s['valid'].shape == (3, 3) and s['valid'][1].tolist() == [1, 1, 0], s['valid']\n"
       "assert s['brdf'].shape == (3, 3), s['brdf'].shape\n"
       "assert s['brdf'][1, 2] == 1.75, s['brdf'][1]\n"
       "assert list(s['wi'][2]) == [1, 0, 0], s['wi'][2]\n"
@@ -249,7 +254,8 @@ TEST_F(SampleFileTest, NumpyLoadsTheFile) {
   EXPECT_TRUE(RunPython(script, path));
 }
 
-// ReadSamples reads a file that NumPy wrote with the same dtype.
+// ReadSamples reads a version 1 file (72-byte rows, no per-channel validity) that NumPy wrote: every
+// channel valid, exposures not recorded.
 TEST_F(SampleFileTest, ReadsFileWrittenByNumpy) {
   if (!HaveNumpy()) GTEST_SKIP() << kPython << " with numpy is not installed";
   const std::string path = Path("from_numpy.npy");
@@ -275,6 +281,37 @@ TEST_F(SampleFileTest, ReadsFileWrittenByNumpy) {
   EXPECT_EQ(samples[1].pixel[0], 3u);
   EXPECT_EQ(samples[1].pixel[1], 4u);
   EXPECT_EQ(samples[0].image, 9u);
+  for (const BrdfSample& s : samples) {
+    EXPECT_TRUE(s.AllValid());
+    EXPECT_EQ(s.exposures, 0);
+  }
+}
+
+// ReadSamples reads a version 2 file that NumPy wrote, per-channel validity included, and refuses a row
+// without any valid channel or with a flag other than 0 or 1.
+TEST_F(SampleFileTest, ReadsValidityWrittenByNumpy) {
+  if (!HaveNumpy()) GTEST_SKIP() << kPython << " with numpy is not installed";
+  const std::string path = Path("valid_from_numpy.npy");
+  const std::string script =
+      "import sys, numpy\n"
+      "dt = numpy.dtype([('wi', '<f4', (3,)), ('wo', '<f4', (3,)), ('theta_i', '<f4'), "
+      "('theta_e', '<f4'), ('delta_phi', '<f4'), ('brdf', '<f4', (3,)), ('sigma', '<f4', (3,)), "
+      "('image', '<u4'), ('pixel', '<u4', (2,)), ('valid', 'u1', (3,)), ('exposures', 'u1')])\n"
+      "a = numpy.zeros(2, dtype=dt)\n"
+      "a['wi'][:] = [0, 0, 1]\n"
+      "a['wo'][:] = [0, 0, 1]\n"
+      "a['valid'][0] = [1, 1, 1]\n"
+      "a['valid'][1] = [1, 0, 0]\n"
+      "a['exposures'] = [3, 1]\n"
+      "numpy.save(sys.argv[1], a)\n";
+  ASSERT_TRUE(RunPython(script, path));
+  const std::vector<BrdfSample> samples = ReadSamples(path);
+  ASSERT_EQ(samples.size(), 2u);
+  EXPECT_TRUE(samples[0].AllValid());
+  EXPECT_TRUE(samples[1].Valid(0));
+  EXPECT_FALSE(samples[1].Valid(1));
+  EXPECT_FALSE(samples[1].Valid(2));
+  EXPECT_EQ(samples[0].exposures, 3);
 }
 
 // Issue 17: sample files with NaN or infinite values, angles out of range, |wi| != 1, negative sigma or
@@ -292,6 +329,8 @@ TEST_F(SampleFileTest, InvalidSamplesAreErrors) {
       {[&](BrdfSample* s) { s->wo[0] = 0.5f; }, "|wo|"},
       {[&](BrdfSample* s) { s->sigma[0] = -1.0f; }, "sigma[0]"},
       {[&](BrdfSample* s) { s->brdf[2] = -0.5f; }, "brdf[2]"},
+      {[&](BrdfSample* s) { s->valid[0] = s->valid[1] = s->valid[2] = 0; }, "no channel is valid"},
+      {[&](BrdfSample* s) { s->valid[1] = 7; }, "valid flag"},
   };
   const std::string path = Path("bad.npy");
   for (const auto& [spoil, expected] : cases) {

@@ -56,6 +56,42 @@ TEST(RadianceImage, SrgbBlackLevelExposureAndGain) {
   EXPECT_TRUE(image.exposures_used.empty());
 }
 
+// Issue 13, part 8: the floor is per channel and tested on the expected signal (the ring of 16
+// neighbours at distance 2), not on the pixel's own value, so a reading that happens to be high under
+// the floor is not selected and a reading that happens to be low above it is kept; a clipped channel
+// leaves the others measured.
+TEST(RadianceImage, PerChannelFloorOnTheExpectedSignal) {
+  ScratchDir dir;
+  Session session = SmallSession(dir);
+  session.radiometry.saturation_stated = true;
+  session.radiometry.saturation_level = 1.0;
+  Image image(kWidth, kHeight, 3);
+  for (size_t p = 0; p < size_t(kWidth) * kHeight; ++p) {
+    image.pixels[3 * p + 0] = 0.5f;    // red: well measured
+    image.pixels[3 * p + 1] = 0.001f;  // green: under the floor everywhere ...
+    image.pixels[3 * p + 2] = 0.01f;   // blue: above it everywhere ...
+  }
+  const size_t noisy = size_t(3) * kWidth + 4;    // pixel (4, 3)
+  image.pixels[3 * noisy + 1] = 0.01f;            // ... but this green reading is high
+  image.pixels[3 * noisy + 2] = 0.0f;             // ... and this blue reading is low
+  const size_t clipped = size_t(1) * kWidth + 1;  // pixel (1, 1): red clipped
+  image.pixels[3 * clipped + 0] = 1.0f;
+  WriteImage(dir / "a.exr", image, PixelFormat::kFloat);
+  PhotoSpec photo;
+  photo.file = "a.exr";
+  photo.exposure_s = 1.0;
+  const RadianceImage out = RadianceReader(session).Read({photo}, 0.002);
+  for (size_t p = 0; p < out.flags.size(); ++p) {
+    EXPECT_EQ(out.channel_flags[3 * p + 0], p == clipped ? kPixelSaturated : 0) << "pixel " << p;
+    EXPECT_EQ(out.channel_flags[3 * p + 1], kPixelBelowSignal) << "pixel " << p;
+    EXPECT_EQ(out.channel_flags[3 * p + 2], 0) << "pixel " << p;
+  }
+  EXPECT_FLOAT_EQ(out.radiance[3 * noisy + 2], 0.0f);  // kept as measured: 0 is a valid reading
+  // The pixel-level flags keep the old test on the pixel's own values (white-reference calibration).
+  EXPECT_NE(out.flags[noisy], 0);
+  EXPECT_NE(out.flags[clipped], 0);
+}
+
 TEST(RadianceImage, LookupTableMatchesTheResponse) {
   ScratchDir dir;
   Session session = SmallSession(dir);

@@ -161,6 +161,24 @@ TEST_F(SummaryTest, AbsentOptionalKeysAndFiles) {
   EXPECT_EQ(summary["truth"]["brdf_coverage"], 0.5);
 }
 
+// Derender's exposure advice (issue 13, part 8) reaches summary.json and the headline; a sidecar
+// without it (older runs) gives an empty list.
+TEST_F(SummaryTest, ExposureWarningsReachTheHeadline) {
+  EXPECT_TRUE(Build()["samples"]["exposure_warnings"].empty());
+  json sidecar = Sidecar();
+  sidecar["exposure"] = {{"warnings", json::array({{{"channel", "red"},
+                                                    {"cause", "saturated"},
+                                                    {"message",
+                                                     "exposure: the red channel is clipped; remedy: "
+                                                     "take exposure brackets"}}})}};
+  WriteJson(dir_ / "run/samples.npy.json", sidecar);
+  const json summary = Build();
+  ASSERT_EQ(summary["samples"]["exposure_warnings"].size(), 1u);
+  const std::vector<std::string> headline = RunHeadline(summary);
+  ASSERT_GE(headline.size(), 2u);
+  EXPECT_EQ(headline[1], "warning: exposure: the red channel is clipped; remedy: take exposure brackets");
+}
+
 TEST(StageJson, TypedAccessByPointer) {
   const StageJson j(json::parse(R"({"a": {"b": [1, 2.5, null]}, "s": "x", "n": -3})"), "f.json");
   EXPECT_TRUE(j.Has("/a/b/1"));
