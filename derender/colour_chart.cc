@@ -313,7 +313,9 @@ Eigen::Matrix3d SampleColourMatrix(const ColourChartSpec& chart, const Eigen::Ve
   return chart.space == ColourSpace::kXyz ? Eigen::Matrix3d(XyzFromLinearSrgb() * corrected) : corrected;
 }
 
-std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples) {
+std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples,
+                                                   size_t* dropped) {
+  if (dropped != nullptr) *dropped = 0;
   if (!session.colour_chart) return {};
   const ColourChartSpec& chart = *session.colour_chart;
   if (!chart.matrix) {
@@ -343,11 +345,27 @@ std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::
     const Eigen::Vector3f brdf = single[light] * Eigen::Map<const Eigen::Vector3f>(sample.brdf);
     const Eigen::Vector3f variance =
         squared[light] * Eigen::Map<const Eigen::Vector3f>(sample.sigma).cwiseAbs2();
+    // A corrected channel mixes the camera's channels: it is measured only when every channel it takes
+    // from is (a clipped or below-floor input would leak into it); otherwise valid 0 and sigma 0.
+    uint8_t valid[3];
+    for (int c = 0; c < 3; ++c) {
+      valid[c] = 1;
+      for (int j = 0; j < 3; ++j) {
+        if (single[light](c, j) != 0.0f && sample.valid[j] == 0) valid[c] = 0;
+      }
+    }
     for (int c = 0; c < 3; ++c) {
       sample.brdf[c] = brdf[c];
-      sample.sigma[c] = std::sqrt(variance[c]);
+      sample.sigma[c] = valid[c] ? std::sqrt(variance[c]) : 0.0f;
+      sample.valid[c] = valid[c];
     }
   }
+  // Samples left with no measured channel carry nothing: dropped and counted.
+  const size_t before = samples->size();
+  samples->erase(std::remove_if(samples->begin(), samples->end(),
+                                [](const BrdfSample& s) { return s.valid[0] == 0 && s.valid[1] == 0 && s.valid[2] == 0; }),
+                 samples->end());
+  if (dropped != nullptr) *dropped = before - samples->size();
   return matrices;
 }
 

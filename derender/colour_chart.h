@@ -108,8 +108,11 @@ Eigen::Matrix3d SampleColourMatrix(const ColourChartSpec& chart, const Eigen::Ve
 
 // Applies SampleColourMatrix of each sample's photo's light to its brdf and (propagated, channels
 // taken as independent) sigma; returns the matrices used, one per light. Nothing without a fitted
-// colour_chart. Throws Error naming the manifest for a colour_chart without a matrix (run `ibrdf colour`).
-std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples);
+// colour_chart. A corrected channel is valid only when every camera channel it mixes is; samples left
+// with no valid channel are removed, their count in `dropped`. Throws Error naming the manifest for a
+// colour_chart without a matrix (run `ibrdf colour`).
+std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples,
+                                                   size_t* dropped = nullptr);
 
 // The sidecar's "colour" entry: space, reference source, the chart's matrix and per-patch fit, and the
 // matrices applied per light. Null without a colour_chart.

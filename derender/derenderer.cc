@@ -766,8 +766,13 @@ DerenderResult Derender(const Session& measured_session, const DerenderOptions& 
     result.summary.mesh_setup_s = setup_s;
   }
   // The colour chart's matrix, per sample by its photo's light (colour_chart.h), after the light's calibration.
-  result.summary.colour_matrices = ApplyColourCorrection(session, &result.samples);
+  size_t colour_dropped = 0;
+  result.summary.colour_matrices = ApplyColourCorrection(session, &result.samples, &colour_dropped);
   if (!result.summary.colour_matrices.empty()) Log(1, ColourCorrectionReport(session, result.summary.colour_matrices));
+  if (colour_dropped > 0) {
+    Log(1, "warning: colour: " + std::to_string(colour_dropped) +
+               " samples dropped: the colour matrix mixes channels and none of theirs stayed measured");
+  }
   return result;
 }
 
