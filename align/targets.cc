@@ -448,8 +448,9 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
     sheet.Text(10.0, text_y + 14.0, 3.5, "white patch " + Mm(patch) + " square inside the corner marks");
     sheet.Text(10.0, text_y + 20.0, 3.5,
                "markers " + Mm(side) + ", ids " + std::to_string(options.white_marker_first_id) + " to " +
-                   std::to_string(options.white_marker_first_id + 3) + "; patch surface " +
-                   Mm(1e3 * options.white_patch_thickness) + " in front of the card");
+                   std::to_string(options.white_marker_first_id + 3));
+    sheet.Text(10.0, text_y + 26.0, 3.5,
+               "patch surface " + Mm(1e3 * options.white_patch_thickness) + " in front of the card");
     emit(sheet);
     readme << "\nwhite-card.svg/.png: glue it flat to a rigid board and mount the white reference (Spectralon, "
            << Mm(patch) << "\n  square) inside the corner marks";
