@@ -420,7 +420,7 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
     const double card = patch + 2.0 * side * (1.0 + 2.0 * options.card_margin);
     Sheet sheet;
     sheet.name = "white-card";
-    sheet.width_mm = std::max(card + 20.0, 1e3 * options.scale_bar + 40.0);
+    sheet.width_mm = std::max(card + 20.0, 190.0);  // room for the captions
     sheet.height_mm = card + 70.0;
     const double cx = 0.5 * sheet.width_mm, cy = 10.0 + 0.5 * card;
     // The card's outline (cut along it), thin.
@@ -445,11 +445,11 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
     }
     const double text_y = cy + h + 12.0;
     DrawScaleBar(10.0, text_y, std::min(1e3 * options.scale_bar, sheet.width_mm - 20.0), &sheet);
-    sheet.Text(10.0, text_y + 14.0, 3.5,
-               "white patch " + Mm(patch) + " square inside the corner marks; markers " + Mm(side) + ", ids " +
-                   std::to_string(options.white_marker_first_id) + "-" +
-                   std::to_string(options.white_marker_first_id + 3));
+    sheet.Text(10.0, text_y + 14.0, 3.5, "white patch " + Mm(patch) + " square inside the corner marks");
     sheet.Text(10.0, text_y + 20.0, 3.5,
+               "markers " + Mm(side) + ", ids " + std::to_string(options.white_marker_first_id) + " to " +
+                   std::to_string(options.white_marker_first_id + 3));
+    sheet.Text(10.0, text_y + 26.0, 3.5,
                "patch surface " + Mm(1e3 * options.white_patch_thickness) + " in front of the card");
     emit(sheet);
     readme << "\nwhite-card.svg/.png: glue it flat to a rigid board and mount the white reference (Spectralon, "
