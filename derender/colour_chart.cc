@@ -12,9 +12,9 @@
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/json_reader.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
-#include "core/json_reader.h"
 #include "derender/radiance_image.h"
 
 namespace ibrdf {
@@ -117,7 +117,7 @@ nlohmann::json ColourChartFit::ToJson() const {
 }
 
 std::array<Eigen::Vector2d, kColorCheckerPatches> ColourPatchCenters(const Camera& camera,
-                                                                    const std::array<Eigen::Vector2d, 4>& corners) {
+                                                                     const std::array<Eigen::Vector2d, 4>& corners) {
   std::array<Eigen::Vector2d, 4> plane;
   for (int k = 0; k < 4; ++k) plane[k] = camera.CamPlaneFromImage(corners[k]);
   const Eigen::Matrix3d plane_from_grid = GridHomography(plane);
@@ -145,8 +145,7 @@ ColourChartFit FitColourChart(const Session& session, const std::array<Eigen::Ve
     }
   }
   // The whole radiometric chain; no signal floor here (a patch is judged on its mean, below).
-  const RadianceImage image =
-      RadianceReader(session).Read(chart.photos, -std::numeric_limits<double>::infinity());
+  const RadianceImage image = RadianceReader(session).Read(chart.photos, -std::numeric_limits<double>::infinity());
   double longest = 0.0;
   for (const PhotoSpec& photo : chart.photos) longest = std::max(longest, photo.exposure_s * photo.gain);
 
@@ -341,8 +340,7 @@ std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::
   for (BrdfSample& sample : *samples) {
     const size_t light = session.photos.at(sample.image).light;
     const Eigen::Vector3f brdf = single[light] * Eigen::Map<const Eigen::Vector3f>(sample.brdf);
-    const Eigen::Vector3f variance =
-        squared[light] * Eigen::Map<const Eigen::Vector3f>(sample.sigma).cwiseAbs2();
+    const Eigen::Vector3f variance = squared[light] * Eigen::Map<const Eigen::Vector3f>(sample.sigma).cwiseAbs2();
     for (int c = 0; c < 3; ++c) {
       sample.brdf[c] = brdf[c];
       sample.sigma[c] = std::sqrt(variance[c]);
@@ -354,9 +352,8 @@ std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::
 nlohmann::json ColourSidecar(const Session& session, const std::vector<Eigen::Matrix3d>& applied) {
   if (!session.colour_chart) return nullptr;
   const ColourChartSpec& chart = *session.colour_chart;
-  nlohmann::json json = {{"chart", chart.chart},
-                         {"space", ColourSpaceName(chart.space)},
-                         {"reference", ColorCheckerReferenceSource()}};
+  nlohmann::json json = {
+      {"chart", chart.chart}, {"space", ColourSpaceName(chart.space)}, {"reference", ColorCheckerReferenceSource()}};
   if (chart.matrix) json["space_from_camera"] = MatrixJson(*chart.matrix);
   nlohmann::json patches = nlohmann::json::array();
   double sum_squares = 0.0, worst = 0.0;
@@ -392,8 +389,8 @@ std::string ColourCorrectionReport(const Session& session, const std::vector<Eig
   const ColourChartSpec& chart = *session.colour_chart;
   auto matrix_text = [](const Eigen::Matrix3d& m) {
     char text[160];
-    std::snprintf(text, sizeof(text), "[[%.5g, %.5g, %.5g], [%.5g, %.5g, %.5g], [%.5g, %.5g, %.5g]]", m(0, 0),
-                  m(0, 1), m(0, 2), m(1, 0), m(1, 1), m(1, 2), m(2, 0), m(2, 1), m(2, 2));
+    std::snprintf(text, sizeof(text), "[[%.5g, %.5g, %.5g], [%.5g, %.5g, %.5g], [%.5g, %.5g, %.5g]]", m(0, 0), m(0, 1),
+                  m(0, 2), m(1, 0), m(1, 1), m(1, 2), m(2, 0), m(2, 1), m(2, 2));
     return std::string(text);
   };
   std::string out = std::string("colour: samples corrected to ") + ColourSpaceName(chart.space) +
@@ -404,8 +401,8 @@ std::string ColourCorrectionReport(const Session& session, const std::vector<Eig
            (fit.excluded.empty() ? Percent(fit.residual) : "left out (" + fit.excluded + ")");
   }
   for (size_t k = 0; k < applied.size(); ++k) {
-    out += "\n  applied to the samples under light " + (session.lights[k].id.empty() ? std::to_string(k) : session.lights[k].id) +
-           ": " + matrix_text(applied[k]);
+    out += "\n  applied to the samples under light " +
+           (session.lights[k].id.empty() ? std::to_string(k) : session.lights[k].id) + ": " + matrix_text(applied[k]);
   }
   return out;
 }

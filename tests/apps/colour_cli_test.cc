@@ -45,11 +45,13 @@ TEST(ColourCliTest, FitsByCornersAndByDetectionThenDerenderApplies) {
   const nlohmann::json by_mcc = ReadJsonFile(scratch / "d/colour.json");
   EXPECT_LT(by_mcc.at("rms_residual").get<double>(), 0.01);
   // Each patch within a quarter pitch of the corner-point fit's (the read-out square is half a pitch).
-  const double pitch = (colour["patches"][1]["center_px"][0].get<double>() -
-                        colour["patches"][0]["center_px"][0].get<double>());
+  const double pitch =
+      (colour["patches"][1]["center_px"][0].get<double>() - colour["patches"][0]["center_px"][0].get<double>());
   for (int k = 0; k < 24; ++k) {
-    const double dx = by_mcc["patches"][k]["center_px"][0].get<double>() - colour["patches"][k]["center_px"][0].get<double>();
-    const double dy = by_mcc["patches"][k]["center_px"][1].get<double>() - colour["patches"][k]["center_px"][1].get<double>();
+    const double dx =
+        by_mcc["patches"][k]["center_px"][0].get<double>() - colour["patches"][k]["center_px"][0].get<double>();
+    const double dy =
+        by_mcc["patches"][k]["center_px"][1].get<double>() - colour["patches"][k]["center_px"][1].get<double>();
     EXPECT_LT(std::hypot(dx, dy), 0.25 * pitch) << "patch " << k + 1;
   }
 
