@@ -58,6 +58,15 @@ nlohmann::json MatrixJson(const Eigen::Matrix3d& m) {
   return rows;
 }
 
+// "cyan: clipped: 3 of 300 pixels; black 2: too dark ..." ("" when every patch is used).
+std::string LeftOut(const std::vector<ColourPatch>& patches) {
+  std::string left_out;
+  for (const ColourPatch& patch : patches) {
+    if (!patch.excluded.empty()) left_out += (left_out.empty() ? "" : "; ") + patch.name + ": " + patch.excluded;
+  }
+  return left_out;
+}
+
 }  // namespace
 
 bool ColourChartOptions::Check(std::string* why) const {
@@ -76,10 +85,7 @@ std::string ColourChartFit::BriefReport() const {
   if (!success) return "colour: not fitted";
   std::string out = "colour: " + std::to_string(kColorCheckerPatches) + " patches located by " + located_by + ", " +
                     std::to_string(used) + " used";
-  std::string left_out;
-  for (const ColourPatch& patch : patches) {
-    if (!patch.excluded.empty()) left_out += (left_out.empty() ? "" : "; ") + patch.name + ": " + patch.excluded;
-  }
+  const std::string left_out = LeftOut(patches);
   if (!left_out.empty()) out += " (left out: " + left_out + ")";
   return out + "; camera RGB -> " + ColourSpaceName(space) + " residual " + Percent(rms_residual) + " RMS, " +
          Percent(max_residual) + " worst";
@@ -221,7 +227,7 @@ ColourChartFit FitColourChart(const Session& session, const std::array<Eigen::Ve
   if (fit.used < options.min_patches) {
     ThrowError(session.manifest_path + ": /colour_chart",
                "only " + std::to_string(fit.used) + " of the chart's patches are usable (at least " +
-                   std::to_string(options.min_patches) + " needed): " + fit.BriefReport().substr(8) +
+                   std::to_string(options.min_patches) + " needed; left out: " + LeftOut(fit.patches) + ")" +
                    "; expose the chart so that its white patch is bright but not clipped");
   }
   const Eigen::MatrixXd c = cameras.leftCols(fit.used), t = targets.leftCols(fit.used);
