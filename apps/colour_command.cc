@@ -57,8 +57,9 @@ void AddColourCommand(CLI::App& app) {
       const ColourChartDetection detection = DetectColorChecker(ColourChartDisplayImage(session));
       if (!detection.found) {
         ThrowError(session.AbsolutePath(session.colour_chart->photos.front().file),
-                   detection.why + "; give the centres of patches 1, 6, 24 and 19 in colour_chart.corners "
-                                   "(docs/session-format.md)");
+                   detection.why +
+                       "; give the centres of patches 1, 6, 24 and 19 in colour_chart.corners "
+                       "(docs/session-format.md)");
       }
       char cost[64];
       std::snprintf(cost, sizeof(cost), "%.3g", detection.cost);
@@ -78,11 +79,12 @@ void AddColourCommand(CLI::App& app) {
     for (const ColourPatch& patch : fit.patches) {
       char line[200];
       if (patch.excluded.empty()) {
-        std::snprintf(line, sizeof(line), "  %2d %-14s camera (%.4g, %.4g, %.4g) -> (%.4f, %.4f, %.4f), reference "
-                      "(%.4f, %.4f, %.4f): %.2f %%", patch.index + 1, patch.name.c_str(), patch.camera_rgb[0],
-                      patch.camera_rgb[1], patch.camera_rgb[2], patch.corrected[0], patch.corrected[1],
-                      patch.corrected[2], patch.reference[0], patch.reference[1], patch.reference[2],
-                      100.0 * patch.residual);
+        std::snprintf(line, sizeof(line),
+                      "  %2d %-14s camera (%.4g, %.4g, %.4g) -> (%.4f, %.4f, %.4f), reference "
+                      "(%.4f, %.4f, %.4f): %.2f %%",
+                      patch.index + 1, patch.name.c_str(), patch.camera_rgb[0], patch.camera_rgb[1],
+                      patch.camera_rgb[2], patch.corrected[0], patch.corrected[1], patch.corrected[2],
+                      patch.reference[0], patch.reference[1], patch.reference[2], 100.0 * patch.residual);
         Log(1, line);
       } else {
         std::snprintf(line, sizeof(line), "  %2d %-14s left out: ", patch.index + 1, patch.name.c_str());

@@ -479,8 +479,8 @@ ColourChartSpec ParseColourChart(JsonObject object, const std::string& directory
   ColourChartSpec chart;
   chart.chart = object.String("chart", kColorCheckerClassic24);
   if (chart.chart != kColorCheckerClassic24) {
-    ThrowError(object.Where("chart"), "unknown chart \"" + chart.chart + "\" (expected \"" +
-                                          std::string(kColorCheckerClassic24) + "\")");
+    ThrowError(object.Where("chart"),
+               "unknown chart \"" + chart.chart + "\" (expected \"" + std::string(kColorCheckerClassic24) + "\")");
   }
   const std::string space = object.String("space", ColourSpaceName(ColourSpace::kLinearSrgb));
   if (!ColourSpaceFromName(space, &chart.space)) {
@@ -833,7 +833,8 @@ nlohmann::json Session::ToJson() const {
       for (const Eigen::Vector2d& p : *chart.corners) c["corners"].push_back({p.x(), p.y()});
     }
     if (chart.matrix) {
-      for (int row = 0; row < 3; ++row) c["matrix"].push_back({(*chart.matrix)(row, 0), (*chart.matrix)(row, 1), (*chart.matrix)(row, 2)});
+      for (int row = 0; row < 3; ++row)
+        c["matrix"].push_back({(*chart.matrix)(row, 0), (*chart.matrix)(row, 1), (*chart.matrix)(row, 2)});
     }
     for (const ColourPatchFit& fit : chart.patches) {
       c["patches"].push_back(fit.excluded.empty() ? nlohmann::json{{"name", fit.name}, {"residual", fit.residual}}

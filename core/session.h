@@ -181,9 +181,9 @@ struct CalibrationSpec {
 // One patch of a colour chart fit (ColourChartSpec::patches): its relative residual, or why the fit
 // left it out.
 struct ColourPatchFit {
-  std::string name;        // the patch's name (ColorCheckerPatchNames)
-  double residual = 0.0;   // |M c - r| / |r| of the fitted matrix M, camera RGB c and reference r; used patches
-  std::string excluded;    // why it was left out ("clipped", "too dark", ...); empty: used in the fit
+  std::string name;       // the patch's name (ColorCheckerPatchNames)
+  double residual = 0.0;  // |M c - r| / |r| of the fitted matrix M, camera RGB c and reference r; used patches
+  std::string excluded;   // why it was left out ("clipped", "too dark", ...); empty: used in the fit
 };
 
 // An optional colour chart (docs/session-format.md, "colour_chart"): photos of a ColorChecker under
@@ -192,7 +192,7 @@ struct ColourPatchFit {
 // fits a 3x3 matrix from camera RGB to `space` and writes it back as `matrix` with the per-patch fit;
 // the derenderer then applies it to every sample (derender/colour_chart.h).
 struct ColourChartSpec {
-  std::string chart = kColorCheckerClassic24;  // the chart type (the only one for now)
+  std::string chart = kColorCheckerClassic24;    // the chart type (the only one for now)
   ColourSpace space = ColourSpace::kLinearSrgb;  // what the samples are corrected into
   // The exposures of one view of the chart (one photo, or a bracket merged like the measurement
   // photos'), all under the same light and from the same place; no pose needed.
@@ -242,9 +242,9 @@ struct Session {
   };
   // A copy of the session whose manifest lives in folder `dir`: `directory` and `manifest_path` name
   // `dir` and `dir`/session.json, and every path field (photos, the flat field, the white-reference
-  // photos, the colour chart's photos, the mesh file, the raw scans) is rewritten, field by field, to name the same file from
+  // photos, the mesh file, the raw scans) is rewritten, field by field, to name the same file from
   // there. For a caller that writes the manifest elsewhere first (e.g. into a temporary folder that
-  // becomes `dir`): `session.Rebased(dir).Save(temporary_manifest)`.
+  // becomes `dir`): `session.Rebased(dir).Save(temporary_manifest)`. The colour chart's photos too.
   Session Rebased(const std::string& dir, PathStyle style = PathStyle::kRelative) const;
   // Writes Rebased(dir, style) to `dir`/session.json atomically (the folder must exist); returns that
   // path. The files the session names stay where they are.
@@ -253,8 +253,9 @@ struct Session {
   // A path field of the manifest (relative to `directory`, or absolute) as an absolute, normalized path.
   std::string AbsolutePath(const std::string& file) const;
   // Every file the session references, absolute and normalized, in manifest order: the photos, the
-  // flat field, the white-reference photos, the colour chart's photos, and for a mesh sample the mesh file and its raw scans.
-  // Not the manifest itself. The mesh file need not exist yet (the scan stage writes it).
+  // flat field, the white-reference photos, and for a mesh sample the mesh file and its raw scans.
+  // Not the manifest itself. The mesh file need not exist yet (the scan stage writes it). The colour
+  // chart's photos come after the white-reference photos.
   std::vector<std::string> InputFiles() const;
 
   // Absolute or session-relative path of photo i.

@@ -12,9 +12,9 @@
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/json_reader.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
-#include "core/json_reader.h"
 #include "derender/radiance_image.h"
 
 namespace ibrdf {
@@ -58,6 +58,15 @@ nlohmann::json MatrixJson(const Eigen::Matrix3d& m) {
   return rows;
 }
 
+// "cyan: clipped: 3 of 300 pixels; black 2: too dark ..." ("" when every patch is used).
+std::string LeftOut(const std::vector<ColourPatch>& patches) {
+  std::string left_out;
+  for (const ColourPatch& patch : patches) {
+    if (!patch.excluded.empty()) left_out += (left_out.empty() ? "" : "; ") + patch.name + ": " + patch.excluded;
+  }
+  return left_out;
+}
+
 }  // namespace
 
 bool ColourChartOptions::Check(std::string* why) const {
@@ -76,10 +85,7 @@ std::string ColourChartFit::BriefReport() const {
   if (!success) return "colour: not fitted";
   std::string out = "colour: " + std::to_string(kColorCheckerPatches) + " patches located by " + located_by + ", " +
                     std::to_string(used) + " used";
-  std::string left_out;
-  for (const ColourPatch& patch : patches) {
-    if (!patch.excluded.empty()) left_out += (left_out.empty() ? "" : "; ") + patch.name + ": " + patch.excluded;
-  }
+  const std::string left_out = LeftOut(patches);
   if (!left_out.empty()) out += " (left out: " + left_out + ")";
   return out + "; camera RGB -> " + ColourSpaceName(space) + " residual " + Percent(rms_residual) + " RMS, " +
          Percent(max_residual) + " worst";
@@ -117,7 +123,7 @@ nlohmann::json ColourChartFit::ToJson() const {
 }
 
 std::array<Eigen::Vector2d, kColorCheckerPatches> ColourPatchCenters(const Camera& camera,
-                                                                    const std::array<Eigen::Vector2d, 4>& corners) {
+                                                                     const std::array<Eigen::Vector2d, 4>& corners) {
   std::array<Eigen::Vector2d, 4> plane;
   for (int k = 0; k < 4; ++k) plane[k] = camera.CamPlaneFromImage(corners[k]);
   const Eigen::Matrix3d plane_from_grid = GridHomography(plane);
@@ -145,8 +151,7 @@ ColourChartFit FitColourChart(const Session& session, const std::array<Eigen::Ve
     }
   }
   // The whole radiometric chain; no signal floor here (a patch is judged on its mean, below).
-  const RadianceImage image =
-      RadianceReader(session).Read(chart.photos, -std::numeric_limits<double>::infinity());
+  const RadianceImage image = RadianceReader(session).Read(chart.photos, -std::numeric_limits<double>::infinity());
   double longest = 0.0;
   for (const PhotoSpec& photo : chart.photos) longest = std::max(longest, photo.exposure_s * photo.gain);
 
@@ -222,7 +227,7 @@ ColourChartFit FitColourChart(const Session& session, const std::array<Eigen::Ve
   if (fit.used < options.min_patches) {
     ThrowError(session.manifest_path + ": /colour_chart",
                "only " + std::to_string(fit.used) + " of the chart's patches are usable (at least " +
-                   std::to_string(options.min_patches) + " needed): " + fit.BriefReport().substr(8) +
+                   std::to_string(options.min_patches) + " needed; left out: " + LeftOut(fit.patches) + ")" +
                    "; expose the chart so that its white patch is bright but not clipped");
   }
   const Eigen::MatrixXd c = cameras.leftCols(fit.used), t = targets.leftCols(fit.used);
@@ -372,9 +377,8 @@ std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::
 nlohmann::json ColourSidecar(const Session& session, const std::vector<Eigen::Matrix3d>& applied) {
   if (!session.colour_chart) return nullptr;
   const ColourChartSpec& chart = *session.colour_chart;
-  nlohmann::json json = {{"chart", chart.chart},
-                         {"space", ColourSpaceName(chart.space)},
-                         {"reference", ColorCheckerReferenceSource()}};
+  nlohmann::json json = {
+      {"chart", chart.chart}, {"space", ColourSpaceName(chart.space)}, {"reference", ColorCheckerReferenceSource()}};
   if (chart.matrix) json["space_from_camera"] = MatrixJson(*chart.matrix);
   nlohmann::json patches = nlohmann::json::array();
   double sum_squares = 0.0, worst = 0.0;
@@ -410,8 +414,8 @@ std::string ColourCorrectionReport(const Session& session, const std::vector<Eig
   const ColourChartSpec& chart = *session.colour_chart;
   auto matrix_text = [](const Eigen::Matrix3d& m) {
     char text[160];
-    std::snprintf(text, sizeof(text), "[[%.5g, %.5g, %.5g], [%.5g, %.5g, %.5g], [%.5g, %.5g, %.5g]]", m(0, 0),
-                  m(0, 1), m(0, 2), m(1, 0), m(1, 1), m(1, 2), m(2, 0), m(2, 1), m(2, 2));
+    std::snprintf(text, sizeof(text), "[[%.5g, %.5g, %.5g], [%.5g, %.5g, %.5g], [%.5g, %.5g, %.5g]]", m(0, 0), m(0, 1),
+                  m(0, 2), m(1, 0), m(1, 1), m(1, 2), m(2, 0), m(2, 1), m(2, 2));
     return std::string(text);
   };
   std::string out = std::string("colour: samples corrected to ") + ColourSpaceName(chart.space) +
@@ -422,8 +426,8 @@ std::string ColourCorrectionReport(const Session& session, const std::vector<Eig
            (fit.excluded.empty() ? Percent(fit.residual) : "left out (" + fit.excluded + ")");
   }
   for (size_t k = 0; k < applied.size(); ++k) {
-    out += "\n  applied to the samples under light " + (session.lights[k].id.empty() ? std::to_string(k) : session.lights[k].id) +
-           ": " + matrix_text(applied[k]);
+    out += "\n  applied to the samples under light " +
+           (session.lights[k].id.empty() ? std::to_string(k) : session.lights[k].id) + ": " + matrix_text(applied[k]);
   }
   return out;
 }

@@ -49,8 +49,8 @@ struct ColourPatch {
   Eigen::Vector3d camera_rgb = Eigen::Vector3d::Zero();  // mean radiance, camera RGB (the session's unit)
   Eigen::Vector3d reference = Eigen::Vector3d::Zero();   // published value in the target space
   Eigen::Vector3d corrected = Eigen::Vector3d::Zero();   // space_from_camera * camera_rgb
-  double residual = 0.0;  // |corrected - reference| / |reference|
-  std::string excluded;   // why the fit left it out; empty: used
+  double residual = 0.0;                                 // |corrected - reference| / |reference|
+  std::string excluded;                                  // why the fit left it out; empty: used
 };
 
 // The chart fit; reads as failure until FitColourChart ran.
@@ -76,7 +76,7 @@ struct ColourChartFit {
 // corner patches, clockwise from the top left): a plane-to-plane homography in the camera's
 // undistorted image plane, mapped back through the lens distortion.
 std::array<Eigen::Vector2d, kColorCheckerPatches> ColourPatchCenters(const Camera& camera,
-                                                                    const std::array<Eigen::Vector2d, 4>& corners);
+                                                                     const std::array<Eigen::Vector2d, 4>& corners);
 
 // Reads the session's chart photos (ColourChartSpec::photos, merged like an exposure bracket), the
 // patches at `corners` (ColourPatchCenters), leaves out clipped and too dark patches, and fits the

@@ -213,10 +213,12 @@ struct SynthColourOptions {
   // chart_corners is off (then `ibrdf colour` must detect the chart).
   bool chart = false;
   bool chart_corners = true;
-  double chart_pitch = 0.017;        // metres, patch centre to centre (a ColorChecker Mini's)
+  double chart_pitch = 0.017;          // metres, patch centre to centre (a ColorChecker Mini's)
   double chart_patch_fraction = 0.85;  // printed patch side / pitch
-  double chart_card_albedo = 0.03;   // the card around the patches
-  double chart_exposure_scale = 1.0;  // relative to the auto-exposure (the white patch's brightest channel at exposure_target)
+  double chart_card_albedo = 0.03;     // the card around the patches
+  // The chart photo's exposure relative to its auto-exposure (the white patch's brightest channel at
+  // exposure_target).
+  double chart_exposure_scale = 1.0;
   ColourSpace space = ColourSpace::kLinearSrgb;  // the colour_chart block's target space
 
   bool Check(std::string* why) const;

@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <filesystem>
 
-#include <nlohmann/json.hpp>
 #include <tbb/parallel_for.h>
+#include <nlohmann/json.hpp>
 
 #include "core/colour.h"
 #include "core/error.h"
@@ -27,17 +27,16 @@ struct ChartFrame {
   Eigen::Vector3d center, right, down, normal;
   // The world point at patch-grid coordinates (column, row), patch 1 at (0, 0), patch 24 at (5, 3).
   Eigen::Vector3d At(double column, double row, double pitch) const {
-    return center + pitch * ((column - 0.5 * (kColorCheckerColumns - 1)) * right +
-                             (row - 0.5 * (kColorCheckerRows - 1)) * down);
+    return center +
+           pitch * ((column - 0.5 * (kColorCheckerColumns - 1)) * right + (row - 0.5 * (kColorCheckerRows - 1)) * down);
   }
 };
 
 // The chart's ideal radiance image in linear sRGB: Lambertian patches of the reference albedo on a
 // card of albedo card_albedo (half a pitch of card around the patches); 0 off the card. `on_white`
 // gets 1 where a pixel centre sees the white patch (the exposure's reference).
-Image RenderChart(const Session& session, const Light& light, const Rigid3d& camera_from_world,
-                  const ChartFrame& frame, const SynthColourOptions& colour, int supersample,
-                  std::vector<uint8_t>* on_white) {
+Image RenderChart(const Session& session, const Light& light, const Rigid3d& camera_from_world, const ChartFrame& frame,
+                  const SynthColourOptions& colour, int supersample, std::vector<uint8_t>* on_white) {
   const Camera& camera = session.camera;
   const Rigid3d world_from_camera = camera_from_world.Inverse();
   const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
@@ -139,8 +138,8 @@ nlohmann::json WriteSynthColour(const SynthOptions& options, const std::string& 
     ChartFrame frame;
     frame.center = session->sample.center;
     const Eigen::Vector3d eye = first->camera_from_world->Inverse().translation;
-    const Eigen::Vector3d to_light = light.kind == Light::Kind::kPoint ? (light.position - frame.center).normalized()
-                                                                      : light.direction.normalized();
+    const Eigen::Vector3d to_light =
+        light.kind == Light::Kind::kPoint ? (light.position - frame.center).normalized() : light.direction.normalized();
     frame.normal = (to_light + (eye - frame.center).normalized()).normalized();
     // Columns along the camera's x axis as seen on the chart, rows down the print (right x down = -normal).
     const Eigen::Vector3d camera_x =
@@ -148,12 +147,13 @@ nlohmann::json WriteSynthColour(const SynthOptions& options, const std::string& 
     frame.right = (camera_x - camera_x.dot(frame.normal) * frame.normal).normalized();
     frame.down = frame.right.cross(frame.normal);
     std::vector<uint8_t> on_white;
-    Image image = RenderChart(*session, light, *first->camera_from_world, frame, colour, options.effects.supersample,
-                              &on_white);
+    Image image =
+        RenderChart(*session, light, *first->camera_from_world, frame, colour, options.effects.supersample, &on_white);
     ApplyCameraMatrix(colour.camera_matrix, &image);
     std::vector<float> levels;
     for (size_t p = 0; p < on_white.size(); ++p) {
-      if (on_white[p]) levels.push_back(std::max({image.pixels[3 * p], image.pixels[3 * p + 1], image.pixels[3 * p + 2]}));
+      if (on_white[p])
+        levels.push_back(std::max({image.pixels[3 * p], image.pixels[3 * p + 1], image.pixels[3 * p + 2]}));
     }
     IBRDF_CHECK(!levels.empty()) << "the colour chart's white patch is out of view";
     const double level = PercentileInPlace(&levels, 0.99);

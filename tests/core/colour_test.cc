@@ -144,7 +144,10 @@ TEST_F(ColourChartBlockTest, BadBlocksNameTheField) {
       {"missing photo", [](json& m) { m["colour_chart"]["photos"][0]["file"] = "photos/none.png"; },
        "/colour_chart/photos/0/file"},
       {"three corners", [](json& m) { m["colour_chart"]["corners"].erase(3); }, "/colour_chart/corners"},
-      {"singular matrix", [](json& m) { m["colour_chart"]["matrix"] = {{1, 2, 3}, {2, 4, 6}, {0, 0, 1}}; },
+      {"singular matrix",
+       [](json& m) {
+         m["colour_chart"]["matrix"] = {{1, 2, 3}, {2, 4, 6}, {0, 0, 1}};
+       },
        "/colour_chart/matrix"},
       {"patches without matrix", [](json& m) { m["colour_chart"]["patches"] = json::array(); },
        "/colour_chart/patches"},
