@@ -359,9 +359,14 @@ TEST(RadianceImage, BracketMergesWhereUsable) {
   EXPECT_EQ(merged.flags[bright], 0);
   EXPECT_EQ(merged.exposures_used[bright], 1);
   EXPECT_NEAR(merged.radiance[3 * bright], 4.0, 1e-5);
-  // Below the floor in both: flagged.
-  EXPECT_EQ(merged.flags[merged.Index(2, 2)], kPixelBelowSignal);
-  EXPECT_EQ(merged.exposures_used[merged.Index(2, 2)], 0);
+  // Below the floor in its own readings but not in its neighbours' (the expected signal, issue 13 part
+  // 8): the pixel-level flag (own values) says below_signal, but every channel is measured, from both
+  // exposures, at its true value: the floor selects on the expected signal, not on the reading.
+  const size_t dark = merged.Index(2, 2);
+  EXPECT_EQ(merged.flags[dark], kPixelBelowSignal);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(merged.channel_flags[3 * dark + c], 0) << "channel " << c;
+  EXPECT_EQ(merged.exposures_used[dark], 2);
+  EXPECT_NEAR(merged.radiance[3 * dark], 1e-4, 1e-7);
 }
 
 }  // namespace
