@@ -72,7 +72,7 @@ TEST(RadianceImage, PerChannelFloorOnTheExpectedSignal) {
     image.pixels[3 * p + 2] = 0.01f;   // blue: above it everywhere ...
   }
   const size_t noisy = size_t(3) * kWidth + 4;    // pixel (4, 3)
-  image.pixels[3 * noisy + 1] = 0.01f;            // ... but this green reading is high
+  image.pixels[3 * noisy + 1] = 0.005f;           // ... but this green reading is high
   image.pixels[3 * noisy + 2] = 0.0f;             // ... and this blue reading is low
   const size_t clipped = size_t(1) * kWidth + 1;  // pixel (1, 1): red clipped
   image.pixels[3 * clipped + 0] = 1.0f;
