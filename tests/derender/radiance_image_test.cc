@@ -72,7 +72,7 @@ TEST(RadianceImage, PerChannelFloorOnTheExpectedSignal) {
     image.pixels[3 * p + 2] = 0.01f;   // blue: above it everywhere ...
   }
   const size_t noisy = size_t(3) * kWidth + 4;    // pixel (4, 3)
-  image.pixels[3 * noisy + 1] = 0.01f;            // ... but this green reading is high
+  image.pixels[3 * noisy + 1] = 0.005f;           // ... but this green reading is high
   image.pixels[3 * noisy + 2] = 0.0f;             // ... and this blue reading is low
   const size_t clipped = size_t(1) * kWidth + 1;  // pixel (1, 1): red clipped
   image.pixels[3 * clipped + 0] = 1.0f;
@@ -359,9 +359,14 @@ TEST(RadianceImage, BracketMergesWhereUsable) {
   EXPECT_EQ(merged.flags[bright], 0);
   EXPECT_EQ(merged.exposures_used[bright], 1);
   EXPECT_NEAR(merged.radiance[3 * bright], 4.0, 1e-5);
-  // Below the floor in both: flagged.
-  EXPECT_EQ(merged.flags[merged.Index(2, 2)], kPixelBelowSignal);
-  EXPECT_EQ(merged.exposures_used[merged.Index(2, 2)], 0);
+  // Below the floor in its own readings but not in its neighbours' (the expected signal, issue 13 part
+  // 8): the pixel-level flag (own values) says below_signal, but every channel is measured, from both
+  // exposures, at its true value: the floor selects on the expected signal, not on the reading.
+  const size_t dark = merged.Index(2, 2);
+  EXPECT_EQ(merged.flags[dark], kPixelBelowSignal);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(merged.channel_flags[3 * dark + c], 0) << "channel " << c;
+  EXPECT_EQ(merged.exposures_used[dark], 2);
+  EXPECT_NEAR(merged.radiance[3 * dark], 1e-4, 1e-7);
 }
 
 }  // namespace
