@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/merl_brdf.h"
+#include "core/rgl_bsdf.h"
 
 namespace ibrdf {
 
@@ -131,9 +132,13 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
     std::filesystem::path table = object.String("file");
     if (table.is_relative() && !file.empty()) table = std::filesystem::path(file).parent_path() / table;
     brdf = std::make_unique<MerlBrdf>(table.string());
+  } else if (model == "rgl_bsdf") {
+    std::filesystem::path table = object.String("file");
+    if (table.is_relative() && !file.empty()) table = std::filesystem::path(file).parent_path() / table;
+    brdf = std::make_unique<RglBsdf>(table.string());
   } else {
     ThrowError(object.Where("model"),
-               "unknown model \"" + model + "\" (expected lambertian, lafortune, ggx or merl)");
+               "unknown model \"" + model + "\" (expected lambertian, lafortune, ggx, merl or rgl_bsdf)");
   }
   object.Finish();
   return brdf;
@@ -141,6 +146,7 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
 
 std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path) {
   if (IsMerlPath(path)) return std::make_unique<MerlBrdf>(path);
+  if (IsRglBsdfPath(path)) return std::make_unique<RglBsdf>(path);
   return MaterialFromJson(ReadJsonFile(path), path);
 }
 

@@ -12,6 +12,7 @@
 //               f = diffuse_albedo/pi + D(h) G(wi, wo) F(wi.h) / (4 cos_i cos_o), GGX D (Walter et al.
 //               2007), separable Smith shadowing for GGX, Schlick's Fresnel
 //   merl:       "file": "x.binary"  a MERL table (core/merl_brdf.h), looked up as the MERL reader does
+//   rgl_bsdf:   "file": "x.bsdf"    an RGL tensor file (core/rgl_bsdf.h), evaluated as brdf-loader does
 // plus optional "name" and "description" strings.
 #pragma once
 
@@ -84,7 +85,8 @@ class GgxBrdf : public BrdfModel {
 std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const std::string& file,
                                             const std::string& pointer = "");
 
-// Reads a material file (see the format above), or a MERL table (a ".binary" path, core/merl_brdf.h).
+// Reads a material file (see the format above), a MERL table (a ".binary" path, core/merl_brdf.h) or an
+// RGL tensor file (a ".bsdf" path, core/rgl_bsdf.h).
 std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path);
 
 }  // namespace ibrdf
