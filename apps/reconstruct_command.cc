@@ -69,7 +69,8 @@ void AddReconstructCommand(CLI::App& app) {
   command->add_flag("--no-fits", args->no_fits, "Skip the Lafortune and GGX fits");
   command->add_flag("--no-bsdf", args->no_bsdf,
                     "Skip NAME.bsdf (the RGL tensor file of Mitsuba 3's and pbrt-v4's measured material)");
-  command->add_option("--truth", o.truth_file, "truth.json, a material file, a MERL table or an RGL .bsdf to score the reconstruction against");
+  command->add_option("--truth", o.truth_file,
+                      "truth.json, a material file, a MERL table or an RGL .bsdf to score the reconstruction against");
   command->add_option("--eval", o.eval_file,
                       "Also evaluate at these points: .npy float64 (N, 3) theta_i, theta_e, delta_phi (radians)");
   command->add_option("--material", args->material,

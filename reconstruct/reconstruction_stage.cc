@@ -391,13 +391,14 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
       {"rgb_size", o.rgb_size},
       {"vndf_size", o.vndf_size},
       {"ndf_size", o.ndf_size},
-      {"nodes", {{"measured", classes.measured},
-                 {"interpolated", classes.interpolated},
-                 {"unmeasured", classes.unmeasured},
-                 {"filled_with_model", filled_model},
-                 {"filled_with_extrapolation", filled_extrapolated},
-                 {"zero", zero},
-                 {"fill_model", chosen ? chosen->ModelName() : ""}}},
+      {"nodes",
+       {{"measured", classes.measured},
+        {"interpolated", classes.interpolated},
+        {"unmeasured", classes.unmeasured},
+        {"filled_with_model", filled_model},
+        {"filled_with_extrapolation", filled_extrapolated},
+        {"zero", zero},
+        {"fill_model", chosen ? chosen->ModelName() : ""}}},
       {"error_against_table",
        {{"domain", "measured cells (domain.npy 2), theta_i, theta_e <= 80 deg, every channel"},
         {"median", result->bsdf_median_error},
@@ -405,8 +406,8 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
         {"values", errors.size()},
         {"by_theta_max_deg", bands}}},
       {"build_s", build_s}};
-  Log(1, "wrote " + file_name + " (RGL .bsdf; " + std::to_string(classes.unmeasured) + " of " +
-             std::to_string(nodes) + " nodes unmeasured" +
+  Log(1, "wrote " + file_name + " (RGL .bsdf; " + std::to_string(classes.unmeasured) + " of " + std::to_string(nodes) +
+             " nodes unmeasured" +
              (classes.unmeasured ? chosen ? ", filled with the " + chosen->ModelName() + " fit" : ", extrapolated or 0"
                                  : std::string()) +
              "); read back against the table's measured cells: median " +

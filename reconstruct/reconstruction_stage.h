@@ -7,8 +7,8 @@
 // The output folder (written atomically: it appears only when complete) holds brdf.binary (MERL
 // 90x90x180), brdf.npy (90,90,180,3; -1 unmeasured), domain.npy (each cell measured 2, interpolated 1,
 // unmeasured 0), brdf.json (the table's sidecar: counts, fill), effective_samples.npy, lafortune.json
-// and ggx.json (material files), the renderer snippets, NAME.bsdf (RGL tensor file), summary.json, and with evaluation points
-// eval.npy and eval_domain.npy (and eval_truth.npy with a truth). docs/reconstruct.md describes them.
+// and ggx.json (material files), the renderer snippets, NAME.bsdf (RGL tensor file), summary.json, and with evaluation
+// points eval.npy and eval_domain.npy (and eval_truth.npy with a truth). docs/reconstruct.md describes them.
 // EvaluateMaterial evaluates a material file at the points without any samples or regression.
 #pragma once
 
