@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -319,7 +320,11 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
   // are built first with a placeholder and the text replaced.
   TensorFile file = BuildRglBsdf(source, "", options.bsdf_export);
   const uint64_t nodes = classes.measured + classes.interpolated + classes.unmeasured;
-  auto percent = [nodes](uint64_t n) { return std::to_string(nodes ? 100.0 * double(n) / double(nodes) : 0.0); };
+  auto percent = [nodes](uint64_t n) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof(buffer), "%.1f", nodes ? 100.0 * double(n) / double(nodes) : 0.0);
+    return std::string(buffer);
+  };
   std::ostringstream text;
   text << "ibrdf reconstruct: the isotropic RGB BRDF of " << name << " from "
        << (samples_file.empty() ? std::string("samples") : samples_file)
