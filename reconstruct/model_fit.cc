@@ -80,6 +80,26 @@ double RelativeRms(const BrdfModel& model, const std::vector<FitSample>& samples
   return count ? std::sqrt(sum / count) : 0.0;
 }
 
+// The relative RMS by band of the larger of theta_i, theta_o: 0-25, 25-50, 50-80 degrees (and beyond,
+// up to the fit's theta limit, in the last band).
+std::vector<double> BandRelativeRms(const BrdfModel& model, const std::vector<FitSample>& samples) {
+  std::vector<double> sum(3, 0.0);
+  std::vector<size_t> count(3, 0);
+  for (const FitSample& s : samples) {
+    const double theta = std::acos(std::min(s.wi.z(), s.wo.z())) * 180.0 / M_PI;
+    const size_t band = theta < 25.0 ? 0 : theta < 50.0 ? 1 : 2;
+    const Eigen::Vector3d f = model.Eval(s.wi, s.wo);
+    for (int c = 0; c < 3; ++c) {
+      const double rel = (f[c] - s.value[c]) / std::max(std::abs(s.value[c]), 1e-6);
+      sum[band] += rel * rel;
+      ++count[band];
+    }
+  }
+  std::vector<double> rms(3, 0.0);
+  for (size_t b = 0; b < 3; ++b) rms[b] = count[b] ? std::sqrt(sum[b] / double(count[b])) : 0.0;
+  return rms;
+}
+
 // Penalty keeping a lobe's maximum anywhere, max(|Cxy|, |Cz|)^n, below `cap`: the excess of n log(max)
 // over log(cap), weighted heavily (the data residuals are in sigmas).
 template <int kLobes>
@@ -204,6 +224,12 @@ std::string ModelFitResult::BriefReport() const {
                 model.c_str(), samples_used, 100.0 * rel_rms, final_cost, starts, max_albedo,
                 max_albedo > 1.0 ? " (ABOVE 1: not energy conserving)" : "", seconds);
   std::string text = buffer;
+  if (band_rel_rms.size() == 3) {
+    char bands[160];
+    std::snprintf(bands, sizeof(bands), "; by max(theta_i, theta_o) 0-25 %.2f %%, 25-50 %.2f %%, 50-80 %.2f %%",
+                  100.0 * band_rel_rms[0], 100.0 * band_rel_rms[1], 100.0 * band_rel_rms[2]);
+    text += bands;
+  }
   if (!variant.empty()) {
     text += "; Fresnel variant " + variant + " chosen by error (";
     for (size_t i = 0; i < variants.size(); ++i) {
@@ -222,9 +248,14 @@ std::string ModelFitResult::BriefReport() const {
 }
 
 nlohmann::json ToJson(const ModelFitResult& fit) {
-  nlohmann::json json = {{"model", fit.model},   {"rel_rms_vs_samples", fit.rel_rms}, {"samples", fit.samples_used},
-                         {"starts", fit.starts}, {"at_bound", fit.at_bound},
-                         {"max_directional_albedo", fit.max_albedo}, {"seconds", fit.seconds}};
+  nlohmann::json json = {{"model", fit.model},          {"rel_rms_vs_samples", fit.rel_rms},
+                         {"samples", fit.samples_used}, {"starts", fit.starts},
+                         {"at_bound", fit.at_bound},    {"max_directional_albedo", fit.max_albedo},
+                         {"seconds", fit.seconds}};
+  if (fit.band_rel_rms.size() == 3) {
+    json["rel_rms_by_theta_max_deg"] = {
+        {"0-25", fit.band_rel_rms[0]}, {"25-50", fit.band_rel_rms[1]}, {"50-80", fit.band_rel_rms[2]}};
+  }
   if (!fit.variant.empty()) {
     json["variant"] = fit.variant;
     nlohmann::json variants = nlohmann::json::object();
@@ -283,6 +314,7 @@ ModelFitResult FitLafortune(const std::vector<BrdfSample>& samples, const ModelF
   }
   result.rel_rms = RelativeRms(*result.brdf, picked);
   result.max_albedo = MaxDirectionalAlbedo(*result.brdf);
+  result.band_rel_rms = BandRelativeRms(*result.brdf, picked);
   result.seconds = timer.ElapsedSeconds();
   result.success = true;
   return result;
@@ -372,6 +404,7 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
   result.brdf = std::move(best_model);
   result.rel_rms = best_rms;
   result.max_albedo = MaxDirectionalAlbedo(*result.brdf);
+  result.band_rel_rms = BandRelativeRms(*result.brdf, picked);
   result.seconds = timer.ElapsedSeconds();
   result.success = true;
   return result;

@@ -47,6 +47,8 @@ struct ModelFitResult {
   // The largest directional albedo over a dense grid of incidence directions on the whole hemisphere
   // (0 to 89.5 degrees), per channel's max; a plausible BRDF keeps it at most 1.
   double max_albedo = 0.0;
+  // Relative RMS against the samples used by band of max(theta_i, theta_o): 0-25, 25-50, 50-80 degrees.
+  std::vector<double> band_rel_rms;
   // GGX: the Fresnel variant kept ("dielectric": exact Fresnel of eta(F0), vanishing with F0 = 0;
   // "conductor": Schlick per channel, F0 rising to 1 at grazing, as a metal) and every variant tried
   // with its relative RMS against the samples; the lower error wins.

@@ -132,6 +132,11 @@ TEST(ModelFit, GgxFitOfALambertianChoosesTheDielectricVariant) {
   EXPECT_LT(RelativeRmsAgainst(*fit.brdf, material, samples), 0.005) << fit.BriefReport();
   EXPECT_NE(fit.BriefReport().find("Fresnel variant dielectric chosen by error"), std::string::npos);
   EXPECT_EQ(fit.brdf->ToJson()["fresnel"], "dielectric");
+  // The error by theta band, in the summary's JSON and the log line.
+  ASSERT_EQ(fit.band_rel_rms.size(), 3u);
+  for (double band : fit.band_rel_rms) EXPECT_LT(band, 0.01);
+  EXPECT_TRUE(ToJson(fit).contains("rel_rms_by_theta_max_deg"));
+  EXPECT_NE(fit.BriefReport().find("by max(theta_i, theta_o) 0-25"), std::string::npos);
 }
 
 // A copper-like conductor (no diffuse, coloured F0): the conductor variant wins and keeps the colour.
