@@ -16,7 +16,8 @@ void AddReconstructCommand(CLI::App& app) {
       "in half/difference coordinates, folded by reciprocity and bilateral symmetry); writes into DIR:\n"
       "brdf.binary (MERL 90x90x180), brdf.npy (90,90,180,3; -1 unmeasured), domain.npy (per cell: 2\n"
       "measured, 1 interpolated, 0 unmeasured), brdf.json (the table's counts and fill), effective_samples.npy,\n"
-      "lafortune.json and ggx.json (material files), NAME.pbrt and NAME.xml (pbrt-v4, Mitsuba 3) and\n"
+      "lafortune.json and ggx.json (material files), NAME.pbrt and NAME.xml (pbrt-v4, Mitsuba 3), NAME.bsdf\n"
+      "(RGL tensor file for Mitsuba 3's and pbrt-v4's measured material; --no-bsdf skips it) and\n"
       "summary.json (timings, counts by class, fit errors; error against the truth with --truth).\n"
       "With --eval POINTS.npy (float64, N x 3: theta_i, theta_e, delta_phi in radians) also eval.npy (N x 3\n"
       "RGB values, -1 where unmeasured unless --fill), eval_domain.npy (the class per point) and, with\n"
@@ -26,7 +27,7 @@ void AddReconstructCommand(CLI::App& app) {
   struct Args {
     std::string samples, out, bandwidth = "given", fill = "none", material;
     ReconstructOptions o;
-    bool no_fold = false, no_fits = false, linear_values = false;
+    bool no_fold = false, no_fits = false, no_bsdf = false, linear_values = false;
   };
   auto args = std::make_shared<Args>();
   ReconstructOptions& o = args->o;
@@ -66,7 +67,10 @@ void AddReconstructCommand(CLI::App& app) {
   command->add_option("--lobes", o.fit.lafortune_lobes, "Lafortune lobes (1 to 3)")->capture_default_str();
   command->add_option("--fit-samples", o.fit.max_samples, "Samples used by the model fits")->capture_default_str();
   command->add_flag("--no-fits", args->no_fits, "Skip the Lafortune and GGX fits");
-  command->add_option("--truth", o.truth_file, "truth.json (or a material file) to score the reconstruction against");
+  command->add_flag("--no-bsdf", args->no_bsdf,
+                    "Skip NAME.bsdf (the RGL tensor file of Mitsuba 3's and pbrt-v4's measured material)");
+  command->add_option("--truth", o.truth_file,
+                      "truth.json, a material file, a MERL table or an RGL .bsdf to score the reconstruction against");
   command->add_option("--eval", o.eval_file,
                       "Also evaluate at these points: .npy float64 (N, 3) theta_i, theta_e, delta_phi (radians)");
   command->add_option("--material", args->material,
@@ -100,6 +104,7 @@ void AddReconstructCommand(CLI::App& app) {
     if (args->no_fold) options.regression.fold_reciprocity = options.regression.fold_bilateral = false;
     if (args->linear_values) options.regression.log_space = false;
     options.fits = !args->no_fits;
+    options.bsdf = !args->no_bsdf;
     if (options.tabulate.fill == FillMode::kModel && (!options.fits || options.eval_only)) {
       ThrowError("--fill model", "fills with the chosen fit: drop --no-fits / --eval-only");
     }

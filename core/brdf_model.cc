@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/merl_brdf.h"
+#include "core/rgl_bsdf.h"
 
 namespace ibrdf {
 
@@ -53,16 +54,38 @@ Eigen::Vector3d GgxBrdf::Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& 
     return 2.0 * cos_theta / (cos_theta + std::sqrt(a2 + (1.0 - a2) * cos_theta * cos_theta));
   };
   const double g = g1(wi.z()) * g1(wo.z());
-  const double schlick = std::pow(1.0 - std::max(0.0, wi.dot(h)), 5.0);
-  const Eigen::Vector3d fresnel = specular_f0_ + (Eigen::Vector3d::Ones() - specular_f0_) * schlick;
+  Eigen::Vector3d fresnel;
+  if (fresnel_ == GgxFresnel::kDielectric) {
+    for (int c = 0; c < 3; ++c) fresnel[c] = DielectricFresnel(wi.dot(h), IorFromF0(specular_f0_[c]));
+  } else {
+    const double schlick = std::pow(1.0 - std::max(0.0, wi.dot(h)), 5.0);
+    fresnel = specular_f0_ + (Eigen::Vector3d::Ones() - specular_f0_) * schlick;
+  }
   return diffuse_albedo_ / M_PI + fresnel * (d * g / (4.0 * wi.z() * wo.z()));
 }
 
+double DielectricFresnel(double cos_theta, double eta) {
+  const double c = std::clamp(std::abs(cos_theta), 0.0, 1.0);
+  const double g2 = eta * eta - 1.0 + c * c;
+  if (g2 < 0.0) return 1.0;  // total internal reflection (eta < 1 only)
+  const double g = std::sqrt(g2);
+  if (g + c == 0.0) return 1.0;
+  const double a = (g - c) / (g + c), b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+  return 0.5 * a * a * (1.0 + b * b);
+}
+
+double IorFromF0(double f0) {
+  const double s = std::sqrt(std::clamp(f0, 0.0, 0.999999));
+  return (1.0 + s) / (1.0 - s);
+}
+
 nlohmann::json GgxBrdf::ToJson() const {
-  return {{"model", "ggx"},
-          {"diffuse_albedo", ibrdf::ToJson(diffuse_albedo_)},
-          {"specular_f0", ibrdf::ToJson(specular_f0_)},
-          {"alpha", alpha_}};
+  nlohmann::json json = {{"model", "ggx"},
+                         {"diffuse_albedo", ibrdf::ToJson(diffuse_albedo_)},
+                         {"specular_f0", ibrdf::ToJson(specular_f0_)},
+                         {"alpha", alpha_}};
+  if (fresnel_ == GgxFresnel::kDielectric) json["fresnel"] = "dielectric";
+  return json;
 }
 
 namespace {
@@ -126,14 +149,26 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
     const Eigen::Vector3d f0 = Reflectance(object, "specular_f0");
     const double alpha = object.Number("alpha");
     if (!(alpha > 0.0 && alpha <= 1.0)) ThrowError(object.Where("alpha"), "expected 0 < alpha <= 1");
-    brdf = std::make_unique<GgxBrdf>(diffuse, f0, alpha);
+    const std::string fresnel = object.String("fresnel", "schlick");
+    if (fresnel != "schlick" && fresnel != "dielectric") {
+      ThrowError(object.Where("fresnel"), "expected \"schlick\" or \"dielectric\", got \"" + fresnel + "\"");
+    }
+    if (fresnel == "dielectric" && (f0.array() >= 1.0).any()) {
+      ThrowError(object.Where("specular_f0"), "expected values below 1 with a dielectric Fresnel");
+    }
+    brdf = std::make_unique<GgxBrdf>(diffuse, f0, alpha,
+                                     fresnel == "dielectric" ? GgxFresnel::kDielectric : GgxFresnel::kSchlick);
   } else if (model == "merl") {
     std::filesystem::path table = object.String("file");
     if (table.is_relative() && !file.empty()) table = std::filesystem::path(file).parent_path() / table;
     brdf = std::make_unique<MerlBrdf>(table.string());
+  } else if (model == "rgl_bsdf") {
+    std::filesystem::path table = object.String("file");
+    if (table.is_relative() && !file.empty()) table = std::filesystem::path(file).parent_path() / table;
+    brdf = std::make_unique<RglBsdf>(table.string());
   } else {
     ThrowError(object.Where("model"),
-               "unknown model \"" + model + "\" (expected lambertian, lafortune, ggx or merl)");
+               "unknown model \"" + model + "\" (expected lambertian, lafortune, ggx, merl or rgl_bsdf)");
   }
   object.Finish();
   return brdf;
@@ -141,6 +176,7 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
 
 std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path) {
   if (IsMerlPath(path)) return std::make_unique<MerlBrdf>(path);
+  if (IsRglBsdfPath(path)) return std::make_unique<RglBsdf>(path);
   return MaterialFromJson(ReadJsonFile(path), path);
 }
 

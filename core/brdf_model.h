@@ -10,11 +10,17 @@
 //               (Lafortune et al. 1997, as in the pbrt fits of the seed paper's materials)
 //   ggx:        "diffuse_albedo": [r,g,b], "specular_f0": [r,g,b], "alpha": a
 //               f = diffuse_albedo/pi + D(h) G(wi, wo) F(wi.h) / (4 cos_i cos_o), GGX D (Walter et al.
-//               2007), separable Smith shadowing for GGX, Schlick's Fresnel
+//               2007), separable Smith shadowing for GGX, Schlick's Fresnel F0 + (1 - F0)(1 - cos)^5
+//               (a conductor-like Fresnel: F0 per channel rising to 1 at grazing); with
+//               "fresnel": "dielectric" the exact unpolarized dielectric Fresnel of the IOR with that
+//               F0 per channel, eta = (1 + sqrt(F0)) / (1 - sqrt(F0)), which vanishes with F0 = 0 (a
+//               pure Lambertian is then representable; Schlick's term stays non-zero at grazing)
 //   merl:       "file": "x.binary"  a MERL table (core/merl_brdf.h), looked up as the MERL reader does
+//   rgl_bsdf:   "file": "x.bsdf"    an RGL tensor file (core/rgl_bsdf.h), evaluated as brdf-loader does
 // plus optional "name" and "description" strings.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -66,10 +72,23 @@ class LafortuneBrdf : public BrdfModel {
   std::vector<LafortuneLobe> lobes_;
 };
 
+// The Fresnel term of a GgxBrdf.
+enum class GgxFresnel : uint8_t {
+  kSchlick = 0,     // F0 + (1 - F0)(1 - cos)^5 per channel: conductor-like, never 0 at grazing
+  kDielectric = 1,  // exact dielectric Fresnel of eta(F0) per channel: 0 everywhere with F0 = 0
+};
+
+// The unpolarized Fresnel reflectance of a dielectric interface of relative IOR eta >= 1 for light
+// arriving at cos_theta from the outside (Walter et al. 2007, eq. 22); 0 for eta = 1.
+double DielectricFresnel(double cos_theta, double eta);
+// The IOR whose normal-incidence reflectance is f0 in [0, 1): (1 + sqrt(f0)) / (1 - sqrt(f0)).
+double IorFromF0(double f0);
+
 class GgxBrdf : public BrdfModel {
  public:
-  GgxBrdf(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& specular_f0, double alpha)
-      : diffuse_albedo_(diffuse_albedo), specular_f0_(specular_f0), alpha_(alpha) {}
+  GgxBrdf(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& specular_f0, double alpha,
+          GgxFresnel fresnel = GgxFresnel::kSchlick)
+      : diffuse_albedo_(diffuse_albedo), specular_f0_(specular_f0), alpha_(alpha), fresnel_(fresnel) {}
   Eigen::Vector3d Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const override;
   nlohmann::json ToJson() const override;
   std::string ModelName() const override { return "ggx"; }
@@ -78,13 +97,15 @@ class GgxBrdf : public BrdfModel {
   Eigen::Vector3d diffuse_albedo_;
   Eigen::Vector3d specular_f0_;
   double alpha_;  // GGX roughness (the slope distribution's width)
+  GgxFresnel fresnel_;
 };
 
 // Reads a material from JSON; `where` names the source for errors (a file, or "file: /pointer").
 std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const std::string& file,
                                             const std::string& pointer = "");
 
-// Reads a material file (see the format above), or a MERL table (a ".binary" path, core/merl_brdf.h).
+// Reads a material file (see the format above), a MERL table (a ".binary" path, core/merl_brdf.h) or an
+// RGL tensor file (a ".bsdf" path, core/rgl_bsdf.h).
 std::unique_ptr<BrdfModel> LoadMaterial(const std::string& path);
 
 }  // namespace ibrdf

@@ -83,9 +83,12 @@ class LafortuneAnalyticResidual : public ceres::SizedCostFunction<1, 1 + 3 * kLo
 // GGX microfacet model as GgxBrdf evaluates it, all three channels: parameters [diffuse_albedo r g b],
 // [specular_f0 r g b], [alpha].
 struct GgxResidual {
+  // With `dielectric_in` the second parameter block is s = sqrt(F0) per channel and the Fresnel term the
+  // exact dielectric one of eta = (1 + s) / (1 - s) (0 at s = 0; no sqrt at F0 = 0 to differentiate);
+  // otherwise it is F0 with Schlick's term.
   GgxResidual(const Eigen::Vector3d& wi_in, const Eigen::Vector3d& wo_in, const Eigen::Vector3d& value_in,
-              const Eigen::Vector3d& sigma)
-      : wi(wi_in), wo(wo_in), value(value_in), inv_sigma(sigma.cwiseInverse()) {}
+              const Eigen::Vector3d& sigma, bool dielectric_in = false)
+      : wi(wi_in), wo(wo_in), value(value_in), inv_sigma(sigma.cwiseInverse()), dielectric(dielectric_in) {}
 
   template <class T>
   bool operator()(const T* diffuse, const T* f0, const T* alpha, T* residual) const {
@@ -98,8 +101,10 @@ struct GgxResidual {
     const T g = G1(a2, wi.z()) * G1(a2, wo.z());
     const double schlick = std::pow(1.0 - std::max(0.0, wi.dot(h)), 5.0);
     const T specular = d * g / T(4.0 * wi.z() * wo.z());
+    const double cos_d = std::max(0.0, wi.dot(h));
     for (int c = 0; c < 3; ++c) {
-      const T fresnel = f0[c] + (T(1.0) - f0[c]) * T(schlick);
+      const T fresnel = dielectric ? DielectricFresnel((T(1.0) + f0[c]) / (T(1.0) - f0[c]), cos_d)
+                                   : f0[c] + (T(1.0) - f0[c]) * T(schlick);
       const T f = diffuse[c] / T(M_PI) + fresnel * specular;
       residual[c] = (f - value[c]) * inv_sigma[c];
     }
@@ -112,7 +117,18 @@ struct GgxResidual {
     return T(2.0 * cos_theta) / (T(cos_theta) + sqrt(a2 + (T(1.0) - a2) * T(cos_theta * cos_theta)));
   }
 
+  // Walter et al. 2007, eq. 22 (as core/brdf_model.h DielectricFresnel), templated for Ceres.
+  template <class T>
+  static T DielectricFresnel(const T& eta, double c) {
+    using std::sqrt;
+    const T g = sqrt(eta * eta - T(1.0) + T(c * c));
+    const T a = (g - T(c)) / (g + T(c));
+    const T b = (T(c) * (g + T(c)) - T(1.0)) / (T(c) * (g - T(c)) + T(1.0));
+    return T(0.5) * a * a * (T(1.0) + b * b);
+  }
+
   Eigen::Vector3d wi, wo, value, inv_sigma;
+  bool dielectric = false;
 };
 
 }  // namespace ibrdf

@@ -85,6 +85,26 @@ double RelativeRms(const BrdfModel& model, const std::vector<FitSample>& samples
   return count ? std::sqrt(sum / count) : 0.0;
 }
 
+// The relative RMS by band of the larger of theta_i, theta_o: 0-25, 25-50, 50-80 degrees (and beyond,
+// up to the fit's theta limit, in the last band).
+std::vector<double> BandRelativeRms(const BrdfModel& model, const std::vector<FitSample>& samples) {
+  std::vector<double> sum(3, 0.0);
+  std::vector<size_t> count(3, 0);
+  for (const FitSample& s : samples) {
+    const double theta = std::acos(std::min(s.wi.z(), s.wo.z())) * 180.0 / M_PI;
+    const size_t band = theta < 25.0 ? 0 : theta < 50.0 ? 1 : 2;
+    const Eigen::Vector3d f = model.Eval(s.wi, s.wo);
+    for (int c = 0; c < 3; ++c) {
+      const double rel = (f[c] - s.value[c]) / std::max(std::abs(s.value[c]), 1e-6);
+      sum[band] += rel * rel;
+      ++count[band];
+    }
+  }
+  std::vector<double> rms(3, 0.0);
+  for (size_t b = 0; b < 3; ++b) rms[b] = count[b] ? std::sqrt(sum[b] / double(count[b])) : 0.0;
+  return rms;
+}
+
 // Penalty keeping a lobe's maximum anywhere, max(|Cxy|, |Cz|)^n, below `cap`: the excess of n log(max)
 // over log(cap), weighted heavily (the data residuals are in sigmas).
 template <int kLobes>
@@ -213,6 +233,22 @@ std::string ModelFitResult::BriefReport() const {
                 model.c_str(), samples_used, 100.0 * rel_rms, final_cost, starts, max_albedo,
                 max_albedo > 1.0 ? " (ABOVE 1: not energy conserving)" : "", seconds);
   std::string text = buffer;
+  if (band_rel_rms.size() == 3) {
+    char bands[160];
+    std::snprintf(bands, sizeof(bands), "; by max(theta_i, theta_o) 0-25 %.2f %%, 25-50 %.2f %%, 50-80 %.2f %%",
+                  100.0 * band_rel_rms[0], 100.0 * band_rel_rms[1], 100.0 * band_rel_rms[2]);
+    text += bands;
+  }
+  if (!variant.empty()) {
+    text += "; Fresnel variant " + variant + " chosen by error (";
+    for (size_t i = 0; i < variants.size(); ++i) {
+      char item[96];
+      std::snprintf(item, sizeof(item), "%s%s %.2f %%", i ? ", " : "", variants[i].first.c_str(),
+                    100.0 * variants[i].second);
+      text += item;
+    }
+    text += ")";
+  }
   if (!at_bound.empty()) {
     text += "; at a bound of the fit:";
     for (const std::string& b : at_bound) text += " " + b + ";";
@@ -221,9 +257,21 @@ std::string ModelFitResult::BriefReport() const {
 }
 
 nlohmann::json ToJson(const ModelFitResult& fit) {
-  return {{"model", fit.model},    {"rel_rms_vs_samples", fit.rel_rms}, {"samples", fit.samples_used},
-          {"starts", fit.starts},  {"at_bound", fit.at_bound},          {"max_directional_albedo", fit.max_albedo},
-          {"seconds", fit.seconds}};
+  nlohmann::json json = {{"model", fit.model},          {"rel_rms_vs_samples", fit.rel_rms},
+                         {"samples", fit.samples_used}, {"starts", fit.starts},
+                         {"at_bound", fit.at_bound},    {"max_directional_albedo", fit.max_albedo},
+                         {"seconds", fit.seconds}};
+  if (fit.band_rel_rms.size() == 3) {
+    json["rel_rms_by_theta_max_deg"] = {
+        {"0-25", fit.band_rel_rms[0]}, {"25-50", fit.band_rel_rms[1]}, {"50-80", fit.band_rel_rms[2]}};
+  }
+  if (!fit.variant.empty()) {
+    json["variant"] = fit.variant;
+    nlohmann::json variants = nlohmann::json::object();
+    for (const auto& [name, rms] : fit.variants) variants[name] = {{"rel_rms_vs_samples", rms}};
+    json["variants"] = variants;
+  }
+  return json;
 }
 
 Eigen::Vector3d DirectionalAlbedo(const BrdfModel& brdf, double theta_i) {
@@ -275,6 +323,7 @@ ModelFitResult FitLafortune(const std::vector<BrdfSample>& samples, const ModelF
   }
   result.rel_rms = RelativeRms(*result.brdf, picked);
   result.max_albedo = MaxDirectionalAlbedo(*result.brdf);
+  result.band_rel_rms = BandRelativeRms(*result.brdf, picked);
   result.seconds = timer.ElapsedSeconds();
   result.success = true;
   return result;
@@ -295,52 +344,80 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
       if (std::isfinite(s.sigma[c])) minimum[c] = std::min(minimum[c], s.value[c]);
     }
   }
+  // Three alpha starts for each of the two Fresnel variants, all six solves in parallel. The
+  // dielectric variant's second block is s = sqrt(F0) (GgxResidual).
   const double alpha_starts[3] = {0.05, 0.2, 0.5};
-  std::array<std::array<double, 7>, 3> solutions;
-  std::array<double, 3> costs;
-  tbb::parallel_for(0, 3, [&](int start) {
-    double* diffuse = solutions[start].data();
+  constexpr int kStarts = 3, kVariants = 2;
+  std::array<std::array<double, 7>, kStarts * kVariants> solutions;
+  std::array<double, kStarts * kVariants> costs;
+  tbb::parallel_for(0, kStarts * kVariants, [&](int job) {
+    const int start = job % kStarts;
+    const bool dielectric = job / kStarts == 0;
+    double* diffuse = solutions[job].data();
     double* f0 = diffuse + 3;
     double* alpha = diffuse + 6;
     alpha[0] = alpha_starts[start];
     for (int c = 0; c < 3; ++c) {
       diffuse[c] = std::max(0.0, 0.8 * M_PI * minimum[c]);
-      f0[c] = 0.04;
+      f0[c] = dielectric ? 0.2 : 0.04;  // sqrt(0.04) for the dielectric
     }
     ceres::Problem problem;
     for (const FitSample& s : picked) {
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<GgxResidual, 3, 3, 3, 1>(new GgxResidual(s.wi, s.wo, s.value, s.sigma)),
-          new ceres::HuberLoss(options.huber_scale), diffuse, f0, alpha);
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<GgxResidual, 3, 3, 3, 1>(
+                                   new GgxResidual(s.wi, s.wo, s.value, s.sigma, dielectric)),
+                               new ceres::HuberLoss(options.huber_scale), diffuse, f0, alpha);
     }
     for (int c = 0; c < 3; ++c) {
       problem.SetParameterLowerBound(diffuse, c, 0.0);
       problem.SetParameterLowerBound(f0, c, 0.0);
-      problem.SetParameterUpperBound(f0, c, 1.0);
+      problem.SetParameterUpperBound(f0, c, dielectric ? 0.99 : 1.0);
     }
     problem.SetParameterLowerBound(alpha, 0, 0.002);
     problem.SetParameterUpperBound(alpha, 0, 1.0);
     ceres::Solver::Summary summary;
     ceres::Solve(SolverOptions(options), &problem, &summary);
-    costs[start] = summary.final_cost;
+    costs[job] = summary.final_cost;
   });
-  result.starts = 3;
-  int chosen = 0;
-  for (int start = 1; start < 3; ++start) {
-    if (costs[start] < costs[chosen]) chosen = start;
+  result.starts = kStarts * kVariants;
+  // The best start of each variant, then the variant with the lower relative RMS.
+  std::unique_ptr<BrdfModel> best_model;
+  int best_job = -1;
+  double best_rms = std::numeric_limits<double>::infinity();
+  for (int variant = 0; variant < kVariants; ++variant) {
+    int chosen = variant * kStarts;
+    for (int job = chosen + 1; job < (variant + 1) * kStarts; ++job) {
+      if (costs[job] < costs[chosen]) chosen = job;
+    }
+    const double* p = solutions[chosen].data();
+    const bool dielectric = variant == 0;
+    Eigen::Vector3d f0(p[3], p[4], p[5]);
+    if (dielectric) f0 = f0.cwiseProduct(f0);
+    auto model = std::make_unique<GgxBrdf>(Eigen::Vector3d(p[0], p[1], p[2]), f0, p[6],
+                                           dielectric ? GgxFresnel::kDielectric : GgxFresnel::kSchlick);
+    const double rms = RelativeRms(*model, picked);
+    result.variants.emplace_back(dielectric ? "dielectric" : "conductor", rms);
+    if (rms < best_rms) {
+      best_rms = rms;
+      best_job = chosen;
+      best_model = std::move(model);
+      result.variant = dielectric ? "dielectric" : "conductor";
+    }
   }
-  const double best_cost = costs[chosen];
-  const double* best = solutions[chosen].data();
+  const double* best = solutions[best_job].data();
+  const bool dielectric = result.variant == "dielectric";
   if (best[6] <= 0.002 + 1e-9) result.at_bound.push_back("alpha at 0.002");
   if (best[6] >= 1.0 - 1e-9) result.at_bound.push_back("alpha at 1");
   for (int c = 0; c < 3; ++c) {
-    if (best[3 + c] >= 1.0 - 1e-9) result.at_bound.push_back(std::string("F0 ") + "RGB"[c] + " at 1");
+    if (!dielectric && best[3 + c] >= 1.0 - 1e-9) result.at_bound.push_back(std::string("F0 ") + "RGB"[c] + " at 1");
+    if (dielectric && best[3 + c] >= 0.99 - 1e-9) {
+      result.at_bound.push_back(std::string("F0 ") + "RGB"[c] + " at 0.98 (dielectric)");
+    }
   }
-  result.final_cost = best_cost;
-  result.brdf = std::make_unique<GgxBrdf>(Eigen::Vector3d(best[0], best[1], best[2]),
-                                          Eigen::Vector3d(best[3], best[4], best[5]), best[6]);
-  result.rel_rms = RelativeRms(*result.brdf, picked);
+  result.final_cost = costs[best_job];
+  result.brdf = std::move(best_model);
+  result.rel_rms = best_rms;
   result.max_albedo = MaxDirectionalAlbedo(*result.brdf);
+  result.band_rel_rms = BandRelativeRms(*result.brdf, picked);
   result.seconds = timer.ElapsedSeconds();
   result.success = true;
   return result;
@@ -363,6 +440,7 @@ namespace {
 struct GgxParameters {
   Eigen::Vector3d diffuse, f0;
   double alpha = 0.0;
+  std::string fresnel;  // "schlick" or "dielectric"
 };
 GgxParameters ReadGgx(const BrdfModel& model) {
   if (model.ModelName() != "ggx") ThrowError("material snippet", "needs a ggx model, got " + model.ModelName());
@@ -373,15 +451,17 @@ GgxParameters ReadGgx(const BrdfModel& model) {
   p.diffuse = object.Vector3("diffuse_albedo");
   p.f0 = object.Vector3("specular_f0");
   p.alpha = object.Number("alpha");
+  p.fresnel = object.String("fresnel", "schlick");
   return p;
 }
-// The real IOR with the given normal-incidence reflectance: F0 = ((eta - 1) / (eta + 1))^2.
-double IorFromF0(double f0) {
+// The real IOR with the given normal-incidence reflectance, F0 = ((eta - 1) / (eta + 1))^2, kept within
+// 1.02 to 1.99 for the snippets (a coating needs an IOR above 1).
+double SnippetIor(double f0) {
   const double r = std::sqrt(std::clamp(f0, 1e-4, 0.99));
   return (1.0 + r) / (1.0 - r);
 }
 // Unpolarized Fresnel reflectance of a smooth dielectric boundary (exterior 1, interior eta).
-double DielectricFresnel(double cos_i, double eta) {
+double SmoothDielectricFresnel(double cos_i, double eta) {
   const double sin_t2 = (1.0 - cos_i * cos_i) / (eta * eta);
   if (sin_t2 >= 1.0) return 1.0;
   const double cos_t = std::sqrt(1.0 - sin_t2);
@@ -404,12 +484,12 @@ double FresnelDiffuseReflectance(double eta) {
 
 PlasticParameters PlasticFromGgx(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& f0, double alpha) {
   PlasticParameters p;
-  p.eta = IorFromF0(f0.mean());
+  p.eta = SnippetIor(f0.mean());
   p.alpha = alpha;
   // A diffuse base under a dielectric coating, with the inter-reflections between them (roughplastic
   // with nonlinear = true): f_d = rho / (1 - rho Fdr_int) / eta^2 t(cos_i) t(cos_o) / pi, t = 1 - F.
   // Solved for rho so that f_d = d / pi at 35 degrees (the middle of 0 to 70) on both sides.
-  const double t = 1.0 - DielectricFresnel(std::cos(35.0 * M_PI / 180.0), p.eta);
+  const double t = 1.0 - SmoothDielectricFresnel(std::cos(35.0 * M_PI / 180.0), p.eta);
   const double fdr = FresnelDiffuseReflectance(1.0 / p.eta);
   const double e2 = p.eta * p.eta;
   for (int c = 0; c < 3; ++c) {

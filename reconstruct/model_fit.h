@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -46,6 +47,13 @@ struct ModelFitResult {
   // The largest directional albedo over a dense grid of incidence directions on the whole hemisphere
   // (0 to 89.5 degrees), per channel's max; a plausible BRDF keeps it at most 1.
   double max_albedo = 0.0;
+  // Relative RMS against the samples used by band of max(theta_i, theta_o): 0-25, 25-50, 50-80 degrees.
+  std::vector<double> band_rel_rms;
+  // GGX: the Fresnel variant kept ("dielectric": exact Fresnel of eta(F0), vanishing with F0 = 0;
+  // "conductor": Schlick per channel, F0 rising to 1 at grazing, as a metal) and every variant tried
+  // with its relative RMS against the samples; the lower error wins.
+  std::string variant;
+  std::vector<std::pair<std::string, double>> variants;
   double seconds = 0.0;
   std::string BriefReport() const;
 };
@@ -58,7 +66,9 @@ double MaxDirectionalAlbedo(const BrdfModel& brdf);
 
 // Fits each colour channel separately with `lafortune_lobes` lobes from several starting points.
 ModelFitResult FitLafortune(const std::vector<BrdfSample>& samples, const ModelFitOptions& options);
-// Fits diffuse albedo and specular F0 per channel and one GGX alpha.
+// Fits diffuse albedo and specular F0 per channel and one GGX alpha, twice: with the dielectric Fresnel
+// (a specular term that vanishes with F0 = 0) and with Schlick's per channel (a conductor's); keeps
+// the variant with the lower relative RMS against the samples and says so (variant, variants).
 ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOptions& options);
 
 // The fit as summary JSON: model, error, samples, starts, time, parameters at a bound, plausibility.

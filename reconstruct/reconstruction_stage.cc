@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -18,6 +19,8 @@
 #include "core/logging.h"
 #include "core/merl_brdf.h"
 #include "core/npy.h"
+#include "core/rgl_bsdf.h"
+#include "core/tensor_file.h"
 #include "reconstruct/sample_domain.h"
 #include "reconstruct/truth_comparison.h"
 
@@ -137,12 +140,13 @@ void EvaluatePoints(const LocalRegression& regression, const StageInputs& inputs
 // truth when there is one.
 void TabulateAndScore(const LocalRegression& regression, const ReconstructOptions& options, const BrdfModel* truth,
                       const BrdfModel* fill_model, const std::string& tmp, ReconstructResult* result,
-                      nlohmann::json* timings) {
+                      nlohmann::json* timings, MerlTable* table_out, std::vector<uint8_t>* domain_out) {
   nlohmann::json& summary = result->summary;
   TabulateSummary tabulated;
   std::vector<float> ess;
-  std::vector<uint8_t> domain;
-  const MerlTable table = TabulateMerl(regression, options.tabulate, &tabulated, &ess, &domain, fill_model);
+  std::vector<uint8_t>& domain = *domain_out;
+  *table_out = TabulateMerl(regression, options.tabulate, &tabulated, &ess, &domain, fill_model);
+  const MerlTable& table = *table_out;
   (*timings)["tabulate_s"] = tabulated.seconds;
   Log(1, "regression: " + std::to_string(regression.size()) + " samples in " + std::to_string(regression.points()) +
              " points, " + tabulated.reliability.Brief());
@@ -272,6 +276,152 @@ std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, con
   return std::move(lafortune_chosen ? lafortune.brdf : ggx.brdf);
 }
 
+// NAME.bsdf from the regression (measured and interpolated nodes) and, where it has no data, the chosen
+// fit (else the regression's extrapolation, else 0), said in the file's description and the summary;
+// then read back as the readers do and compared with the table over its measured cells.
+void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& options, const BrdfModel* chosen,
+                const MerlTable& table, const std::vector<uint8_t>& domain, const std::string& name,
+                const std::string& samples_file, const std::string& tmp, ReconstructResult* result,
+                nlohmann::json* timings) {
+  Timer timer;
+  DomainCounts classes;
+  uint64_t filled_model = 0, filled_extrapolated = 0, zero = 0;
+  const BrdfBatch source = [&](const std::vector<Eigen::Vector3d>& wi, const std::vector<Eigen::Vector3d>& wo,
+                               std::vector<Eigen::Vector3d>* f) {
+    const size_t n = wi.size();
+    std::vector<Eigen::Vector3d> uvw(n);
+    std::vector<double> theta_d(n);
+    for (size_t i = 0; i < n; ++i) {
+      HalfDiffAngles angles;
+      ToHalfDiff(wi[i], wo[i], &angles);
+      theta_d[i] = angles.theta_d;
+      uvw[i] = RegressionCoordinates(angles);
+    }
+    ReliabilityCounts counts;
+    const std::vector<Estimate> estimates = regression.EvaluateMany(uvw, &counts);
+    f->assign(n, Eigen::Vector3d::Zero());
+    for (size_t i = 0; i < n; ++i) {
+      const Estimate& e = estimates[i];
+      DomainClass c = ClassifyEstimate(e, theta_d[i], regression, options.tabulate.domain);
+      if (e.effective_samples < options.tabulate.min_effective_samples) c = DomainClass::kUnmeasured;
+      classes.Add(c);
+      if (c != DomainClass::kUnmeasured) {
+        (*f)[i] = e.value;
+      } else if (chosen) {
+        (*f)[i] = chosen->Eval(wi[i], wo[i]);
+        ++filled_model;
+      } else if (e.status != EstimateStatus::kUnsupported) {
+        (*f)[i] = e.value;
+        ++filled_extrapolated;
+      } else {
+        ++zero;
+      }
+    }
+  };
+  // The description is written after the tables are built (it names what was filled), so the tables
+  // are built first with a placeholder and the text replaced.
+  TensorFile file = BuildRglBsdf(source, "", options.bsdf_export);
+  const uint64_t nodes = classes.measured + classes.interpolated + classes.unmeasured;
+  auto percent = [nodes](uint64_t n) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof(buffer), "%.1f", nodes ? 100.0 * double(n) / double(nodes) : 0.0);
+    return std::string(buffer);
+  };
+  std::ostringstream text;
+  text << "ibrdf reconstruct: the isotropic RGB BRDF of " << name << " from "
+       << (samples_file.empty() ? std::string("samples") : samples_file)
+       << " by local polynomial regression (Marschner et al. 1999); tables after Dupuy and Jakob 2018 (NDF from"
+          " retro-reflection). Of the "
+       << nodes << " BRDF nodes, " << classes.measured << " measured, " << classes.interpolated << " interpolated, "
+       << classes.unmeasured << " (" << percent(classes.unmeasured) << " %) unmeasured: ";
+  if (!classes.unmeasured) {
+    text << "none";
+  } else if (chosen) {
+    text << "filled with the " << chosen->ModelName() << " fit (invented values)";
+  } else {
+    text << filled_extrapolated << " filled with the regression's extrapolation (invented values), " << zero
+         << " set to 0 (no estimate, no fit)";
+  }
+  text << ". Spectra: a box-like upsampling of the RGB (not colour-exact); the rgb field is exact.";
+  file["description"] = TextField(text.str());
+  const std::string file_name = name + ".bsdf";
+  WriteTensorFile(tmp + "/" + file_name, file);
+  const double build_s = timer.ElapsedSeconds();
+
+  // Read back as a reader does and compare with the table over its measured cells (theta <= 80).
+  const RglBsdf written(tmp + "/" + file_name);
+  std::vector<size_t> cells;
+  for (size_t flat = 0; flat < domain.size(); ++flat) {
+    if (domain[flat] == uint8_t(DomainClass::kMeasured)) cells.push_back(flat);
+  }
+  const size_t stride = std::max<size_t>(1, cells.size() / 200000);
+  std::vector<double> errors;
+  std::vector<std::vector<double>> band_errors(3);  // theta_max 0-25, 25-50, 50-80 degrees
+  for (size_t n = 0; n < cells.size(); n += stride) {
+    const size_t flat = cells[n];
+    const int i_h = int(flat / (size_t(kMerlThetaD) * kMerlPhiD)), i_d = int(flat / kMerlPhiD % kMerlThetaD),
+              i_p = int(flat % kMerlPhiD);
+    Eigen::Vector3d wi, wo;
+    FromHalfDiff(MerlCellCentre(i_h, i_d, i_p), &wi, &wo);
+    const double theta_max = std::acos(std::min(wi.z(), wo.z())) * 180 / M_PI;
+    if (theta_max > 80.0) continue;
+    const Eigen::Vector3d t = table.Cell(flat), g = written.Eval(wi, wo);
+    const int band = theta_max < 25.0 ? 0 : theta_max < 50.0 ? 1 : 2;
+    for (int c = 0; c < 3; ++c) {
+      if (!(t[c] > 0.0)) continue;
+      errors.push_back(std::abs(g[c] - t[c]) / t[c]);
+      band_errors[band].push_back(errors.back());
+    }
+  }
+  auto quantile = [](std::vector<double> v, double q) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v[std::min(v.size() - 1, size_t(q * double(v.size())))];
+  };
+  nlohmann::json bands = nlohmann::json::object();
+  const char* band_names[] = {"0-25", "25-50", "50-80"};
+  for (int b = 0; b < 3; ++b) {
+    bands[band_names[b]] = {{"median", quantile(band_errors[b], 0.5)},
+                            {"p95", quantile(band_errors[b], 0.95)},
+                            {"values", band_errors[b].size()}};
+  }
+  result->bsdf_written = true;
+  result->bsdf_median_error = quantile(errors, 0.5);
+  result->bsdf_p95_error = quantile(errors, 0.95);
+  (*timings)["bsdf_s"] = timer.ElapsedSeconds();
+  const BsdfExportOptions& o = options.bsdf_export;
+  result->summary["bsdf"] = {
+      {"file", file_name},
+      {"format", "RGL tensor file (Dupuy and Jakob 2018): Mitsuba 3 / pbrt-v4 measured, brdf-loader"},
+      {"theta_i_count", o.theta_i_count},
+      {"max_theta_i_deg", o.max_theta_i_deg},
+      {"rgb_size", o.rgb_size},
+      {"vndf_size", o.vndf_size},
+      {"ndf_size", o.ndf_size},
+      {"nodes",
+       {{"measured", classes.measured},
+        {"interpolated", classes.interpolated},
+        {"unmeasured", classes.unmeasured},
+        {"filled_with_model", filled_model},
+        {"filled_with_extrapolation", filled_extrapolated},
+        {"zero", zero},
+        {"fill_model", chosen ? chosen->ModelName() : ""}}},
+      {"error_against_table",
+       {{"domain", "measured cells (domain.npy 2), theta_i, theta_e <= 80 deg, every channel"},
+        {"median", result->bsdf_median_error},
+        {"p95", result->bsdf_p95_error},
+        {"values", errors.size()},
+        {"by_theta_max_deg", bands}}},
+      {"build_s", build_s}};
+  Log(1, "wrote " + file_name + " (RGL .bsdf; " + std::to_string(classes.unmeasured) + " of " + std::to_string(nodes) +
+             " nodes unmeasured" +
+             (classes.unmeasured ? chosen ? ", filled with the " + chosen->ModelName() + " fit" : ", extrapolated or 0"
+                                 : std::string()) +
+             "); read back against the table's measured cells: median " +
+             std::to_string(100 * result->bsdf_median_error) + " %, 95th percentile " +
+             std::to_string(100 * result->bsdf_p95_error) + " %");
+}
+
 nlohmann::json RegressionJson(const ReconstructOptions& options, const LocalRegressionOptions& r,
                               const LocalRegression& regression) {
   return {{"degree", r.degree},
@@ -338,7 +488,13 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
   }
   result.summary["regression"] = RegressionJson(options, result.regression, regression);
   if (!options.eval_only) {
-    TabulateAndScore(regression, options, inputs.truth.get(), fill_model, tmp, &result, &timings);
+    MerlTable table;
+    std::vector<uint8_t> domain;
+    TabulateAndScore(regression, options, inputs.truth.get(), fill_model, tmp, &result, &timings, &table, &domain);
+    if (options.bsdf) {
+      ExportBsdf(regression, options, chosen.get(), table, domain, MaterialName(options, samples_file), samples_file,
+                 tmp, &result, &timings);
+    }
   }
   result.total_s = total.ElapsedSeconds();
   timings["total_s"] = result.total_s;
@@ -362,6 +518,7 @@ bool ReconstructOptions::Check(std::string* why) const {
   if (!selection.Check(&inner)) return fail("selection");
   if (!tabulate.Check(&inner)) return fail("tabulate");
   if (!fit.Check(&inner)) return fail("fit");
+  if (!bsdf_export.Check(&inner)) return fail("bsdf_export");
   IBRDF_CHECK_OPTION(!eval_only || !eval_file.empty());
   // --fill model fills with the chosen fit, so the fits must run.
   IBRDF_CHECK_OPTION(tabulate.fill != FillMode::kModel || (fits && !eval_only));
@@ -382,6 +539,7 @@ std::string ReconstructResult::BriefReport() const {
     out << ", fits rel. RMS Lafortune " << lafortune_rel_rms << " GGX " << ggx_rel_rms << " (chosen " << chosen_model
         << ")";
   }
+  if (bsdf_written) out << ", .bsdf vs table median " << 100 * bsdf_median_error << " %";
   if (scored) out << ", against the truth " << error_against_truth.Brief();
   out << ", " << total_s << " s";
   return out.str();

@@ -7,8 +7,8 @@
 // The output folder (written atomically: it appears only when complete) holds brdf.binary (MERL
 // 90x90x180), brdf.npy (90,90,180,3; -1 unmeasured), domain.npy (each cell measured 2, interpolated 1,
 // unmeasured 0), brdf.json (the table's sidecar: counts, fill), effective_samples.npy, lafortune.json
-// and ggx.json (material files), the renderer snippets, summary.json, and with evaluation points
-// eval.npy and eval_domain.npy (and eval_truth.npy with a truth). docs/reconstruct.md describes them.
+// and ggx.json (material files), the renderer snippets, NAME.bsdf (RGL tensor file), summary.json, and with evaluation
+// points eval.npy and eval_domain.npy (and eval_truth.npy with a truth). docs/reconstruct.md describes them.
 // EvaluateMaterial evaluates a material file at the points without any samples or regression.
 #pragma once
 
@@ -20,6 +20,7 @@
 
 #include "core/sample_file.h"
 #include "reconstruct/bandwidth_selection.h"
+#include "reconstruct/bsdf_export.h"
 #include "reconstruct/local_regression.h"
 #include "reconstruct/merl_table.h"
 #include "reconstruct/model_fit.h"
@@ -39,6 +40,10 @@ struct ReconstructOptions {
   TabulateOptions tabulate;  // the MERL table: theta limit, minimum effective samples per cell
   ModelFitOptions fit;       // the Lafortune and GGX fits
   bool fits = true;          // fit the Lafortune and GGX models (false: `--no-fits`)
+  // Write NAME.bsdf, the RGL tensor file of Mitsuba 3's and pbrt-v4's `measured` materials
+  // (reconstruct/bsdf_export.h; false: `--no-bsdf`), with these table sizes.
+  bool bsdf = true;
+  BsdfExportOptions bsdf_export;
   // Also evaluate at these points: a float64 .npy of shape (N, 3) holding theta_i, theta_e, delta_phi
   // in radians (empty: none). Writes eval.npy (N x 3 RGB, -1 where unsupported).
   std::string eval_file;
@@ -72,6 +77,9 @@ struct ReconstructResult {
   std::string chosen_model;                 // the fit with the lowest error (the one --fill model uses)
   bool scored = false;                      // compared with the truth (a truth and a table)
   ReconstructionError error_against_truth;  // in the measured domain (theta <= 80 degrees)
+  bool bsdf_written = false;                // NAME.bsdf was written
+  double bsdf_median_error = 0.0;           // the .bsdf against the table over the measured cells: median
+  double bsdf_p95_error = 0.0;              // and 95th percentile relative error (all channels)
   double total_s = 0.0;                     // wall time of the stage
   nlohmann::json summary;                   // summary.json as written
   // One line: samples, points, cells, fit and truth errors, time.

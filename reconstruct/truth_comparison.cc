@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/merl_brdf.h"
+#include "core/rgl_bsdf.h"
 #include "core/sample_file.h"
 #include "core/statistics.h"
 
@@ -135,7 +136,7 @@ std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path) {
 }
 
 std::unique_ptr<BrdfModel> LoadTruthFile(const std::string& path) {
-  if (IsMerlPath(path)) return LoadMaterial(path);
+  if (IsMerlPath(path) || IsRglBsdfPath(path)) return LoadMaterial(path);
   const nlohmann::json json = ReadJsonFile(path);
   if (json.is_object() && json.contains("format")) return LoadTruthMaterial(path);
   return MaterialFromJson(json, path);

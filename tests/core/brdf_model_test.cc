@@ -384,5 +384,42 @@ TEST(MaterialFromJson, SampleMaterialsLoad) {
   }
 }
 
+// The dielectric GGX's specular term vanishes with F0 = 0: a pure Lambertian is representable (the
+// Schlick term stays at (1 - cos)^5 D G / (4 cos cos) there).
+TEST(GgxBrdf, DielectricWithZeroF0IsLambertian) {
+  const Eigen::Vector3d albedo(0.6, 0.3, 0.1);
+  const GgxBrdf dielectric(albedo, Eigen::Vector3d::Zero(), 0.3, GgxFresnel::kDielectric);
+  const GgxBrdf schlick(albedo, Eigen::Vector3d::Zero(), 0.3);
+  const LambertianBrdf lambert(albedo);
+  const Eigen::Vector3d wi = FromSpherical(80.0 * M_PI / 180, 0.0), wo = FromSpherical(80.0 * M_PI / 180, M_PI);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_DOUBLE_EQ(dielectric.Eval(wi, wo)[c], lambert.Eval(wi, wo)[c]);
+    EXPECT_DOUBLE_EQ(dielectric.Eval(wo, wo)[c], lambert.Eval(wo, wo)[c]);
+  }
+  EXPECT_GT(schlick.Eval(FromSpherical(85.0 * M_PI / 180, 0.0), FromSpherical(85.0 * M_PI / 180, M_PI))[0],
+            1.05 * lambert.Eval(wi, wo)[0]);
+  ExpectReciprocal(GgxBrdf(albedo, Eigen::Vector3d(0.04, 0.05, 0.06), 0.2, GgxFresnel::kDielectric));
+}
+
+TEST(GgxBrdf, DielectricFresnelMatchesItsLimits) {
+  // Normal incidence: ((eta - 1) / (eta + 1))^2 = F0; grazing: 1; eta 1.5 at 45 degrees: 0.0502
+  // (the textbook value of the unpolarized average).
+  EXPECT_NEAR(DielectricFresnel(1.0, IorFromF0(0.04)), 0.04, 1e-12);
+  EXPECT_NEAR(IorFromF0(0.04), 1.5, 1e-12);
+  EXPECT_NEAR(DielectricFresnel(1e-9, 1.5), 1.0, 1e-6);
+  EXPECT_NEAR(DielectricFresnel(std::cos(M_PI / 4), 1.5), 0.0502, 2e-4);
+  EXPECT_EQ(DielectricFresnel(0.3, 1.0), 0.0);
+  // Round trip through the material format.
+  const GgxBrdf ggx(Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Vector3d(0.04, 0.04, 0.04), 0.2, GgxFresnel::kDielectric);
+  const nlohmann::json material = ggx.ToJson();
+  EXPECT_EQ(material["fresnel"], "dielectric");
+  const auto again = MaterialFromJson(material, "x.json");
+  const Eigen::Vector3d wi = FromSpherical(0.4, 0.0), wo = FromSpherical(0.9, 2.5);
+  EXPECT_EQ(again->Eval(wi, wo), ggx.Eval(wi, wo));
+  nlohmann::json bad = material;
+  bad["fresnel"] = "fancy";
+  EXPECT_NE(testing::ErrorOf([&] { MaterialFromJson(bad, "x.json"); }).find("x.json: /fresnel"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace ibrdf
