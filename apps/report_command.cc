@@ -40,6 +40,11 @@ void AddReportCommand(CLI::App& app) {
       ->delimiter(',')
       ->expected(1, 8)
       ->capture_default_str();
+  command
+      ->add_option("--held-out", o.held_out_photos,
+                   "Photos shown held out (0 to 16): each beside the sample rendered by the regression fitted\n"
+                   "without it (the photos `ibrdf check --regression --held-out N` holds out; one fit each)")
+      ->capture_default_str();
   command->add_option("--title", o.title, "Report title (default: the recipe's or session's name)");
   command
       ->add_option("--render-size-px,--render-size", o.render_size_px,

@@ -121,7 +121,8 @@ void AddRunCommand(CLI::App& app) {
                              Named{"--visibility", "derender", "Mesh samples' shadow rays: auto, on or off"},
                              Named{"--max-theta-i-deg", "derender", "Reject samples beyond this incidence angle"},
                              Named{"--max-theta-e-deg", "derender", "Reject samples beyond this exitance angle"},
-                             Named{"--min-signal", "derender", "Reject pixels below this linear signal"}}) {
+                             Named{"--min-signal", "derender", "Reject pixels below this linear signal"},
+                             Named{"--held-out", "report", "Photos shown held out (a fit without each)"}}) {
     const std::string flag = named.flag, stage = named.stage;
     command
         ->add_option_function<std::string>(
@@ -163,7 +164,9 @@ void AddRunCommand(CLI::App& app) {
       const size_t a = named.find('\n'), b = named.find('\n', a + 1);
       const std::string stage = named.substr(0, a);
       std::vector<std::string>* target =
-          stage == "derender" ? &args->options.derender_args : &args->options.reconstruct_args;
+          stage == "derender" ? &args->options.derender_args
+          : stage == "report" ? &args->options.report_args
+                              : &args->options.reconstruct_args;
       target->push_back(named.substr(a + 1, b - a - 1));
       target->push_back(named.substr(b + 1));
     }

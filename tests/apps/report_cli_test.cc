@@ -110,6 +110,13 @@ TEST_F(RunFolderTest, RunPassesStageOptionsThrough) {
   EXPECT_TRUE(has(ReadJson(out + "/stamps/derender.json")["args"], "--min-signal", "0.001"));
   EXPECT_TRUE(has(ReadJson(out + "/stamps/check.json")["args"], "--match-deg", "0.4"));
   EXPECT_EQ(ReadJson(out + "/consistency.json")["options"]["match_deg"], 0.4);
+  // The same run with its report: only the report runs, with the held-out photos asked for.
+  const RunResult report = RunIbrdf("run " + dir_ / "a" + " --out " + out +
+                                    " --lobes 1 --min-signal 0.001 --reconstruct-args '--degree 1' "
+                                    "--check-args '--match-deg 0.4' --held-out 2");
+  ASSERT_EQ(report.exit_code, 0) << report.output;
+  EXPECT_TRUE(has(ReadJson(out + "/stamps/report.json")["args"], "--held-out", "2"));
+  EXPECT_EQ(ReadJson(out + "/report/report-data.json")["held_out"].size(), 2u);
   // A bad pass-through value fails in its stage, naming the flag.
   const RunResult bad = RunIbrdf("run " + dir_ / "a" + " --out " + out + " --no-report --lobes 7");
   EXPECT_NE(bad.exit_code, 0);
@@ -152,39 +159,70 @@ TEST_F(RunFolderTest, ReportFindsTheGivenReconstructionAndAcceptsOldNames) {
 namespace ibrdf {
 namespace {
 
-// The README's demo figures come from a run's summary.json through scripts/readme_figures.py, not typed.
-TEST(ReportCli, ReadmeFiguresAreRegeneratedFromTheRun) {
-  ScratchDir dir;
-  const nlohmann::json summary = {{"samples", {{"accepted", 1234}}},
-                                  {"timings_s", {{"stages_total", 26.04}}},
-                                  {"truth",
-                                   {{"samples_median_rel_error", {0.01, 0.02, 0.03}},
-                                    {"brdf_rel_rmse", {0.004, 0.005, 0.006}},
-                                    {"brdf_cells_scored", 777}}},
-                                  {"consistency", {{"reciprocity", 0.0012}, {"isotropy", 0.0034}}},
-                                  {"report", "/x/report/index.html"}};
-  { std::ofstream(dir / "summary.json") << summary.dump(); }
-  {
-    std::ofstream(dir / "README.md") << "intro\n<!-- readme-figures -->\n```\n1117060 samples; stages took 146.8 "
-                                        "s\n```\n<!-- /readme-figures -->\nrest\n";
-  }
+// The README's demo figures come from a run's summary.json through scripts/readme_figures.py, not typed:
+// the script writes the block (headline lines and the stage-time table) and its --check holds the
+// README's block to the script's format (every line; the values are the run's).
+int Python(const std::string& arguments) {
   const std::string script = std::string(IBRDF_SAMPLES_DIR) + "/../scripts/readme_figures.py";
-  ASSERT_EQ(
-      std::system(
-          ("/usr/bin/python3 " + script + " " + dir.str() + " --update " + dir / "README.md" + " > /dev/null").c_str()),
-      0);
-  std::ifstream in(dir / "README.md");
+  return testing::RunShell("/usr/bin/python3 " + script + " " + arguments + " 2>&1").exit_code;
+}
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path);
   std::stringstream text;
   text << in.rdbuf();
-  const std::string readme = text.str();
+  return text.str();
+}
+
+TEST(ReportCli, ReadmeFiguresAreRegeneratedFromTheRun) {
+  ScratchDir dir;
+  const nlohmann::json summary = {
+      {"samples", {{"accepted", 1234}, {"photos", 20}}},
+      {"timings_s", {{"synth", 6.0}, {"derender", 10.0}, {"reconstruct", 10.04}, {"stages_total", 26.04}}},
+      {"truth",
+       {{"samples_median_rel_error", {0.01, 0.02, 0.03}},
+        {"brdf_rel_rmse", {0.004, 0.005, 0.006}},
+        {"brdf_cells_scored", 777}}},
+      {"consistency",
+       {{"reciprocity", 0.0012}, {"reciprocity_p95", 0.003}, {"bilateral_symmetry", 0.0034},
+        {"bilateral_symmetry_p95", 0.0051}}},
+      {"report", "/x/report/index.html"}};
+  { std::ofstream(dir / "summary.json") << summary.dump(); }
+  const std::string typed =
+      "intro\n<!-- readme-figures -->\n```\n1117060 samples; stages took 146.8 s\n```\n<!-- /readme-figures "
+      "-->\nrest\n";
+  { std::ofstream(dir / "README.md") << typed; }
+  EXPECT_NE(Python("--check " + dir / "README.md"), 0) << "a typed block is not the script's";
+  ASSERT_EQ(Python(dir.str() + " --update " + dir / "README.md"), 0);
+  const std::string readme = Slurp(dir / "README.md");
   EXPECT_EQ(readme.find("146.8"), std::string::npos) << readme;
-  EXPECT_NE(readme.find("1234 samples; stages took 26.0 s"), std::string::npos) << readme;
-  EXPECT_NE(readme.find("Reciprocity error 0.12 %, bilateral-symmetry error 0.34 %"), std::string::npos) << readme;
+  EXPECT_NE(readme.find("1234 samples from 20 photos; stages took 26.0 s"), std::string::npos) << readme;
+  EXPECT_NE(readme.find("Reciprocity error 0.12 %, bilateral-symmetry error 0.34 % (medians over bins; 95th "
+                        "percentiles 0.30 %, 0.51 %)"),
+            std::string::npos)
+      << readme;
   EXPECT_NE(readme.find("over 777 MERL cells"), std::string::npos) << readme;
+  EXPECT_NE(readme.find("| reconstruct | 10.0 | 39 % |"), std::string::npos) << readme;
+  EXPECT_NE(readme.find("| total | 26.0 | 100 % |"), std::string::npos) << readme;
   EXPECT_EQ(readme.rfind("intro\n", 0), 0u);
   EXPECT_NE(readme.find("-->\nrest\n"), std::string::npos) << readme;
+  EXPECT_EQ(Python("--check " + dir / "README.md"), 0) << readme;
+  // A value edited by hand into another shape fails the check.
+  std::string edited = readme;
+  edited.replace(edited.find("| total | 26.0 |"), 16, "| total | 26 s |");
+  { std::ofstream(dir / "README.md") << edited; }
+  EXPECT_NE(Python("--check " + dir / "README.md"), 0);
   // No summary: an error naming it, the README untouched.
-  EXPECT_NE(std::system(("/usr/bin/python3 " + script + " " + dir / "nowhere" + " 2> /dev/null").c_str()), 0);
+  EXPECT_NE(Python(dir / "nowhere" + " --update " + dir / "README.md"), 0);
+  EXPECT_EQ(Slurp(dir / "README.md"), edited);
+}
+
+// The repository's README shows the block the script writes (its format; the values are a demo run's).
+TEST(ReportCli, TheReadmesFiguresHaveTheScriptsFormat) {
+  const std::string readme = std::string(IBRDF_SAMPLES_DIR) + "/../README.md";
+  const testing::RunResult check = testing::RunShell("/usr/bin/python3 " + std::string(IBRDF_SAMPLES_DIR) +
+                                                     "/../scripts/readme_figures.py --check " + readme + " 2>&1");
+  EXPECT_EQ(check.exit_code, 0) << check.output;
 }
 
 }  // namespace
