@@ -68,6 +68,7 @@ void AddTargetsCommand(CLI::App& app) {
     options.board.square_size = 1e-3 * args->square_mm;
     options.board.marker_size = 1e-3 * args->board_marker_mm;
     options.charuco = !args->no_charuco;
+    RequireValidOptions(options, "ibrdf targets");
     const TargetSheetsResult result = WriteTargetSheets(options, args->out);
     Log(1, result.BriefReport());
     for (const std::string& file : result.files) std::cout << args->out << "/" << file << "\n";

@@ -27,8 +27,8 @@
 #include "reconstruct/merl_table.h"
 #include "reconstruct/prediction_check.h"
 #include "reconstruct/truth_comparison.h"
-#include "report/photo_comparison.h"
 #include "report/light_photos.h"
+#include "report/photo_comparison.h"
 #include "report/photo_statistics.h"
 #include "report/report_script.h"
 #include "report/sphere_render.h"
@@ -154,7 +154,7 @@ Eigen::Vector3d Wo(const BrdfSample& s) { return Eigen::Vector3d(s.wo[0], s.wo[1
 // A model's values at one photo's samples: a function of the directions, or given per sample.
 struct PhotoModel {
   std::string name;
-  BrdfEvalFunction eval;               // empty when `values` holds them
+  BrdfEvalFunction eval;                // empty when `values` holds them
   std::vector<Eigen::Vector3d> values;  // per sample of the photo, in its order
 };
 
@@ -186,14 +186,10 @@ nlohmann::json RenderPhoto(const Session& session, uint32_t index, const PhotoSt
                        {"difference", npy},
                        {"median_abs_difference", render.median_abs_difference}});
   }
-  return {{"file", prefix + ".png"},
-          {"source", session.PhotoPath(index)},
-          {"index", index},
-          {"crop", {box.x0, box.y0, box.x1, box.y1}},
-          {"full_resolution", true},
-          {"stride", SampleStride(own)},
-          {"samples", p.count},
-          {"renders", renders}};
+  return {{"file", prefix + ".png"}, {"source", session.PhotoPath(index)},
+          {"index", index},          {"crop", {box.x0, box.y0, box.x1, box.y1}},
+          {"full_resolution", true}, {"stride", SampleStride(own)},
+          {"samples", p.count},      {"renders", renders}};
 }
 
 // The samples' session, from the sample file's sidecar; `*note` says why not when it cannot be read.
@@ -273,8 +269,8 @@ LocalRegressionOptions ReconstructionRegression(const std::string& table_path) {
 // reconstruction's options, evaluated at the photo's own directions rather than through the table), the
 // reconstruction that saw it, and the signed differences. A photo that cannot be read is a note.
 void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector<BrdfSample>& samples,
-                        std::map<uint32_t, PhotoStats>& photos, int count, const RunModels& models,
-                        const fs::path& tmp, nlohmann::json* data, ReportResult* result) {
+                        std::map<uint32_t, PhotoStats>& photos, int count, const RunModels& models, const fs::path& tmp,
+                        nlohmann::json* data, ReportResult* result) {
   if (count <= 0 || !session) return;
   const LocalRegressionOptions regression_options = ReconstructionRegression(models.table_path);
   nlohmann::json held = nlohmann::json::array();
@@ -306,8 +302,8 @@ void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector
     if (!models.named.empty() && models.named.front().name == "reconstruction")
       photo_models.push_back({"reconstruction", models.named.front().eval, {}});
     try {
-      nlohmann::json photo = RenderPhoto(*session, image, photos[image], own, photo_models,
-                                         "held-out-" + std::to_string(image), tmp);
+      nlohmann::json photo =
+          RenderPhoto(*session, image, photos[image], own, photo_models, "held-out-" + std::to_string(image), tmp);
       const std::vector<float>& phase = photos[image].phase;
       photo["phase_deg"] = phase.empty() ? 0.0 : Percentile(phase, 0.5) / kDeg;
       photo["fit_samples"] = fit.size();
@@ -316,7 +312,8 @@ void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector
       HeldOutRender shown;
       shown.image = image;
       shown.median_abs_difference = photo["renders"][0]["median_abs_difference"];
-      if (photo["renders"].size() > 1) shown.in_sample_median_abs_difference = photo["renders"][1]["median_abs_difference"];
+      if (photo["renders"].size() > 1)
+        shown.in_sample_median_abs_difference = photo["renders"][1]["median_abs_difference"];
       result->held_out.push_back(shown);
       held.push_back(photo);
     } catch (const Error& e) {

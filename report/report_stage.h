@@ -62,9 +62,9 @@ struct ReportResult {
   std::string photo_note;       // why not, when the samples' session could not be read
   bool reconstruction = false;  // a reconstruction was found (its path in reconstruction_path)
   std::string reconstruction_path;
-  std::vector<std::string> fits;     // the fitted models found beside it ("lafortune", "ggx")
-  bool truth = false;                // the run's truth-comparison.json names a truth
-  std::vector<BandAgreement> bands;  // incidence-plane agreement of the reconstruction with the samples
+  std::vector<std::string> fits;        // the fitted models found beside it ("lafortune", "ggx")
+  bool truth = false;                   // the run's truth-comparison.json names a truth
+  std::vector<BandAgreement> bands;     // incidence-plane agreement of the reconstruction with the samples
   std::vector<HeldOutRender> held_out;  // the held-out photos shown
   // One line: where, which photo, what was rendered.
   std::string BriefReport() const;

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -46,13 +47,16 @@ TEST(ReportCli, RegressionLineSaysInvalidNotZeroPercent) {
   EXPECT_EQ(line.find("over 0 pairs"), std::string::npos) << line;
 }
 
+// Every subcommand's help: no CLI11 default braces on a flag ("--no-mixed-pixel-mask{false}").
 TEST(ReportCli, HelpTextsHaveNoDefaultBracesOnFlags) {
-  for (const char* command : {"check", "report", "run"}) {
+  for (const char* command : {"targets", "session init", "synth", "scan", "align", "lights calibrate", "lights synth",
+                              "derender", "reconstruct", "check", "report", "run", "compare", "batch", "library"}) {
     const RunResult help = RunIbrdf(std::string(command) + " --help");
     EXPECT_EQ(help.exit_code, 0) << command;
     EXPECT_EQ(help.output.find("{false}"), std::string::npos) << command << ":\n" << help.output;
     EXPECT_EQ(help.output.find("{true}"), std::string::npos) << command << ":\n" << help.output;
   }
+  EXPECT_NE(RunIbrdf("derender --help").output.find("--no-mixed-pixel-mask "), std::string::npos);
   const RunResult report = RunIbrdf("report --help");
   for (const char* name : {"--render-size-px", "--angles-deg", "--reconstruction", "--title"}) {
     EXPECT_NE(report.output.find(name), std::string::npos) << name;
@@ -60,6 +64,91 @@ TEST(ReportCli, HelpTextsHaveNoDefaultBracesOnFlags) {
   const RunResult check = RunIbrdf("check --help");
   EXPECT_NE(check.output.find("--min-pairs"), std::string::npos);
   EXPECT_EQ(check.output.find("isotropy"), std::string::npos) << "one name: bilateral symmetry";
+}
+
+// Option names carry their unit; the previous release's names still work for one release, hidden from
+// --help, with a warning naming the new name; giving both is a usage error.
+TEST(ReportCli, UnitSuffixedNamesWithHiddenOldAliases) {
+  const struct {
+    const char* command;
+    std::vector<std::string> renamed;  // old name, new name, ...
+  } commands[] = {
+      {"synth",
+       {"--radius", "--radius-m", "--length", "--length-m", "--camera-distance", "--camera-distance-m",
+        "--light-distance", "--light-distance-m", "--origin", "--origin-m", "--full-well", "--full-well-e",
+        "--read-noise", "--read-noise-e"}},
+      {"session init",
+       {"--sample-radius", "--sample-radius-m", "--sample-center", "--sample-center-m", "--light-position",
+        "--light-position-m"}},
+      {"lights synth",
+       {"--light-distance", "--light-distance-m", "--center", "--center-m", "--radius", "--radius-m", "--distance",
+        "--distance-m"}},
+      {"lights calibrate", {"--light-distance", "--light-distance-m"}},
+      {"library", {"--sphere-size", "--sphere-size-px"}},
+      {"report", {"--angles", "--angles-deg", "--render-size", "--render-size-px"}},
+      {"check", {"--min-samples", "--min-pairs"}},
+  };
+  for (const auto& c : commands) {
+    const std::string help = RunIbrdf(std::string(c.command) + " --help").output;
+    for (size_t i = 0; i + 1 < c.renamed.size(); i += 2) {
+      const std::string& old_name = c.renamed[i];
+      const std::string& new_name = c.renamed[i + 1];
+      EXPECT_NE(help.find("  " + new_name + " "), std::string::npos) << c.command << " " << new_name << "\n" << help;
+      EXPECT_EQ(help.find("  " + old_name + " "), std::string::npos) << c.command << " " << old_name << "\n" << help;
+      EXPECT_EQ(help.find(old_name + ","), std::string::npos) << c.command << " " << old_name << "\n" << help;
+    }
+  }
+  // The old and the new name write the same session; the old one warns.
+  ScratchDir dir;
+  const std::string synth = std::string("synth --material ") + IBRDF_SAMPLES_DIR +
+                            "/materials/lambertian50.json --photos 1 --width 48 --height 36 --effects none --out ";
+  const RunResult by_new =
+      RunIbrdf(synth + dir / "new" + " --radius-m 0.03 --camera-distance-m 0.9 --read-noise-e 2", true);
+  ASSERT_EQ(by_new.exit_code, 0) << by_new.output;
+  EXPECT_EQ(by_new.output.find("deprecated"), std::string::npos) << by_new.output;
+  const RunResult by_old = RunIbrdf(synth + dir / "old" + " --radius 0.03 --camera-distance 0.9 --read-noise 2", true);
+  ASSERT_EQ(by_old.exit_code, 0) << by_old.output;
+  EXPECT_NE(by_old.output.find("warning: --radius is deprecated; use --radius-m"), std::string::npos) << by_old.output;
+  EXPECT_NE(by_old.output.find("warning: --camera-distance is deprecated; use --camera-distance-m"), std::string::npos)
+      << by_old.output;
+  const nlohmann::json a = ReadJson(dir / "new/session.json"), b = ReadJson(dir / "old/session.json");
+  EXPECT_EQ(a["sample"]["radius"], 0.03);
+  EXPECT_EQ(a["sample"], b["sample"]);
+  EXPECT_EQ(a["photos"], b["photos"]);
+  const RunResult both = RunIbrdf(synth + dir / "both" + " --radius 0.03 --radius-m 0.03");
+  EXPECT_EQ(both.exit_code, 2) << both.output;
+  EXPECT_FALSE(fs::exists(dir / "both"));
+}
+
+// An option value that a stage's options Check() rejects is a usage error: exit 2, the flags and the
+// failed constraint named, nothing written; bad input (a missing file) stays exit 1.
+TEST(ReportCli, BadOptionValuesAreUsageErrors) {
+  ScratchDir dir;
+  const std::string material = std::string(IBRDF_SAMPLES_DIR) + "/materials/lambertian50.json";
+  const struct {
+    std::string arguments, named, output;
+  } cases[] = {
+      {"derender " + dir / "none" + " --out " + dir / "x.npy" + " --stride 0", "pixel_stride", dir / "x.npy"},
+      {"derender " + dir / "none" + " --out " + dir / "x.npy" + " --max-theta-i-deg 95", "max_theta_i_deg",
+       dir / "x.npy"},
+      {"reconstruct " + dir / "none.npy" + " --out " + dir / "r" + " --lobes 7", "--lobes", dir / "r"},
+      {"reconstruct " + dir / "none.npy" + " --out " + dir / "r" + " --fill sideways", "--fill", dir / "r"},
+      {"reconstruct " + dir / "none.npy" + " --out " + dir / "r" + " --degree 5", "--degree", dir / "r"},
+      {"check " + dir / "none.npy" + " --out " + dir / "c.json" + " --phi-bin-deg 7", "phi_bin_deg", dir / "c.json"},
+      {"report " + dir.str() + " --out " + dir / "rep" + " --render-size-px 8", "render_size_px", dir / "rep"},
+      {"report " + dir.str() + " --out " + dir / "rep" + " --held-out 99", "held_out_photos", dir / "rep"},
+      {"run " + dir / "none" + " --out " + dir / "run" + " --stride 0", "--stride", dir / "run"},
+      {"synth --material " + material + " --out " + dir / "s" + " --photos 0", "ibrdf synth", dir / "s"},
+  };
+  for (const auto& c : cases) {
+    const RunResult result = RunIbrdf(c.arguments);
+    EXPECT_EQ(result.exit_code, 2) << c.arguments << "\n" << result.output;
+    EXPECT_NE(result.output.find(c.named), std::string::npos) << c.arguments << "\n" << result.output;
+    EXPECT_EQ(result.output.find("-- "), std::string::npos) << "no stage timer: " << result.output;
+    EXPECT_FALSE(fs::exists(c.output)) << c.arguments;
+  }
+  const RunResult missing = RunIbrdf("derender " + dir / "none" + " --out " + dir / "x.npy");
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
 }
 
 class RunFolderTest : public ::testing::Test {
@@ -130,7 +219,7 @@ TEST_F(RunFolderTest, ReportFindsTheGivenReconstructionAndAcceptsOldNames) {
   ASSERT_EQ(RunIbrdf("run " + dir_ / "a" + " --out " + out + " --no-report --no-fits").exit_code, 0);
   fs::rename(out + "/reconstruction", dir_ / "recon");
   const RunResult report = RunIbrdf("report " + out + " --reconstruction " + dir_ / "recon" +
-                                    " --render-size 32 --angles 20,50 --no-explorer");
+                                    " --render-size 32 --angles 20,50 --no-explorer --held-out 2");
   ASSERT_EQ(report.exit_code, 0) << report.output;
   const nlohmann::json data = ReadJson(out + "/report/report-data.json");
   EXPECT_EQ(data["reconstruction"], dir_ / "recon/brdf.binary");
@@ -140,6 +229,7 @@ TEST_F(RunFolderTest, ReportFindsTheGivenReconstructionAndAcceptsOldNames) {
   page << index.rdbuf();
   EXPECT_NE(page.str().find("<title>ibrdf report: a</title>"), std::string::npos);
   EXPECT_EQ(data["incidence_plane"].size(), 2u);
+  EXPECT_EQ(data["held_out"].size(), 2u);
   EXPECT_FALSE(fs::exists(out + "/report/explorer.html"));
   const RunResult missing =
       RunIbrdf("report " + out + " --out " + dir_ / "r2" + " --reconstruction " + dir_ / "nowhere");
@@ -184,7 +274,9 @@ TEST(ReportCli, ReadmeFiguresAreRegeneratedFromTheRun) {
         {"brdf_rel_rmse", {0.004, 0.005, 0.006}},
         {"brdf_cells_scored", 777}}},
       {"consistency",
-       {{"reciprocity", 0.0012}, {"reciprocity_p95", 0.003}, {"bilateral_symmetry", 0.0034},
+       {{"reciprocity", 0.0012},
+        {"reciprocity_p95", 0.003},
+        {"bilateral_symmetry", 0.0034},
         {"bilateral_symmetry_p95", 0.0051}}},
       {"report", "/x/report/index.html"}};
   { std::ofstream(dir / "summary.json") << summary.dump(); }
