@@ -274,34 +274,36 @@ void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector
   if (count <= 0 || !session) return;
   const LocalRegressionOptions regression_options = ReconstructionRegression(models.table_path);
   nlohmann::json held = nlohmann::json::array();
+  // A figure written as JSON: NaN (no pixel had one) is null there.
+  auto number = [](const nlohmann::json& value) { return value.is_number() ? value.get<double>() : double(NAN); };
   for (const uint32_t image : HeldOutImages(samples, count)) {
-    Timer timer;
-    std::vector<BrdfSample> fit;
-    fit.reserve(samples.size());
-    for (const BrdfSample& s : samples) {
-      if (s.image != image) fit.push_back(s);
-    }
-    const std::vector<const BrdfSample*> own = PhotoSamples(samples, image);
-    std::vector<Eigen::Vector3d> points;
-    points.reserve(own.size());
-    for (const BrdfSample* s : own) points.push_back(RegressionCoordinates(Wi(*s), Wo(*s)));
-    ReliabilityCounts reliability;
-    std::vector<Estimate> estimates;
-    {
-      const LocalRegression regression(fit, regression_options);
-      estimates = regression.EvaluateMany(points, &reliability);
-    }
-    std::vector<Eigen::Vector3d> values(own.size());
-    size_t unsupported = 0;
-    for (size_t i = 0; i < own.size(); ++i) {
-      const bool supported = estimates[i].status != EstimateStatus::kUnsupported;
-      values[i] = supported ? estimates[i].value : Eigen::Vector3d::Constant(NAN);
-      unsupported += !supported;
-    }
-    std::vector<PhotoModel> photo_models = {{"held-out", {}, std::move(values)}};
-    if (!models.named.empty() && models.named.front().name == "reconstruction")
-      photo_models.push_back({"reconstruction", models.named.front().eval, {}});
     try {
+      Timer timer;
+      std::vector<BrdfSample> fit;
+      fit.reserve(samples.size());
+      for (const BrdfSample& s : samples) {
+        if (s.image != image) fit.push_back(s);
+      }
+      const std::vector<const BrdfSample*> own = PhotoSamples(samples, image);
+      std::vector<Eigen::Vector3d> points;
+      points.reserve(own.size());
+      for (const BrdfSample* s : own) points.push_back(RegressionCoordinates(Wi(*s), Wo(*s)));
+      ReliabilityCounts reliability;
+      std::vector<Estimate> estimates;
+      {
+        const LocalRegression regression(fit, regression_options);
+        estimates = regression.EvaluateMany(points, &reliability);
+      }
+      std::vector<Eigen::Vector3d> values(own.size());
+      size_t unsupported = 0;
+      for (size_t i = 0; i < own.size(); ++i) {
+        const bool supported = estimates[i].status != EstimateStatus::kUnsupported;
+        values[i] = supported ? estimates[i].value : Eigen::Vector3d::Constant(NAN);
+        unsupported += !supported;
+      }
+      std::vector<PhotoModel> photo_models = {{"held-out", {}, std::move(values)}};
+      if (!models.named.empty() && models.named.front().name == "reconstruction")
+        photo_models.push_back({"reconstruction", models.named.front().eval, {}});
       nlohmann::json photo =
           RenderPhoto(*session, image, photos[image], own, photo_models, "held-out-" + std::to_string(image), tmp);
       const std::vector<float>& phase = photos[image].phase;
@@ -311,9 +313,9 @@ void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector
       photo["seconds"] = timer.ElapsedSeconds();
       HeldOutRender shown;
       shown.image = image;
-      shown.median_abs_difference = photo["renders"][0]["median_abs_difference"];
+      shown.median_abs_difference = number(photo["renders"][0]["median_abs_difference"]);
       if (photo["renders"].size() > 1)
-        shown.in_sample_median_abs_difference = photo["renders"][1]["median_abs_difference"];
+        shown.in_sample_median_abs_difference = number(photo["renders"][1]["median_abs_difference"]);
       result->held_out.push_back(shown);
       held.push_back(photo);
     } catch (const Error& e) {
