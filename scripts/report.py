@@ -323,7 +323,7 @@ def held_out_difference_figure(data, out, photo):
         image = ax.imshow(100 * d, cmap="RdBu_r", vmin=-10, vmax=10, interpolation="nearest")
         med = r.get("median_abs_difference")
         who = "fitted without this photo" if r["model"] == "held-out" else "reconstruction (saw this photo)"
-        ax.set_title(f"{who}: median |difference| {100 * med:.2f} %" if med is not None else who, fontsize=9)
+        ax.set_title(f"{who}:\nmedian |difference| {100 * med:.2f} %" if med is not None else who, fontsize=9)
         ax.set_xticks([])
         ax.set_yticks([])
     fig.colorbar(image, ax=list(axes[0]), fraction=0.03, label="(render - photo) / photo, % (clipped at +-10)")
