@@ -152,7 +152,7 @@ LightProbeCalibration CalibrateLightProbe(const std::vector<Session>& placements
   if (point && placements.size() < 2 && !(options.light_distance > 0)) {
     ThrowError(placements[0].manifest_path,
                "point lights need the mirror sphere at two places (two sessions) or the lights' distance from "
-               "the sphere's centre (--light-distance)");
+               "the sphere's centre (--light-distance-m)");
   }
   std::map<std::string, std::vector<Ray>> rays;  // by light id
   std::map<std::string, std::vector<Highlight>> highlights;
@@ -293,7 +293,7 @@ LightProbeCalibration CalibrateLightProbe(const std::vector<Session>& placements
       } else {
         if (!(options.light_distance > 0)) {
           ThrowError(first.manifest_path, id + " was photographed at one sphere placement only: its position needs "
-                                               "a second placement or --light-distance");
+                                               "a second placement or --light-distance-m");
         }
         // On the reflected ray, at the given distance from the sphere's centre.
         const Ray& ray = list[0];

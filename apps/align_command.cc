@@ -71,6 +71,7 @@ void AddAlignCommand(CLI::App& app) {
     options.align.fit_light = !args->no_light;
     options.align.fit_cylinder = !args->no_cylinder;
     options.colmap_runner.fix_intrinsics = !args->colmap_refine_intrinsics;
+    RequireValidOptions(options, "ibrdf align");
     // The output guard: the session folder, its files, the COLMAP model and the calibration photos.
     std::vector<std::string> inputs = session.InputFiles();
     inputs.push_back(session.manifest_path);

@@ -29,10 +29,11 @@ void AddCheckCommand(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--phi-bin-deg", args->options.phi_bin_deg, "Bin width in delta_phi (divides 360; 10, 20 or 30)")
       ->capture_default_str();
-  command
-      ->add_option("--min-pairs,--min-samples", args->options.min_samples_per_bin,
-                   "Sample pairs a bin needs to be reported (--min-samples: the old name, for one release)")
-      ->capture_default_str();
+  AddDeprecatedAlias(
+      *command,
+      command->add_option("--min-pairs", args->options.min_samples_per_bin, "Sample pairs a bin needs to be reported")
+          ->capture_default_str(),
+      "--min-samples", args->options.min_samples_per_bin);
   command
       ->add_option("--match-deg", args->options.match_deg,
                    "Partners lie within this angle of the reciprocal (mirrored) point; 0: automatic, the first of\n"
@@ -47,6 +48,8 @@ void AddCheckCommand(CLI::App& app) {
       ->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace an existing report");
   command->callback([args] {
+    RequireValidOptions(args->options, "--theta-bin-deg/--phi-bin-deg/--min-pairs/--match-deg/--max-theta-deg");
+    if (args->regression) RequireValidOptions(args->prediction, "--held-out");
     StageLog stage("check");
     RequireWritableOutput(args->out, args->overwrite, {args->samples, SidecarPath(args->samples)});
     const std::vector<BrdfSample> samples = ReadSamples(args->samples);

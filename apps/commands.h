@@ -41,6 +41,43 @@ void RequireOutputOutsideInputs(const std::string& output, const std::vector<std
 // that reads a whole folder (a run folder, a COLMAP model, a calibration folder).
 std::vector<std::string> FilesUnder(const std::string& folder);
 
+// Prints once that `old_name` is deprecated in favour of `new_name` (a warning on standard error).
+void WarnDeprecatedOption(const std::string& old_name, const std::string& new_name);
+
+// Adds `old_name` as a hidden alias of `option` (both set `variable`), kept for one release after a
+// rename (e.g. --radius to --radius-m): not shown by --help, takes as many values as the option (and its
+// delimiter), warns once when used, and excludes the new name.
+template <typename T>
+CLI::Option* AddDeprecatedAlias(CLI::App& app, CLI::Option* option, const std::string& old_name, T& variable) {
+  const std::string new_name = option->get_name();
+  // Values are checked once the whole line is parsed, so both names' counts are known here. (Not
+  // CLI11's excludes(): it would print the hidden alias, nameless, in the new name's help.)
+  return app.add_option(old_name, variable, "Deprecated name of " + new_name)
+      ->group("")
+      ->expected(option->get_expected_min(), option->get_expected_max())
+      ->delimiter(option->get_delimiter())
+      ->each([option, old_name, new_name](const std::string&) {
+        if (option->count() > 0) throw CLI::ExcludesError(old_name, new_name + " (the same option; give one)");
+        WarnDeprecatedOption(old_name, new_name);
+      });
+}
+
+// The error of an option value that a library's options Check() rejected: a usage error (exit 2), its
+// message naming the flags and the failed constraint.
+class OptionValueError : public CLI::ValidationError {
+ public:
+  OptionValueError(const std::string& flags, const std::string& why)
+      : CLI::ValidationError(flags, "bad value: " + why) {}
+};
+
+// Throws OptionValueError (a usage error, exit 2) unless `options.Check()` passes; `flags` names the
+// flags that set them, e.g. "--stride/--max-theta-i-deg".
+template <typename Options>
+void RequireValidOptions(const Options& options, const std::string& flags) {
+  std::string why;
+  if (!options.Check(&why)) throw OptionValueError(flags, why);
+}
+
 }  // namespace ibrdf
 
 #define IBRDF_REGISTER_COMMAND(order, function) \

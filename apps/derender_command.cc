@@ -33,8 +33,10 @@ void AddDerenderCommand(CLI::App& app) {
                    "off; overrides the session's sample.visibility")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->each([args](const std::string& name) { VisibilityFromName(name, &args->options.visibility.emplace()); });
-  command->add_flag("!--no-mixed-pixel-mask", o.mask_mixed_pixels,
-                    "Mesh samples: keep pixels that straddle the silhouette (corner rays miss or jump in depth)");
+  // A plain flag inverted in its callback: CLI11 shows a negated flag ("!--no-x") as "--no-x{false}".
+  command->add_flag_callback(
+      "--no-mixed-pixel-mask", [args] { args->options.mask_mixed_pixels = false; },
+      "Mesh samples: keep pixels that straddle the silhouette (corner rays miss or jump in depth)");
   command
       ->add_option("--mixed-pixel-depth-factor", o.mixed_pixel_depth_factor,
                    "Mesh samples: depth jump across a pixel, in pixel footprints, that marks it mixed")
@@ -57,6 +59,7 @@ void AddDerenderCommand(CLI::App& app) {
       ->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace existing output files");
   command->callback([args] {
+    RequireValidOptions(args->options, "ibrdf derender");
     StageLog stage("derender");
     const Session session = Session::Load(args->session);
     std::vector<std::string> inputs = session.InputFiles();

@@ -36,7 +36,10 @@ void AddLibraryCommand(CLI::App& app) {
       ->add_option("--compare", args->compare,
                    "Materials in the comparison plot (default: the batch config's, else the first 8)")
       ->delimiter(',');
-  command->add_option("--sphere-size", args->options.sphere_size, "Lit sphere images, pixels")->capture_default_str();
+  AddDeprecatedAlias(*command,
+                     command->add_option("--sphere-size-px", args->options.sphere_size, "Lit sphere images, pixels")
+                         ->capture_default_str(),
+                     "--sphere-size", args->options.sphere_size);
   command->add_flag("--overwrite", args->options.overwrite, "Replace an existing folder that is not a library");
   command->callback([args] {
     std::vector<LibraryEntry> entries;
@@ -62,6 +65,7 @@ void AddLibraryCommand(CLI::App& app) {
       }
     }
     if (!args->compare.empty()) options.compare = args->compare;
+    RequireValidOptions(options, "ibrdf library");
     const LibraryResult result = BuildLibrary(entries, options);
     Log(1, "library: " + result.BriefReport());
   });

@@ -60,8 +60,10 @@ void AddCalibrate(CLI::App& group) {
   command->add_option("--kind", args->probe.kind, "What the lights are: directional or point")
       ->check(CLI::IsMember({"directional", "point"}))
       ->capture_default_str();
-  command->add_option("--light-distance", args->probe.light_distance,
-                      "Point lights from one placement: their distance from the sphere's centre, metres");
+  AddDeprecatedAlias(*command,
+                     command->add_option("--light-distance-m", args->probe.light_distance,
+                                         "Point lights from one placement: their distance from the sphere's centre"),
+                     "--light-distance", args->probe.light_distance);
   command->add_flag("--known-sphere", args->known_sphere,
                     "Take the session's sphere centre and radius as exact (no silhouette fit)");
   command->add_option("--diffuse", args->diffuse,
@@ -92,6 +94,8 @@ void AddCalibrate(CLI::App& group) {
     args->diffuse_options.max_theta_e_deg = args->diffuse_options.max_theta_i_deg;
     args->probe.fit_silhouette = !args->known_sphere;
     args->diffuse_options.fit_silhouette = !args->known_sphere;
+    RequireValidOptions(args->probe, "--kind/--light-distance-m/--blob-fraction/--rim-margin-px");
+    RequireValidOptions(args->diffuse_options, "--max-theta-deg");
     std::vector<Session> placements;
     std::vector<std::string> inputs;
     for (const std::string& path : args->sessions) {
@@ -210,24 +214,33 @@ void AddSynth(CLI::App& group) {
       ->add_option("--max-light-angle-deg", args->options.max_light_angle_deg,
                    "Lights within this angle of the direction to the camera")
       ->capture_default_str();
-  command->add_flag("--point", args->options.point_lights, "Point lights at --light-distance instead of directional");
-  command->add_option("--light-distance", args->options.light_distance, "Point lights' distance, metres")
-      ->capture_default_str();
-  command
-      ->add_option("--center", args->center,
-                   "The sphere's centre x,y,z, metres (world: x right, y up, z to the camera)")
-      ->delimiter(',')
-      ->expected(3);
-  command->add_option("--radius", args->options.radius, "The sphere's radius, metres")->capture_default_str();
+  command->add_flag("--point", args->options.point_lights, "Point lights at --light-distance-m instead of directional");
+  AddDeprecatedAlias(*command,
+                     command->add_option("--light-distance-m", args->options.light_distance, "Point lights' distance")
+                         ->capture_default_str(),
+                     "--light-distance", args->options.light_distance);
+  AddDeprecatedAlias(
+      *command,
+      command
+          ->add_option("--center-m", args->center, "The sphere's centre x,y,z (world: x right, y up, z to the camera)")
+          ->delimiter(',')
+          ->expected(3),
+      "--center", args->center);
+  AddDeprecatedAlias(
+      *command, command->add_option("--radius-m", args->options.radius, "The sphere's radius")->capture_default_str(),
+      "--radius", args->options.radius);
   command->add_option("--focal-px", args->options.focal_px, "Focal length, pixels")->capture_default_str();
-  command->add_option("--distance", args->options.distance, "Camera distance, metres")->capture_default_str();
+  AddDeprecatedAlias(
+      *command, command->add_option("--distance-m", args->options.distance, "Camera distance")->capture_default_str(),
+      "--distance", args->options.distance);
   command->add_option("--source-sigma-deg", args->options.source_sigma_deg, "The light's angular size, one sigma")
       ->capture_default_str();
   command->add_option("--seed", args->options.seed, "Noise and light layout")->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace an existing folder");
   command->callback([args] {
+    if (!args->center.empty()) args->options.center = Vector3Option(args->center, "--center-m");
+    RequireValidOptions(args->options, "ibrdf lights synth");
     StageLog stage("lights synth");
-    if (!args->center.empty()) args->options.center = Vector3Option(args->center, "--center");
     Log(1, WriteSyntheticMirrorSphere(args->options, args->out, args->overwrite).BriefReport());
   });
 }

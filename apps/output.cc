@@ -1,10 +1,12 @@
 #include <algorithm>
 #include <filesystem>
+#include <set>
 #include <utility>
 
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/file_util.h"
+#include "core/logging.h"
 
 namespace ibrdf {
 namespace {
@@ -70,6 +72,12 @@ void RequireWritableOutput(const std::string& output, bool overwrite, const std:
   if (!parent.empty() && !std::filesystem::is_directory(parent)) {
     ThrowError(output, "output folder " + parent.string() + " does not exist");
   }
+}
+
+void WarnDeprecatedOption(const std::string& old_name, const std::string& new_name) {
+  static std::set<std::string> warned;
+  if (!warned.insert(old_name).second) return;
+  Log(1, "warning: " + old_name + " is deprecated; use " + new_name + " (the old name goes in the next release)");
 }
 
 std::vector<std::string> FilesUnder(const std::string& folder) {

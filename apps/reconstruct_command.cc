@@ -99,7 +99,7 @@ void AddReconstructCommand(CLI::App& app) {
     RequireWritableOutput(args->out, options.overwrite,
                           {args->samples, SidecarPath(args->samples), options.truth_file, options.eval_file});
     if (!ParseFillMode(args->fill, &options.tabulate.fill)) {
-      ThrowError("--fill", "expected 'none', 'model' or 'extrapolate', got '" + args->fill + "'");
+      throw OptionValueError("--fill", "expected 'none', 'model' or 'extrapolate', got '" + args->fill + "'");
     }
     if (args->no_fold) options.regression.fold_reciprocity = options.regression.fold_bilateral = false;
     if (args->linear_values) options.regression.log_space = false;
@@ -109,15 +109,14 @@ void AddReconstructCommand(CLI::App& app) {
       ThrowError("--fill model", "fills with the chosen fit: drop --no-fits / --eval-only");
     }
     // The option groups checked here too, so that a message names the flags.
-    std::string why;
-    if (!options.regression.Check(&why)) ThrowError("--degree/--radius", why);
+    RequireValidOptions(options.regression, "--degree/--radius-h-deg/--radius-d-deg/--bin-h/--bin-d");
     options.select_bandwidth = args->bandwidth != "given";
     if (options.select_bandwidth && !ParseBandwidthCriterion(args->bandwidth, &options.selection.criterion)) {
-      ThrowError("--bandwidth", "expected 'given', 'loo' or 'gcv', got '" + args->bandwidth + "'");
+      throw OptionValueError("--bandwidth", "expected 'given', 'loo' or 'gcv', got '" + args->bandwidth + "'");
     }
-    if (!options.selection.Check(&why)) ThrowError("--bandwidth-scales/--bandwidth-samples", why);
-    if (!options.tabulate.Check(&why)) ThrowError("--max-theta-deg", why);
-    if (!options.fit.Check(&why)) ThrowError("--lobes/--fit-samples", why);
+    RequireValidOptions(options.selection, "--bandwidth-scales/--bandwidth-samples");
+    RequireValidOptions(options.tabulate, "--max-theta-deg/--min-effective-samples");
+    RequireValidOptions(options.fit, "--lobes/--fit-samples");
     if (options.eval_only && options.eval_file.empty()) ThrowError("--eval-only", "needs --eval POINTS.npy");
     ReconstructFile(args->samples, options, args->out);
   });

@@ -34,24 +34,29 @@ void AddReportCommand(CLI::App& app) {
                       "Reconstruction folder of `ibrdf reconstruct` (or its brdf.binary) to show, wherever it is\n"
                       "(default: RUN_DIR/reconstruction); the fits beside it are shown too");
   command->add_option("--photo", o.photo, "Photo index shown beside the renders (default: median phase angle)");
+  AddDeprecatedAlias(
+      *command,
+      command->add_option("--angles-deg", o.angles_deg, "Incidence-plane angles theta_0, 1 to 8 in [0, 85]")
+          ->delimiter(',')
+          ->expected(1, 8)
+          ->capture_default_str(),
+      "--angles", o.angles_deg);
   command
-      ->add_option("--angles-deg,--angles", o.angles_deg,
-                   "Incidence-plane angles theta_0, 1 to 8 in [0, 85] (--angles: the same, for one release)")
-      ->delimiter(',')
-      ->expected(1, 8)
+      ->add_option("--held-out", o.held_out_photos,
+                   "Photos shown held out (0 to 16): each beside the sample rendered by the regression fitted\n"
+                   "without it (the photos `ibrdf check --regression --held-out N` holds out; one fit each)")
       ->capture_default_str();
   command->add_option("--title", o.title, "Report title (default: the recipe's or session's name)");
-  command
-      ->add_option("--render-size-px,--render-size", o.render_size_px,
-                   "Rendered sphere size, pixels (--render-size: the old name, for one release)")
-      ->capture_default_str();
+  AddDeprecatedAlias(
+      *command,
+      command->add_option("--render-size-px", o.render_size_px, "Rendered sphere size, pixels")->capture_default_str(),
+      "--render-size", o.render_size_px);
   command->add_flag_callback(
       "--no-explorer", [args] { args->options.explorer = false; }, "Skip explorer.html");
   command->add_flag("--overwrite", o.overwrite, "Replace an existing report folder");
   command->callback([args] {
+    RequireValidOptions(args->options, "ibrdf report");
     StageLog stage("report");
-    std::string why;
-    if (!args->options.Check(&why)) ThrowError("ibrdf report", why);
     // The output guard: every file of the run folder is an input, except the default report's own.
     const std::filesystem::path own_report = std::filesystem::path(args->run_dir) / "report";
     std::vector<std::string> inputs = {args->run_dir};

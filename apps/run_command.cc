@@ -121,7 +121,8 @@ void AddRunCommand(CLI::App& app) {
                              Named{"--visibility", "derender", "Mesh samples' shadow rays: auto, on or off"},
                              Named{"--max-theta-i-deg", "derender", "Reject samples beyond this incidence angle"},
                              Named{"--max-theta-e-deg", "derender", "Reject samples beyond this exitance angle"},
-                             Named{"--min-signal", "derender", "Reject pixels below this linear signal"}}) {
+                             Named{"--min-signal", "derender", "Reject pixels below this linear signal"},
+                             Named{"--held-out", "report", "Photos shown held out (a fit without each)"}}) {
     const std::string flag = named.flag, stage = named.stage;
     command
         ->add_option_function<std::string>(
@@ -148,8 +149,7 @@ void AddRunCommand(CLI::App& app) {
                       "reconstruct, report); later stages are left as they are");
   command->callback([args] {
     Timer wall;
-    std::string why;
-    if (!args->options.Check(&why)) ThrowError("ibrdf run", why);
+    RequireValidOptions(args->options, "ibrdf run");
     // The output guard: the run folder is resumed, not replaced, but it must not be (or hold) the input.
     RequireOutputOutsideInputs(args->out, {args->input});
     for (auto [text, target] : {std::pair{&args->derender_args, &args->options.derender_args},
@@ -162,8 +162,9 @@ void AddRunCommand(CLI::App& app) {
     for (const std::string& named : args->named) {
       const size_t a = named.find('\n'), b = named.find('\n', a + 1);
       const std::string stage = named.substr(0, a);
-      std::vector<std::string>* target =
-          stage == "derender" ? &args->options.derender_args : &args->options.reconstruct_args;
+      std::vector<std::string>* target = stage == "derender" ? &args->options.derender_args
+                                         : stage == "report" ? &args->options.report_args
+                                                             : &args->options.reconstruct_args;
       target->push_back(named.substr(a + 1, b - a - 1));
       target->push_back(named.substr(b + 1));
     }

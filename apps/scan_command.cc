@@ -43,10 +43,9 @@ void AddScanCommand(CLI::App& app) {
   option("--min-convex-fraction", o.convexity.min_convex_fraction, "Convexity: surface fraction on the hull");
   command->add_flag("--overwrite", args->overwrite, "Replace existing output files");
   command->callback([args] {
-    StageLog stage("scan");
     args->options.clean.remove_outliers = !args->no_outliers;
-    std::string why;
-    if (!args->options.Check(&why)) ThrowError("ibrdf scan", "bad option: " + why);
+    RequireValidOptions(args->options, "ibrdf scan");
+    StageLog stage("scan");
     std::vector<std::string> read;
     const std::vector<ScanInputSpec> inputs = ResolveScanInputs(args->sources, &read);
     RequireWritableOutput(args->out, args->overwrite, read);

@@ -55,15 +55,21 @@ void AddSessionCommand(CLI::App& app) {
       ->capture_default_str();
   init->add_option("--bracket-gap-s", o.bracket_gap_s, "Longest time between two exposures of one bracket")
       ->capture_default_str();
-  init->add_option("--light-position", args->light_position, "The light's position X Y Z (metres, targets' frame)")
-      ->expected(3);
+  AddDeprecatedAlias(
+      *init,
+      init->add_option("--light-position-m", args->light_position, "The light's position X Y Z (targets' frame)")
+          ->expected(3),
+      "--light-position", args->light_position);
   init->add_option("--light-intensity", args->light_intensity, "The light's RGB intensity (session radiance unit)")
       ->expected(3);
-  init->add_option("--sample-radius", args->sample_radius, "The sphere's radius (metres)");
+  AddDeprecatedAlias(*init, init->add_option("--sample-radius-m", args->sample_radius, "The sphere's radius"),
+                     "--sample-radius", args->sample_radius);
   init->add_flag("--radius-known", o.radius_known, "The radius is measured: `ibrdf align` fits only the centre");
-  init->add_option("--sample-center", args->sample_center,
-                   "The sphere's centre X Y Z (default with --targets: on the platform's centre)")
-      ->expected(3);
+  AddDeprecatedAlias(*init,
+                     init->add_option("--sample-center-m", args->sample_center,
+                                      "The sphere's centre X Y Z (default with --targets: on the platform's centre)")
+                         ->expected(3),
+                     "--sample-center", args->sample_center);
   init->add_option("--response", o.response, "\"linear\" or \"srgb\" (default: from the file format)");
   init->add_option("--name", o.name, "The session's name (default: the output folder's)");
   init->add_flag("--overwrite", o.overwrite, "Replace session.json / session.draft.json in OUT");
@@ -75,6 +81,7 @@ void AddSessionCommand(CLI::App& app) {
     if (args->sample_radius > 0.0) options.sample_radius = args->sample_radius;
     if (args->white_size != 0.0) options.white_size = args->white_size;
     options.white_reflectance = Vector(args->white_reflectance);
+    RequireValidOptions(options, "ibrdf session init");
     const SessionInitResult result = InitSession(options, args->out);
     for (const std::string& line : result.assumptions) std::cout << "assumed: " << line << "\n";
     for (const std::string& line : result.missing) std::cout << "missing: " << line << "\n";

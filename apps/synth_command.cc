@@ -34,8 +34,9 @@ void AddSynthCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   add("--sample", r.sample, "sphere or cylinder")->check(CLI::IsMember({"sphere", "cylinder"}));
-  add("--radius", o.scene.sample_radius, "Sample radius, metres");
-  add("--length", o.scene.cylinder_length, "Cylinder length, metres (axis vertical)");
+  AddDeprecatedAlias(c, add("--radius-m", o.scene.sample_radius, "Sample radius"), "--radius", o.scene.sample_radius);
+  AddDeprecatedAlias(c, add("--length-m", o.scene.cylinder_length, "Cylinder length (axis vertical)"), "--length",
+                     o.scene.cylinder_length);
   add("--rig", r.rig,
       "arc: one light, cameras on an arc (the paper); dome: one fixed camera, a light per photo on the\n"
       "upper hemisphere; turntable: camera and light fixed while the sample turns (a pose and a light\n"
@@ -49,14 +50,17 @@ void AddSynthCommand(CLI::App& app) {
   add("--dome-min-elevation-deg", o.rig.dome_min_elevation_deg, "Dome: the lowest lights' elevation");
   add("--turntable-phase-deg", o.rig.turntable_phase_deg, "Turntable: camera azimuth from the light, in the lab");
   add("--turntable-span-deg", o.rig.turntable_span_deg, "Turntable: the sample's turn over all photos");
-  add("--camera-distance", o.rig.camera_distance, "Metres from the sample centre");
+  AddDeprecatedAlias(c, add("--camera-distance-m", o.rig.camera_distance, "Camera distance from the sample centre"),
+                     "--camera-distance", o.rig.camera_distance);
   auto* elevation =
       add("--camera-elevation-deg", o.rig.camera_elevation_deg, "Camera elevation above the light's plane");
-  add("--light-distance", o.scene.light_distance, "Metres from the sample centre");
+  AddDeprecatedAlias(c, add("--light-distance-m", o.scene.light_distance, "Light distance from the sample centre"),
+                     "--light-distance", o.scene.light_distance);
   c.add_option("--light-intensity", r.light_intensity, "RGB intensity of the point light")->expected(3);
   add("--width", o.rig.width, "Image width, pixels");
   add("--height", o.rig.height, "Image height, pixels");
-  c.add_option("--origin", r.origin, "Move the whole scene to x y z (metres)")->expected(3);
+  AddDeprecatedAlias(c, c.add_option("--origin-m", r.origin, "Move the whole scene to x y z")->expected(3), "--origin",
+                     r.origin);
   add("--effects", r.effects,
       "Camera effects preset: default (12-bit, shot and read noise) or none (float EXR, noise-free)")
       ->check(CLI::IsMember({"default", "none"}));
@@ -66,8 +70,10 @@ void AddSynthCommand(CLI::App& app) {
   c.add_flag("--no-read-noise", r.no_read_noise, "No read noise");
   c.add_flag("--no-clip", r.no_clip, "Do not clip at saturation (float output only)");
   c.add_option("--black-level", r.black_level, "Black level added to the signal (normalized units)");
-  c.add_option("--full-well", r.full_well_e, "Electrons at saturation");
-  c.add_option("--read-noise", r.read_noise_e, "Read noise, electrons");
+  AddDeprecatedAlias(c, c.add_option("--full-well-e", r.full_well_e, "Electrons at saturation"), "--full-well",
+                     r.full_well_e);
+  AddDeprecatedAlias(c, c.add_option("--read-noise-e", r.read_noise_e, "Read noise, electrons (one sigma)"),
+                     "--read-noise", r.read_noise_e);
   c.add_option("--supersample", r.supersample, "n x n rays per pixel");
   c.add_option("--vignetting", r.vignetting,
                "Light lost at the image corners (cos^4 law), 0 to 0.9; writes the matching flat_field.exr");
@@ -131,6 +137,7 @@ void AddSynthCommand(CLI::App& app) {
     request.options.colour.chart_corners = !args->chart_detect;
     ColourSpaceFromName(args->colour_space, &request.options.colour.space);
     const SynthOptions options = SynthOptionsFromRequest(request);
+    RequireValidOptions(options, "ibrdf synth");
     StageLog stage("synth");
     RequireWritableOutput(args->out, args->overwrite, {args->material});
     const std::unique_ptr<BrdfModel> material = LoadMaterial(args->material);

@@ -87,6 +87,7 @@ void AddTargetsCommand(CLI::App& app) {
     options.white_marker_size = 1e-3 * args->white_marker_mm;
     options.white_patch_size = 1e-3 * args->white_patch_mm;
     options.white_patch_thickness = 1e-3 * args->white_thickness_mm;
+    RequireValidOptions(options, "ibrdf targets");
     const TargetSheetsResult result = WriteTargetSheets(options, args->out);
     Log(1, result.BriefReport());
     for (const std::string& file : result.files) std::cout << args->out << "/" << file << "\n";

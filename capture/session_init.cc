@@ -286,7 +286,7 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
   } else {
     light["position"] = nullptr;
     result.missing.push_back(
-        "the light's position (metres, the targets' frame): pass --light-position X,Y,Z or put markers on the "
+        "the light's position (metres, the targets' frame): pass --light-position-m X Y Z or put markers on the "
         "light (`ibrdf targets` prints its card)");
   }
   if (options.light_intensity) {
@@ -307,7 +307,7 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
     if (options.radius_known) sample["radius_known"] = true;
   } else {
     sample["radius"] = nullptr;
-    result.missing.push_back("the sphere's radius (metres): pass --sample-radius R (and --radius-known if measured)");
+    result.missing.push_back("the sphere's radius (metres): pass --sample-radius-m R (and --radius-known if measured)");
   }
   if (options.sample_center) {
     sample["center"] = ToJson(*options.sample_center);
@@ -317,7 +317,7 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
         "sphere centre: resting on the platform's centre, (0, 0, radius); `ibrdf align` fits it from the silhouettes");
   } else {
     sample["center"] = nullptr;
-    result.missing.push_back("the sphere's centre (metres, the targets' frame): pass --sample-center X,Y,Z");
+    result.missing.push_back("the sphere's centre (metres, the targets' frame): pass --sample-center-m X Y Z");
   }
   json["sample"] = sample;
   // Radiometry.

@@ -77,6 +77,17 @@ bool PredictionCheckOptions::Check(std::string* why) const {
   return true;
 }
 
+std::vector<uint32_t> HeldOutImages(const std::vector<BrdfSample>& samples, int count) {
+  std::map<uint32_t, size_t> per_image;
+  for (const BrdfSample& s : samples) ++per_image[s.image];
+  std::vector<uint32_t> images;
+  for (const auto& [image, n] : per_image) images.push_back(image);
+  const int held = std::min<int>(std::max(count, 0), images.size() > 1 ? int(images.size()) : 0);
+  std::vector<uint32_t> held_out;
+  for (int h = 0; h < held; ++h) held_out.push_back(images[(2 * h + 1) * images.size() / (2 * held)]);
+  return held_out;
+}
+
 PredictionReport CheckWithRegression(const std::vector<BrdfSample>& samples, const PredictionCheckOptions& options) {
   std::string why;
   if (!options.Check(&why)) ThrowError("check options", why);
@@ -122,15 +133,9 @@ PredictionReport CheckWithRegression(const std::vector<BrdfSample>& samples, con
   }
 
   // Held-out photos, evenly spaced over the images present.
-  std::map<uint32_t, size_t> per_image;
-  for (const BrdfSample& s : samples) ++per_image[s.image];
-  std::vector<uint32_t> images;
-  for (const auto& [image, count] : per_image) images.push_back(image);
-  const int held = std::min<int>(options.held_out_photos, images.size() > 1 ? int(images.size()) : 0);
   double sum_squares[3] = {0, 0, 0};
   size_t total = 0;
-  for (int h = 0; h < held; ++h) {
-    const uint32_t image = images[(2 * h + 1) * images.size() / (2 * held)];
+  for (const uint32_t image : HeldOutImages(samples, options.held_out_photos)) {
     std::vector<BrdfSample> fit, predict;
     for (const BrdfSample& s : samples) (s.image == image ? predict : fit).push_back(s);
     const double max_theta = options.max_theta_deg * kDegree;

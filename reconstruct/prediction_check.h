@@ -56,6 +56,10 @@ struct PredictionReport {
   std::string BriefReport() const;
 };
 
+// The photos held out by CheckWithRegression with `count` held-out photos: `count` (at most the photos
+// present, none with one photo) evenly spaced over the image indices present in `samples`.
+std::vector<uint32_t> HeldOutImages(const std::vector<BrdfSample>& samples, int count);
+
 PredictionReport CheckWithRegression(const std::vector<BrdfSample>& samples, const PredictionCheckOptions& options);
 
 nlohmann::json ToJson(const PredictionReport& report, const PredictionCheckOptions& options);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "core/error.h"
 #include "core/statistics.h"
 
 namespace ibrdf {
@@ -39,6 +40,20 @@ Image CropPhoto(const Image& photo, const PixelBox& box) {
 
 PhotoRender RenderPhotoPixels(const Image& photo, const PixelBox& box, const std::vector<const BrdfSample*>& samples,
                               const std::string& model, const BrdfEvalFunction& eval) {
+  std::vector<Eigen::Vector3d> values(samples.size(), Eigen::Vector3d::Constant(NAN));
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const BrdfSample* s = samples[i];
+    const int px = int(s->pixel[0]), py = int(s->pixel[1]);
+    if (px < box.x0 || px > box.x1 || py < box.y0 || py > box.y1) continue;
+    values[i] = eval(Eigen::Vector3d(s->wi[0], s->wi[1], s->wi[2]).normalized(),
+                     Eigen::Vector3d(s->wo[0], s->wo[1], s->wo[2]).normalized());
+  }
+  return RenderPhotoPixels(photo, box, samples, model, values);
+}
+
+PhotoRender RenderPhotoPixels(const Image& photo, const PixelBox& box, const std::vector<const BrdfSample*>& samples,
+                              const std::string& model, const std::vector<Eigen::Vector3d>& values) {
+  IBRDF_CHECK(values.size() == samples.size()) << values.size() << " values for " << samples.size() << " samples";
   PhotoRender render;
   render.model = model;
   render.linear = Image(box.width(), box.height(), 3);
@@ -47,11 +62,11 @@ PhotoRender RenderPhotoPixels(const Image& photo, const PixelBox& box, const std
   const int stride = SampleStride(samples);
   const int before = stride / 2;
   std::vector<double> differences;
-  for (const BrdfSample* s : samples) {
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const BrdfSample* s = samples[i];
     const int px = int(s->pixel[0]), py = int(s->pixel[1]);
     if (px < box.x0 || px > box.x1 || py < box.y0 || py > box.y1) continue;
-    const Eigen::Vector3d f = eval(Eigen::Vector3d(s->wi[0], s->wi[1], s->wi[2]).normalized(),
-                                   Eigen::Vector3d(s->wo[0], s->wo[1], s->wo[2]).normalized());
+    const Eigen::Vector3d& f = values[i];
     // The sample's own pixel: E cos(theta_i) per channel, as the derenderer divided by it.
     double rendered[3];
     bool ok = true;

@@ -40,6 +40,11 @@ int SampleStride(const std::vector<const BrdfSample*>& samples);
 PhotoRender RenderPhotoPixels(const Image& photo, const PixelBox& box, const std::vector<const BrdfSample*>& samples,
                               const std::string& model, const BrdfEvalFunction& eval);
 
+// The same with the model's values given per sample (values[i] for samples[i], RGB; a negative or NaN
+// component: no value), e.g. a regression evaluated at all of a photo's samples at once.
+PhotoRender RenderPhotoPixels(const Image& photo, const PixelBox& box, const std::vector<const BrdfSample*>& samples,
+                              const std::string& model, const std::vector<Eigen::Vector3d>& values);
+
 // The crop of `photo` to `box` (RGB; a grey photo's one channel copied to three).
 Image CropPhoto(const Image& photo, const PixelBox& box);
 

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -22,10 +23,12 @@
 #include "core/sample_file.h"
 #include "core/session.h"
 #include "core/statistics.h"
+#include "reconstruct/local_regression.h"
 #include "reconstruct/merl_table.h"
+#include "reconstruct/prediction_check.h"
 #include "reconstruct/truth_comparison.h"
-#include "report/photo_comparison.h"
 #include "report/light_photos.h"
+#include "report/photo_comparison.h"
 #include "report/photo_statistics.h"
 #include "report/report_script.h"
 #include "report/sphere_render.h"
@@ -148,62 +151,179 @@ std::string ReportTitle(const fs::path& run_dir, const std::string& samples_path
 Eigen::Vector3d Wi(const BrdfSample& s) { return Eigen::Vector3d(s.wi[0], s.wi[1], s.wi[2]).normalized(); }
 Eigen::Vector3d Wo(const BrdfSample& s) { return Eigen::Vector3d(s.wo[0], s.wo[1], s.wo[2]).normalized(); }
 
+// A model's values at one photo's samples: a function of the directions, or given per sample.
+struct PhotoModel {
+  std::string name;
+  BrdfEvalFunction eval;                // empty when `values` holds them
+  std::vector<Eigen::Vector3d> values;  // per sample of the photo, in its order
+};
+
+// One photo at full resolution (cropped to its samples' box, linearized, tone-mapped) as
+// PREFIX.png, and each model rendered at the photo's own pixels (PREFIX-render-MODEL.png, on the
+// photo's tone scale) with its signed difference (PREFIX-diff-MODEL.npy). Returns the photo's data.
+nlohmann::json RenderPhoto(const Session& session, uint32_t index, const PhotoStats& p,
+                           const std::vector<const BrdfSample*>& own, const std::vector<PhotoModel>& models,
+                           const std::string& prefix, const fs::path& tmp) {
+  if (index >= session.photos.size()) ThrowError(session.manifest_path, "has fewer photos than the samples name");
+  Image photo = ReadImage(session.PhotoPath(index));
+  LinearizeImage(session, index, &photo, /*divide_by_exposure=*/true);
+  const int pad = std::max(4, (p.x1 - p.x0) / 16);
+  PixelBox box{std::max(0, p.x0 - pad), std::max(0, p.y0 - pad), std::min(photo.width - 1, p.x1 + pad),
+               std::min(photo.height - 1, p.y1 + pad)};
+  const Image crop = CropPhoto(photo, box);
+  double scale = 1.0;
+  WriteImage((tmp / (prefix + ".png")).string(), ToneMap(crop, &scale), PixelFormat::kUint8);
+  nlohmann::json renders = nlohmann::json::array();
+  for (const PhotoModel& model : models) {
+    const PhotoRender render = model.eval ? RenderPhotoPixels(photo, box, own, model.name, model.eval)
+                                          : RenderPhotoPixels(photo, box, own, model.name, model.values);
+    const std::string png = prefix + "-render-" + model.name + ".png", npy = prefix + "-diff-" + model.name + ".npy";
+    WriteImage((tmp / png).string(), ToneMapWithScale(render.linear, scale), PixelFormat::kUint8);
+    WriteNpyArray((tmp / npy).string(), render.difference.pixels,
+                  {size_t(render.difference.height), size_t(render.difference.width)});
+    renders.push_back({{"model", model.name},
+                       {"file", png},
+                       {"difference", npy},
+                       {"median_abs_difference", render.median_abs_difference}});
+  }
+  return {{"file", prefix + ".png"}, {"source", session.PhotoPath(index)},
+          {"index", index},          {"crop", {box.x0, box.y0, box.x1, box.y1}},
+          {"full_resolution", true}, {"stride", SampleStride(own)},
+          {"samples", p.count},      {"renders", renders}};
+}
+
+// The samples' session, from the sample file's sidecar; `*note` says why not when it cannot be read.
+std::optional<Session> SamplesSession(const std::string& samples_path, std::string* note) {
+  const fs::path sidecar(SidecarPath(samples_path));
+  if (!fs::exists(sidecar)) {
+    *note = sidecar.string() + " is missing, so the samples' session (and photos) are unknown";
+    return std::nullopt;
+  }
+  try {
+    const nlohmann::json side = ReadJsonFile(sidecar.string());
+    return Session::Load(side.at("session").get<std::string>());
+  } catch (const Error& e) {
+    *note = e.what();
+  } catch (const nlohmann::json::exception& e) {
+    *note = sidecar.string() + ": no session named (" + e.what() + ")";
+  }
+  return std::nullopt;
+}
+
+std::vector<const BrdfSample*> PhotoSamples(const std::vector<BrdfSample>& samples, uint32_t image) {
+  std::vector<const BrdfSample*> own;
+  for (const BrdfSample& s : samples) {
+    if (s.image == image) own.push_back(&s);
+  }
+  return own;
+}
+
 // The measured photo at full resolution (cropped to the samples' box), and each model rendered at the
 // photo's own pixels with its signed difference. Errors reading the samples' session become a note in
 // the data instead of failing the report.
-void WritePhoto(const std::string& samples_path, const std::vector<BrdfSample>& samples, const PhotoStats& p,
+void WritePhoto(const std::optional<Session>& session, const std::vector<BrdfSample>& samples, const PhotoStats& p,
                 const ChosenPhoto& chosen, const RunModels& models, const fs::path& tmp, nlohmann::json* data,
                 ReportResult* result) {
-  const fs::path sidecar(SidecarPath(samples_path));
-  if (!fs::exists(sidecar)) {
-    result->photo_note = sidecar.string() + " is missing, so the samples' session (and photos) are unknown";
-    (*data)["photo_note"] = result->photo_note;
-    return;
-  }
-  const nlohmann::json side = ReadJsonFile(sidecar.string());
-  try {
-    const Session session = Session::Load(side.at("session").get<std::string>());
-    if (chosen.photo >= session.photos.size())
-      ThrowError(session.manifest_path, "has fewer photos than the samples name");
-    Image photo = ReadImage(session.PhotoPath(chosen.photo));
-    LinearizeImage(session, chosen.photo, &photo, /*divide_by_exposure=*/true);
-    const int pad = std::max(4, (p.x1 - p.x0) / 16);
-    PixelBox box{std::max(0, p.x0 - pad), std::max(0, p.y0 - pad), std::min(photo.width - 1, p.x1 + pad),
-                 std::min(photo.height - 1, p.y1 + pad)};
-    std::vector<const BrdfSample*> own;
-    for (const BrdfSample& s : samples) {
-      if (s.image == chosen.photo) own.push_back(&s);
+  if (session) {
+    try {
+      std::vector<PhotoModel> photo_models;
+      for (const NamedModel& model : models.named) photo_models.push_back({model.name, model.eval, {}});
+      nlohmann::json photo =
+          RenderPhoto(*session, chosen.photo, p, PhotoSamples(samples, chosen.photo), photo_models, "photo", tmp);
+      photo["phase_deg"] = chosen.phase / kDeg;
+      (*data)["photo"] = photo;
+      result->photo_shown = true;
+    } catch (const Error& e) {
+      result->photo_note = e.what();
+      Log(1, "report: no photo: " + result->photo_note);
     }
-    const Image crop = CropPhoto(photo, box);
-    double scale = 1.0;
-    WriteImage((tmp / "photo.png").string(), ToneMap(crop, &scale), PixelFormat::kUint8);
-    nlohmann::json renders = nlohmann::json::array();
-    for (const NamedModel& model : models.named) {
-      const PhotoRender render = RenderPhotoPixels(photo, box, own, model.name, model.eval);
-      const std::string png = "photo-render-" + model.name + ".png", npy = "photo-diff-" + model.name + ".npy";
-      WriteImage((tmp / png).string(), ToneMapWithScale(render.linear, scale), PixelFormat::kUint8);
-      WriteNpyArray((tmp / npy).string(), render.difference.pixels,
-                    {size_t(render.difference.height), size_t(render.difference.width)});
-      renders.push_back({{"model", model.name},
-                         {"file", png},
-                         {"difference", npy},
-                         {"median_abs_difference", render.median_abs_difference}});
-    }
-    (*data)["photo"] = {{"file", "photo.png"},
-                        {"source", session.PhotoPath(chosen.photo)},
-                        {"index", chosen.photo},
-                        {"crop", {box.x0, box.y0, box.x1, box.y1}},
-                        {"full_resolution", true},
-                        {"stride", SampleStride(own)},
-                        {"phase_deg", chosen.phase / kDeg},
-                        {"samples", p.count},
-                        {"renders", renders}};
-    result->photo_shown = true;
-  } catch (const Error& e) {
-    result->photo_note = e.what();
-    Log(1, "report: no photo: " + result->photo_note);
   }
   if (!result->photo_note.empty()) (*data)["photo_note"] = result->photo_note;
+}
+
+// The local regression's options of the reconstruction (its summary.json's "regression": degree, radii,
+// binning, folds, log space), or the defaults when there is none.
+LocalRegressionOptions ReconstructionRegression(const std::string& table_path) {
+  LocalRegressionOptions options;
+  if (table_path.empty()) return options;
+  const fs::path summary = fs::path(table_path).parent_path() / "summary.json";
+  if (!fs::is_regular_file(summary)) return options;
+  const nlohmann::json json = ReadJsonFile(summary.string());
+  if (!json.contains("regression") || !json["regression"].is_object()) return options;
+  const nlohmann::json& r = json["regression"];
+  options.degree = r.value("degree", options.degree);
+  options.radius_h_deg = r.value("radius_h_deg", options.radius_h_deg);
+  options.radius_d_deg = r.value("radius_d_deg", options.radius_d_deg);
+  options.bin_fraction_h = r.value("bin_fraction_h", options.bin_fraction_h);
+  options.bin_fraction_d = r.value("bin_fraction_d", options.bin_fraction_d);
+  options.fold_reciprocity = r.value("fold_reciprocity", options.fold_reciprocity);
+  options.fold_bilateral = r.value("fold_bilateral", options.fold_bilateral);
+  options.log_space = r.value("log_space", options.log_space);
+  std::string why;
+  if (!options.Check(&why)) ThrowError(summary.string(), "\"regression\": " + why);
+  return options;
+}
+
+// Held-out photos (the ones `ibrdf check --regression --held-out N` holds out): each photo beside the
+// sample rendered from its camera by the local regression fitted WITHOUT that photo's samples (the
+// reconstruction's options, evaluated at the photo's own directions rather than through the table), the
+// reconstruction that saw it, and the signed differences. A photo that cannot be read is a note.
+void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector<BrdfSample>& samples,
+                        std::map<uint32_t, PhotoStats>& photos, int count, const RunModels& models, const fs::path& tmp,
+                        nlohmann::json* data, ReportResult* result) {
+  if (count <= 0 || !session) return;
+  const LocalRegressionOptions regression_options = ReconstructionRegression(models.table_path);
+  nlohmann::json held = nlohmann::json::array();
+  // A figure written as JSON: NaN (no pixel had one) is null there.
+  auto number = [](const nlohmann::json& value) { return value.is_number() ? value.get<double>() : double(NAN); };
+  for (const uint32_t image : HeldOutImages(samples, count)) {
+    try {
+      Timer timer;
+      std::vector<BrdfSample> fit;
+      fit.reserve(samples.size());
+      for (const BrdfSample& s : samples) {
+        if (s.image != image) fit.push_back(s);
+      }
+      const std::vector<const BrdfSample*> own = PhotoSamples(samples, image);
+      std::vector<Eigen::Vector3d> points;
+      points.reserve(own.size());
+      for (const BrdfSample* s : own) points.push_back(RegressionCoordinates(Wi(*s), Wo(*s)));
+      ReliabilityCounts reliability;
+      std::vector<Estimate> estimates;
+      {
+        const LocalRegression regression(fit, regression_options);
+        estimates = regression.EvaluateMany(points, &reliability);
+      }
+      std::vector<Eigen::Vector3d> values(own.size());
+      size_t unsupported = 0;
+      for (size_t i = 0; i < own.size(); ++i) {
+        const bool supported = estimates[i].status != EstimateStatus::kUnsupported;
+        values[i] = supported ? estimates[i].value : Eigen::Vector3d::Constant(NAN);
+        unsupported += !supported;
+      }
+      std::vector<PhotoModel> photo_models = {{"held-out", {}, std::move(values)}};
+      if (!models.named.empty() && models.named.front().name == "reconstruction")
+        photo_models.push_back({"reconstruction", models.named.front().eval, {}});
+      nlohmann::json photo =
+          RenderPhoto(*session, image, photos[image], own, photo_models, "held-out-" + std::to_string(image), tmp);
+      const std::vector<float>& phase = photos[image].phase;
+      photo["phase_deg"] = phase.empty() ? 0.0 : Percentile(phase, 0.5) / kDeg;
+      photo["fit_samples"] = fit.size();
+      photo["unsupported"] = unsupported;
+      photo["seconds"] = timer.ElapsedSeconds();
+      HeldOutRender shown;
+      shown.image = image;
+      shown.median_abs_difference = number(photo["renders"][0]["median_abs_difference"]);
+      if (photo["renders"].size() > 1)
+        shown.in_sample_median_abs_difference = number(photo["renders"][1]["median_abs_difference"]);
+      result->held_out.push_back(shown);
+      held.push_back(photo);
+    } catch (const Error& e) {
+      held.push_back({{"index", image}, {"note", e.what()}});
+      Log(1, "report: held-out photo " + std::to_string(image) + " not shown: " + e.what());
+    }
+  }
+  (*data)["held_out"] = held;
 }
 
 // Spheres of every model, lit at the chosen photo's phase angle.
@@ -384,6 +504,7 @@ nlohmann::json ExplorerGrids(const std::vector<BrdfSample>& samples, const RunMo
 
 bool ReportOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_RANGE(render_size_px, 16, 4096);
+  IBRDF_CHECK_OPTION_RANGE(held_out_photos, 0, 16);
   IBRDF_CHECK_OPTION(!angles_deg.empty() && angles_deg.size() <= 8);
   for (const double angle : angles_deg) {
     if (!(angle >= 0.0 && angle <= 85.0)) {
@@ -400,6 +521,10 @@ std::string ReportResult::BriefReport() const {
       << photo << " (" << phase_deg << " deg phase" << (photo_shown ? ", shown" : ", not shown") << ")"
       << (reconstruction ? ", reconstruction" : "") << (truth ? ", truth" : "");
   for (const std::string& fit : fits) out << ", " << fit << " fit";
+  for (const HeldOutRender& h : held_out) {
+    out << "; held-out photo " << h.image << ": median |render - photo| / photo " << 100.0 * h.median_abs_difference
+        << " % (the reconstruction that saw it: " << 100.0 * h.in_sample_median_abs_difference << " %)";
+  }
   return out.str();
 }
 
@@ -442,7 +567,9 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
 
   AtomicDirectory directory(out, options.overwrite);
   const fs::path tmp(directory.temporary_path());
-  WritePhoto(samples_path, samples, photos[chosen.photo], chosen, models, tmp, &data, &result);
+  const std::optional<Session> session = SamplesSession(samples_path, &result.photo_note);
+  WritePhoto(session, samples, photos[chosen.photo], chosen, models, tmp, &data, &result);
+  WriteHeldOutPhotos(session, samples, photos, options.held_out_photos, models, tmp, &data, &result);
   // Multi-light sessions (a dome, a turntable): the lights and a photo under each.
   const nlohmann::json lights = WriteLightPhotos(samples_path, photos, tmp.string());
   if (!lights.is_null()) data["lights"] = lights;

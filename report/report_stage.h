@@ -7,6 +7,7 @@
 // plots and writes the HTML. docs/report.md describes it.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -18,6 +19,9 @@ struct ReportOptions {
   int photo = -1;            // the measured photo shown (negative: the one of median phase angle)
   int render_size_px = 256;  // pixels, square renders of a sphere, in [16, 4096]
   std::vector<double> angles_deg = {15, 30, 45, 60};  // incidence-plane angles theta_0, 1 to 8 in [0, 85]
+  // Photos shown held out, in [0, 16]: each rendered by the local regression fitted without it (the
+  // photos `ibrdf check --regression --held-out N` holds out; 0: none). One regression fit each.
+  int held_out_photos = 1;
   std::string reconstruction;  // the reconstruction folder or its brdf.binary (empty: RUN_DIR/reconstruction)
   std::string title;           // the report's title (empty: the recipe's or session's name)
   bool explorer = true;        // write explorer.html
@@ -37,6 +41,14 @@ struct BandAgreement {
   double ratio[3] = {0, 0, 0};
 };
 
+// A held-out photo shown: the median |render - photo| / photo of the regression that never saw it, and
+// of the reconstruction that did (NaN without a reconstruction).
+struct HeldOutRender {
+  uint32_t image = 0;
+  double median_abs_difference = 0.0;
+  double in_sample_median_abs_difference = NAN;
+};
+
 // What the stage wrote; reads as failure until the folder was committed.
 struct ReportResult {
   bool success = false;         // the report folder was committed
@@ -50,9 +62,10 @@ struct ReportResult {
   std::string photo_note;       // why not, when the samples' session could not be read
   bool reconstruction = false;  // a reconstruction was found (its path in reconstruction_path)
   std::string reconstruction_path;
-  std::vector<std::string> fits;     // the fitted models found beside it ("lafortune", "ggx")
-  bool truth = false;                // the run's truth-comparison.json names a truth
-  std::vector<BandAgreement> bands;  // incidence-plane agreement of the reconstruction with the samples
+  std::vector<std::string> fits;        // the fitted models found beside it ("lafortune", "ggx")
+  bool truth = false;                   // the run's truth-comparison.json names a truth
+  std::vector<BandAgreement> bands;     // incidence-plane agreement of the reconstruction with the samples
+  std::vector<HeldOutRender> held_out;  // the held-out photos shown
   // One line: where, which photo, what was rendered.
   std::string BriefReport() const;
 };

@@ -311,6 +311,57 @@ def photo_difference_figure(data, out):
     return save(fig, out, "photo-difference.png")
 
 
+def held_out_difference_figure(data, out, photo):
+    """A held-out photo's signed differences: the regression without it, the reconstruction with it."""
+    renders = photo.get("renders", [])
+    if not renders:
+        return None
+    fig, axes = plt.subplots(1, len(renders), figsize=(4 * len(renders) + 1, 4.2), squeeze=False)
+    image = None
+    for ax, r in zip(axes[0], renders):
+        d = np.load(os.path.join(out, r["difference"]))
+        image = ax.imshow(100 * d, cmap="RdBu_r", vmin=-10, vmax=10, interpolation="nearest")
+        med = r.get("median_abs_difference")
+        who = "fitted without this photo" if r["model"] == "held-out" else "reconstruction (saw this photo)"
+        ax.set_title(f"{who}:\nmedian |difference| {100 * med:.2f} %" if med is not None else who, fontsize=9)
+        ax.set_xticks([])
+        ax.set_yticks([])
+    fig.colorbar(image, ax=list(axes[0]), fraction=0.03, label="(render - photo) / photo, % (clipped at +-10)")
+    return save(fig, out, f"held-out-{photo['index']}-difference.png")
+
+
+def held_out_html(data, out):
+    """Held-out photos, shown as the main photo is: measured beside rendered, and the signed difference."""
+    held = data.get("held_out") or []
+    if not held:
+        return ""
+    parts = ["<h3>Held-out photos</h3><p>Each photo below beside the sample rendered from its camera by the local "
+             "regression fitted <em>without</em> that photo's samples (the reconstruction's degree and radii, "
+             "evaluated at the photo's own directions), and by the reconstruction that saw it: the gap between "
+             "the two differences is how well the kernel bridges the missing sheet (the photos "
+             "<code>ibrdf check --regression --held-out N</code> holds out).</p>"]
+    for photo in held:
+        if "note" in photo:
+            parts.append(f"<p>Held-out photo {photo['index']} not shown: {html.escape(photo['note'])}</p>")
+            continue
+        x0, y0, x1, y1 = photo["crop"]
+        zoom = max(1, min(4, ZOOM_TARGET_PX // (x1 - x0 + 1)))
+        shown = (x1 - x0 + 1) * zoom if zoom > 1 else None
+        enlarged = f", shown {zoom}x enlarged" if zoom > 1 else ""
+        parts.append(figure_html(out, photo["file"], f"held-out photo {photo['index']} (linearized, full resolution"
+                                 f"{enlarged}, pixels {x0}-{x1} x {y0}-{y1}, light {photo['phase_deg']:.0f} deg from "
+                                 f"the view)", zoom_width=shown))
+        for r in photo.get("renders", []):
+            who = (f"regression fitted without photo {photo['index']} ({photo['fit_samples']} samples of the other "
+                   f"photos; {photo['unsupported']} pixels without support, magenta)") \
+                if r["model"] == "held-out" else "the reconstruction (its table; saw this photo)"
+            parts.append(figure_html(out, r["file"], f"{who}, rendered from the photo's camera{enlarged}",
+                                     zoom_width=shown))
+        parts.append("<br>" + figure_html(out, held_out_difference_figure(data, out, photo),
+                                          f"signed difference from held-out photo {photo['index']}"))
+    return "\n".join(parts)
+
+
 def stamps(run_dir):
     result = {}
     for path in sorted(glob.glob(os.path.join(run_dir, "stamps", "*.json"))):
@@ -494,6 +545,12 @@ def headline_rows(s, side, c, t, r, data, times):
         for rd in photo.get("renders", []):
             if rd.get("median_abs_difference") is not None:
                 rows.append((f"photo {photo['index']}: median |render - photo| / photo, {rd['model']}",
+                             pct(rd["median_abs_difference"])))
+    for h in data.get("held_out") or []:
+        for rd in h.get("renders", []):
+            if rd.get("median_abs_difference") is not None:
+                who = "regression fitted without it" if rd["model"] == "held-out" else rd["model"]
+                rows.append((f"held-out photo {h['index']}: median |render - photo| / photo, {who}",
                              pct(rd["median_abs_difference"])))
     for stage in [n for n in STAGE_ORDER if n in times]:
         rows.append((f"time: {stage}", f"{times[stage]:.2f} s"))
@@ -805,6 +862,7 @@ BRDF Measurement. Every figure is embedded in this file; the same PNGs lie besid
 pixel that gave a sample, f_model(wi, wo) times the irradiance term E cos(theta_i) the derenderer divided by
 (so sphere, cylinder or scanned mesh alike, shadows included), on the photo's tone scale; and the signed difference.</p>
 {appearance_html(data, out, figures)}
+{held_out_html(data, out)}
 {lights_section(out, data)}
 <h2>Sample coverage</h2>
 {figure_html(out, figures['coverage'], 'exitant directions sampled at each incidence angle')}

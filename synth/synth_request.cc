@@ -35,7 +35,7 @@ SynthOptions SynthOptionsFromRequest(const SynthRequest& request) {
     if (!request.light_photos_given) options.targets.light_photos = 3;
   }
   const std::vector<double>& o = request.origin;
-  if (!o.empty() && o.size() != 3) ThrowError("--origin", "expected 3 values (x y z)");
+  if (!o.empty() && o.size() != 3) ThrowError("--origin-m", "expected 3 values (x y z)");
   if (!o.empty()) options.scene.origin = Eigen::Vector3d(o[0], o[1], o[2]);
   const std::vector<double>& i = request.light_intensity;
   if (!i.empty() && i.size() != 3) ThrowError("--light-intensity", "expected 3 values (R G B)");

@@ -36,17 +36,29 @@ void AddSamples(const fs::path& dir, nlohmann::json* summary) {
   (*summary)["samples"]["exposure_warnings"] = warnings;
 }
 
-// consistency.json: `ibrdf check`'s figures (null where a figure is not valid).
+// consistency.json: `ibrdf check`'s figures (null where a figure is not valid): the median over bins
+// (`reciprocity`, `bilateral_symmetry`), the 95th percentile, per channel and the bins compared. A
+// consistency.json of the previous release names bilateral symmetry "isotropy"; it is read under that
+// name. The summary writes "isotropy*" copies of the bilateral-symmetry keys for one release.
 void AddConsistency(const fs::path& dir, nlohmann::json* summary) {
   const std::optional<StageJson> c = StageJson::ReadIfExists((dir / "consistency.json").string());
   if (!c) return;
   nlohmann::json out;
-  for (const std::string figure : {"reciprocity", "isotropy"}) {
-    const std::string at = "/" + figure;
+  for (const std::string figure : {"reciprocity", "bilateral_symmetry"}) {
+    std::string at = "/" + figure;
+    if (!c->Has(at) && figure == "bilateral_symmetry") at = "/isotropy";
     if (!c->Has(at)) continue;
-    out[figure] = c->Boolean(at + "/valid", false) ? c->Figure(at + "/overall_rel_error") : nlohmann::json();
+    const bool valid = c->Boolean(at + "/valid", false);
+    out[figure] = valid ? c->Figure(at + "/overall_rel_error") : nlohmann::json();
+    out[figure + "_p95"] = valid ? c->FigureOr(at + "/p95_rel_error", nlohmann::json()) : nlohmann::json();
     out[figure + "_per_channel"] = c->FigureOr(at + "/per_channel_rel_error", nlohmann::json());
     out[figure + "_bins_compared"] = c->Count(at + "/bins_compared", 0);
+  }
+  if (out.contains("bilateral_symmetry")) {
+    for (const char* suffix : {"", "_per_channel", "_bins_compared"}) {
+      out[std::string("isotropy") + suffix] = out[std::string("bilateral_symmetry") + suffix];
+    }
+    out["aliases"] = {{"isotropy", "bilateral_symmetry (deprecated name, removed in the next release)"}};
   }
   if (c->Has("/regression")) out["regression"] = c->Value("/regression");
   (*summary)["consistency"] = out;
@@ -147,7 +159,8 @@ std::vector<std::string> RunHeadline(const nlohmann::json& summary_json) {
   }
   if (summary.Has("/consistency")) {
     lines.push_back("consistency: reciprocity " + Percent(summary.ValueOr("/consistency/reciprocity", nullptr)) +
-                    ", bilateral symmetry " + Percent(summary.ValueOr("/consistency/isotropy", nullptr)));
+                    ", bilateral symmetry " + Percent(summary.ValueOr("/consistency/bilateral_symmetry", nullptr)) +
+                    " (medians over bins)");
   }
   if (summary.Has("/truth")) {
     lines.push_back("against the truth: samples' median relative error (R, G, B) " +

@@ -55,11 +55,11 @@ std::string WriteBatch(const ScratchDir& dir) {
   WriteRecipe(dir / "recipes/felt-sphere", "felt", "\"--sample\", \"sphere\", \"--seed\", \"2\"");
   WriteRecipe(dir / "recipes/primer-cylinder", "primer", "\"--sample\", \"cylinder\", \"--seed\", \"3\"");
   WriteRecipe(dir / "recipes/clay-cylinder", "clay",
-              "\"--sample\", \"cylinder\", \"--radius\", \"0.03\", \"--seed\", \"4\"");
+              "\"--sample\", \"cylinder\", \"--radius-m\", \"0.03\", \"--seed\", \"4\"");
   WriteRecipe(dir / "recipes/glossy-sphere", "glossy-ggx",
-              "\"--sample\", \"sphere\", \"--radius\", \"0.03\", \"--seed\", \"5\"");
+              "\"--sample\", \"sphere\", \"--radius-m\", \"0.03\", \"--seed\", \"5\"");
   WriteRecipe(dir / "recipes/matte-sphere", "lambertian50",
-              "\"--sample\", \"sphere\", \"--radius\", \"0.05\", \"--seed\", \"6\"");
+              "\"--sample\", \"sphere\", \"--radius-m\", \"0.05\", \"--seed\", \"6\"");
   EXPECT_EQ(RunIbrdf(std::string("synth --material ") + IBRDF_SAMPLES_DIR +
                      "/materials/bluepaint.json --width 160 --height 120 --photos 4 --out " + dir / "broken")
                 .exit_code,

@@ -95,8 +95,8 @@ TEST(CaptureCli, SessionInitFromSyntheticPhotos) {
   ASSERT_EQ(RunIbrdf("targets --out " + dir / "targets" + " --no-charuco --dpi 72").exit_code, 0);
   const RunResult done =
       RunIbrdf("session init" + photos + " --out " + dir / "init" + " --targets " + dir / "targets/targets.json" +
-               " --light-position 1.2 0 0 --light-intensity 1 1 1 --sample-radius 0.04"
-               " --sample-center 0 0 0 --overwrite");
+               " --light-position-m 1.2 0 0 --light-intensity 1 1 1 --sample-radius-m 0.04"
+               " --sample-center-m 0 0 0 --overwrite");
   ASSERT_EQ(done.exit_code, 0) << done.output;
   const Session session = Session::Load(dir / "init/session.json");
   ASSERT_EQ(session.photos.size(), truth.photos.size());

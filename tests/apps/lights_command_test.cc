@@ -46,9 +46,9 @@ TEST(LightsCommand, SyntheticMirrorSphereAgainstTheTruth) {
 
 TEST(LightsCommand, PointLightsFromTwoPlacements) {
   testing::ScratchDir scratch;
-  const std::string common = " --lights 4 --point --light-distance 0.6 --seed 3";
-  ASSERT_EQ(RunIbrdf("lights synth --out " + scratch / "a" + common + " --center -0.03,0,0").exit_code, 0);
-  ASSERT_EQ(RunIbrdf("lights synth --out " + scratch / "b" + common + " --center 0.03,0.01,0").exit_code, 0);
+  const std::string common = " --lights 4 --point --light-distance-m 0.6 --seed 3";
+  ASSERT_EQ(RunIbrdf("lights synth --out " + scratch / "a" + common + " --center-m -0.03,0,0").exit_code, 0);
+  ASSERT_EQ(RunIbrdf("lights synth --out " + scratch / "b" + common + " --center-m 0.03,0.01,0").exit_code, 0);
   // One placement without a distance: an error that says what is needed.
   const auto one = RunIbrdf("lights calibrate " + scratch / "a" + " --kind point --out " + scratch / "l1.json");
   EXPECT_NE(one.exit_code, 0);

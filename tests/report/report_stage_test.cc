@@ -26,6 +26,7 @@
 #include "derender/derenderer.h"
 #include "reconstruct/consistency.h"
 #include "reconstruct/merl_table.h"
+#include "reconstruct/prediction_check.h"
 #include "reconstruct/reconstruction_stage.h"
 #include "reconstruct/truth_comparison.h"
 #include "report/table_interpolation.h"
@@ -130,6 +131,30 @@ TEST_F(ReportTest, WritesEveryFigureAndTheHtmlShowsThemInHeadlessChromium) {
     const double limit = render.at("model") == "truth" ? 0.03 : 0.05;
     EXPECT_LT(render.at("median_abs_difference").get<double>(), limit) << render.dump();
   }
+  // A held-out photo (by default one, the one `check --regression --held-out 1` holds out) is shown as
+  // the main photo is, rendered by a regression fitted on the other photos' samples only.
+  const std::vector<BrdfSample> samples = ReadSamples(dir_ / "run/samples.npy");
+  const std::vector<uint32_t> held = HeldOutImages(samples, 1);
+  ASSERT_EQ(held.size(), 1u);
+  ASSERT_EQ(data.at("held_out").size(), 1u);
+  const nlohmann::json& held_out = data.at("held_out")[0];
+  ASSERT_FALSE(held_out.contains("note")) << held_out.dump();
+  EXPECT_EQ(held_out.at("index"), held[0]);
+  size_t own = 0;
+  for (const BrdfSample& s : samples) own += s.image == held[0];
+  EXPECT_EQ(held_out.at("samples").get<size_t>(), own);
+  EXPECT_EQ(held_out.at("fit_samples").get<size_t>(), samples.size() - own);
+  ASSERT_EQ(held_out.at("renders").size(), 2u);
+  EXPECT_EQ(held_out.at("renders")[0].at("model"), "held-out");
+  EXPECT_EQ(held_out.at("renders")[1].at("model"), "reconstruction");
+  for (const nlohmann::json& render : held_out.at("renders")) {
+    EXPECT_TRUE(fs::exists(folder + "/" + render.at("file").get<std::string>()));
+    EXPECT_LT(render.at("median_abs_difference").get<double>(), 0.05) << render.dump();
+  }
+  ASSERT_EQ(report.held_out.size(), 1u);
+  EXPECT_EQ(report.held_out[0].image, held[0]);
+  EXPECT_TRUE(fs::exists(folder + "/held-out-" + std::to_string(held[0]) + "-difference.png"));
+  EXPECT_NE(Slurp(folder + "/index.html").find("Held-out photos"), std::string::npos);
   // The incidence-plane curves pass through the samples' band: the median of sample / reconstruction
   // at the samples' own directions is within 2 %.
   ASSERT_EQ(report.bands.size(), 4u);
@@ -197,6 +222,10 @@ TEST(ReportStage, OptionsCheckNamesTheRenderSize) {
   angles.angles_deg = {30, 89};
   EXPECT_FALSE(angles.Check(&why));
   EXPECT_NE(why.find("angles_deg"), std::string::npos) << why;
+  ReportOptions held;
+  held.held_out_photos = -1;
+  EXPECT_FALSE(held.Check(&why));
+  EXPECT_NE(why.find("held_out_photos"), std::string::npos) << why;
 }
 
 // `report` finds the reconstruction it is given, wherever it is, and says so when it is missing.
@@ -208,6 +237,7 @@ TEST_F(ReportTest, FindsTheReconstructionItIsGiven) {
   ReportOptions options;
   options.reconstruction = dir_ / "elsewhere";
   options.explorer = false;
+  options.held_out_photos = 0;
   options.angles_deg = {20, 40};
   const ReportResult report = WriteReport(dir_ / "run", options);
   EXPECT_TRUE(report.reconstruction);
@@ -233,6 +263,7 @@ TEST_F(ReportTest, FindsTheReconstructionItIsGiven) {
 TEST_F(ReportTest, ExplorerSliderChangesTheCurveAsTheTableSays) {
   ASSERT_NO_FATAL_FAILURE(MakeRunFolder());
   ReportOptions options;
+  options.held_out_photos = 0;  // shown by the test above
   const ReportResult report = WriteReport(dir_ / "run", options);
   ASSERT_TRUE(report.success);
   const std::string html = Slurp(report.explorer_html);

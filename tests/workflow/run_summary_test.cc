@@ -91,9 +91,12 @@ TEST_F(SummaryTest, FieldsFromEveryStage) {
   EXPECT_EQ(summary["samples"]["pixels_examined"].get<uint64_t>(), 5000000000ull);  // no int truncation
   EXPECT_EQ(summary["samples"]["rejected"]["off_sample"], 12);
   EXPECT_EQ(summary["consistency"]["reciprocity"], 0.02);
-  EXPECT_TRUE(summary["consistency"]["isotropy"].is_null());  // not valid
+  // A consistency.json of the previous release ("isotropy") is read under the one name.
+  EXPECT_TRUE(summary["consistency"]["bilateral_symmetry"].is_null());  // not valid
   EXPECT_EQ(summary["consistency"]["reciprocity_bins_compared"], 40);
-  EXPECT_TRUE(summary["consistency"]["isotropy_per_channel"].is_null());  // absent: recorded as absent
+  EXPECT_TRUE(summary["consistency"]["bilateral_symmetry_per_channel"].is_null());  // absent: recorded as absent
+  EXPECT_EQ(summary["consistency"]["bilateral_symmetry_bins_compared"], 0);
+  EXPECT_TRUE(summary["consistency"].contains("isotropy"));  // the old name's copy, for one release
   EXPECT_EQ(summary["reconstruction"]["table"]["cells_measured"], 10);
   EXPECT_TRUE(summary["reconstruction"]["fits"].is_null());
   EXPECT_EQ(summary["truth"]["samples_compared"], 7000);
@@ -104,10 +107,32 @@ TEST_F(SummaryTest, FieldsFromEveryStage) {
   const std::vector<std::string> headline = RunHeadline(summary);
   ASSERT_EQ(headline.size(), 3u);
   EXPECT_EQ(headline[0], "samples: 7000 accepted; rejected: off_sample 12");
-  EXPECT_EQ(headline[1], "consistency: reciprocity 2.00 %, bilateral symmetry n/a");
+  EXPECT_EQ(headline[1], "consistency: reciprocity 2.00 %, bilateral symmetry n/a (medians over bins)");
   EXPECT_EQ(headline[2],
             "against the truth: samples' median relative error (R, G, B) 1.00 %, 2.00 %, 3.00 %; reconstruction "
             "relative RMS 10.00 %, 10.00 %, 10.00 %");
+}
+
+// The current consistency.json names the check "bilateral_symmetry" (with an "isotropy" copy): the
+// summary and its headline read the one name, and carry the 95th percentile over bins.
+TEST_F(SummaryTest, BilateralSymmetryIsReadUnderItsOneName) {
+  json consistency = Consistency();
+  consistency.erase("isotropy");
+  consistency["reciprocity"]["p95_rel_error"] = 0.05;
+  consistency["bilateral_symmetry"] = {{"valid", true},
+                                       {"overall_rel_error", 0.03},
+                                       {"p95_rel_error", 0.07},
+                                       {"per_channel_rel_error", {0.03, 0.03, 0.03}},
+                                       {"bins_compared", 12}};
+  consistency["isotropy"] = {{"valid", true}, {"overall_rel_error", 0.99}, {"bins_compared", 1}};  // ignored
+  WriteJson(dir_ / "run/consistency.json", consistency);
+  const json summary = Build();
+  EXPECT_EQ(summary["consistency"]["bilateral_symmetry"], 0.03);
+  EXPECT_EQ(summary["consistency"]["bilateral_symmetry_p95"], 0.07);
+  EXPECT_EQ(summary["consistency"]["reciprocity_p95"], 0.05);
+  EXPECT_EQ(summary["consistency"]["bilateral_symmetry_bins_compared"], 12);
+  EXPECT_EQ(summary["consistency"]["isotropy"], 0.03);  // the copy of the one name, not the file's alias
+  EXPECT_EQ(RunHeadline(summary)[1], "consistency: reciprocity 2.00 %, bilateral symmetry 3.00 % (medians over bins)");
 }
 
 // Expects Build() to throw an Error naming `file` and `key`.
