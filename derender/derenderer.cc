@@ -24,6 +24,7 @@
 #include "core/logging.h"
 #include "core/sample_file.h"
 #include "derender/analytic_sample.h"
+#include "derender/huge_pages.h"
 #include "derender/light_calibration.h"
 #include "derender/mesh_sample.h"
 #include "derender/photo_mask.h"
@@ -102,6 +103,21 @@ PixelBox SampleBox(const Camera& camera, const Rigid3d& camera_from_world, const
   box.y0 = std::clamp(static_cast<int>(std::floor(y_min)) - 2, 0, camera.height);
   box.y1 = std::clamp(static_cast<int>(std::ceil(y_max)) + 2, 0, camera.height);
   return box;
+}
+
+// PixelRays (derenderer.h) for the pixels inside `box` only; the others are left unset (Eigen does
+// not initialize them, so their pages are never touched).
+std::vector<Eigen::Vector2f> PixelRaysInBox(const Camera& camera, const PixelBox& box) {
+  std::vector<Eigen::Vector2f> rays(size_t(camera.width) * camera.height);
+  if (box.Empty()) return rays;
+  tbb::parallel_for(tbb::blocked_range<int>(box.y0, box.y1), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      for (int x = box.x0; x < box.x1; ++x) {
+        rays[size_t(y) * camera.width + x] = camera.CamPlaneFromImage(Eigen::Vector2d(x + 0.5, y + 0.5)).cast<float>();
+      }
+    }
+  });
+  return rays;
 }
 
 // The radiometric tests of a pixel (flags from radiance_image.h) in RejectionReasons() order;
@@ -337,7 +353,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
   });
   size_t total = samples->size();
   for (const auto& block : block_samples) total += block.size();
-  samples->reserve(total);
+  ReserveWithHugePages(samples, total);
   for (size_t b = 0; b < blocks; ++b) {
     samples->insert(samples->end(), block_samples[b].begin(), block_samples[b].end());
     for (int r = 0; r < kNumReasons; ++r) stats->counts[r] += block_stats[b].counts[r];
@@ -464,7 +480,17 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   }
   session.CheckPhotos();
 
-  const std::vector<Eigen::Vector2f> rays = PixelRays(session.camera);
+  // The rays of the pixels some photo's box holds (the per-pixel loops read no others): undistorting
+  // every pixel of the camera costs more than the geometry of the sample's pixels.
+  PixelBox ray_box{session.camera.width, session.camera.height, 0, 0};
+  for (const PixelBox& box : boxes) {
+    if (box.Empty()) continue;
+    ray_box.x0 = std::min(ray_box.x0, box.x0);
+    ray_box.y0 = std::min(ray_box.y0, box.y0);
+    ray_box.x1 = std::max(ray_box.x1, box.x1);
+    ray_box.y1 = std::max(ray_box.y1, box.y1);
+  }
+  const std::vector<Eigen::Vector2f> rays = PixelRaysInBox(session.camera, ray_box);
   const RadianceReader reader(session);
   // Each photo (exposure group) is linearized only inside the pixel box that can see the sample (the
   // per-pixel loops below trace nothing outside it). A TBB pipeline keeps a few photos in flight, so
@@ -494,7 +520,7 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     if (!box.Empty())
       box_pixels += uint64_t((box.x1 - box.x0 + stride - 1) / stride) * ((box.y1 - box.y0 + stride - 1) / stride);
   }
-  result.samples.reserve(box_pixels);
+  ReserveWithHugePages(&result.samples, box_pixels);
   ProgressBar progress("photos", groups.size());
   size_t next_group = 0;
   tbb::parallel_pipeline(
@@ -521,14 +547,14 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
         reader.ReadWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1}, &w->decoded,
                           &w->image, &w->decode_s);
         w->image.mask = ReadGroupMask(session, groups[g]);
+        // Room for every examined pixel: reserved once per buffer (regrowth copies and page faults
+        // cost more than the per-pixel geometry).
+        ReserveWithHugePages(&w->samples, PixelsPerImage(session.camera, options.pixel_stride));
         if (mesh_path) {
           DerenderMeshPhoto(session, groups[g].front(), w->image, rays, *mesh_path, options, &w->samples,
                             &w->mesh_stats);
           AddCounts(w->mesh_stats.counts, &w->rejected);
         } else {
-          // Room for every examined pixel: reserved once per buffer (regrowth copies and page
-          // faults cost more than the per-pixel geometry).
-          w->samples.reserve(PixelsPerImage(session.camera, options.pixel_stride));
           DerenderPhoto(session, groups[g].front(), w->image, rays, sample, options, &w->samples, &w->rejected);
         }
         return w;
@@ -617,15 +643,7 @@ std::string DerenderSummary::BriefReport() const {
 }
 
 std::vector<Eigen::Vector2f> PixelRays(const Camera& camera) {
-  std::vector<Eigen::Vector2f> rays(size_t(camera.width) * camera.height);
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      for (int x = 0; x < camera.width; ++x) {
-        rays[size_t(y) * camera.width + x] = camera.CamPlaneFromImage(Eigen::Vector2d(x + 0.5, y + 0.5)).cast<float>();
-      }
-    }
-  });
-  return rays;
+  return PixelRaysInBox(camera, PixelBox{0, 0, camera.width, camera.height});
 }
 
 std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera) {

@@ -14,6 +14,7 @@
 #include "core/image_io.h"
 #include "core/linear_image.h"
 #include "core/logging.h"
+#include "derender/huge_pages.h"
 
 namespace fs = std::filesystem;
 
@@ -191,6 +192,7 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
   for (size_t e = 0; e < m; ++e) {
     const std::string path = ResolvePath(impl.directory, exposures[e].file);
     Timer timer;
+    ReserveWithHugePages(&images[e].pixels, 3 * size_t(impl.width) * impl.height);
     ReadImage(path, &images[e]);
     if (decode_s) *decode_s += timer.ElapsedSeconds();
     if (images[e].width != impl.width || images[e].height != impl.height) {
@@ -209,6 +211,8 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
   const size_t n = size_t(impl.width) * impl.height;
   // Sized once; every pixel of the window is written below (sigma and exposures_used included), so
   // nothing needs clearing between photos.
+  ReserveWithHugePages(&out.radiance, 3 * n);
+  ReserveWithHugePages(&out.sigma, 3 * n);
   out.radiance.resize(3 * n);
   out.sigma.resize(3 * n);
   out.flags.resize(n);
