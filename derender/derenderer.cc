@@ -514,7 +514,9 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     MeshPhotoStats mesh_stats;
     double decode_s = 0.0;
   };
-  const size_t tokens = size_t(std::max(2, 2 * tbb::this_task_arena::max_concurrency()));
+  // One photo in flight per thread and one more waiting its turn in the in-order merge: each token
+  // holds full-frame buffers (tens of MB whose first touch costs page faults), so no more than that.
+  const size_t tokens = size_t(std::max(2, tbb::this_task_arena::max_concurrency() + 1));
   std::vector<std::unique_ptr<PhotoWork>> work(tokens);
   tbb::concurrent_queue<PhotoWork*> idle;
   for (auto& w : work) {
@@ -684,13 +686,13 @@ void DerenderPhoto(const Session& session, size_t photo_index, const RadianceIma
   const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, sample);
   const int x_start = (box.x0 + stride - 1) / stride * stride, y_start = (box.y0 + stride - 1) / stride * stride;
   uint64_t traced = 0;
+  SurfaceHit hit;  // reused: Intersect sets every field it reports
   for (int y = y_start; y < box.y1; y += stride) {
     for (int x = x_start; x < box.x1; x += stride) {
       ++traced;
       const Eigen::Vector2f& xy = rays[size_t(y) * image.width + x];
       const Eigen::Vector3d direction =
           (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
-      SurfaceHit hit;
       if (!sample.Intersect(camera_center, direction, &hit)) {
         ++counts[kOff];
         continue;
