@@ -121,6 +121,22 @@ std::vector<Eigen::Vector2f> PixelRaysInBox(const Camera& camera, const PixelBox
   return rays;
 }
 
+// PixelCornerRays (derenderer.h) for the corners inside `box` (corner coordinates, [x0, x1) x [y0, y1)
+// of the (width + 1) x (height + 1) grid) only; the others are left unset.
+std::vector<Eigen::Vector2f> PixelCornerRaysInBox(const Camera& camera, const PixelBox& box) {
+  const int columns = camera.width + 1;
+  std::vector<Eigen::Vector2f> rays(size_t(columns) * (camera.height + 1));
+  if (box.Empty()) return rays;
+  tbb::parallel_for(tbb::blocked_range<int>(box.y0, box.y1), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      for (int x = box.x0; x < box.x1; ++x) {
+        rays[size_t(y) * columns + x] = camera.CamPlaneFromImage(Eigen::Vector2d(x, y)).cast<float>();
+      }
+    }
+  });
+  return rays;
+}
+
 // The radiometric tests of a pixel (flags from radiance_image.h) in RejectionReasons() order;
 // kNumReasons when measurable.
 inline Reason RadiometricReason(uint8_t flags) {
@@ -441,7 +457,18 @@ MeshPath PrepareMeshPath(const Session& session, const DerenderOptions& options)
     if (!quads.empty()) path.occluders = std::make_unique<QuadOccluders>(quads);
   }
   if (options.mask_mixed_pixels) {
-    path.corner_rays = PixelCornerRays(session.camera);
+    // Corner rays only where a photo's sample box reads them (its pixels' corners x .. x + 1, y .. y + 1).
+    PixelBox corners{session.camera.width + 1, session.camera.height + 1, 0, 0};
+    for (const PhotoSpec& photo : session.photos) {
+      if (photo.role == PhotoRole::kTargets || !photo.camera_from_world) continue;
+      const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, *path.mesh);
+      if (box.Empty()) continue;
+      corners.x0 = std::min(corners.x0, box.x0);
+      corners.y0 = std::min(corners.y0, box.y0);
+      corners.x1 = std::max(corners.x1, box.x1 + 1);
+      corners.y1 = std::max(corners.y1, box.y1 + 1);
+    }
+    path.corner_rays = PixelCornerRaysInBox(session.camera, corners);
     path.half_diagonal = 0.5 * std::hypot(1.0 / session.camera.FocalX(), 1.0 / session.camera.FocalY());
   }
   Log(1, "mesh " + file + ": " + std::to_string(path.mesh->NumPoints()) + " points, " +
@@ -657,16 +684,7 @@ std::vector<Eigen::Vector2f> PixelRays(const Camera& camera) {
 }
 
 std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera) {
-  const int columns = camera.width + 1;
-  std::vector<Eigen::Vector2f> rays(size_t(columns) * (camera.height + 1));
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height + 1), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      for (int x = 0; x < columns; ++x) {
-        rays[size_t(y) * columns + x] = camera.CamPlaneFromImage(Eigen::Vector2d(x, y)).cast<float>();
-      }
-    }
-  });
-  return rays;
+  return PixelCornerRaysInBox(camera, PixelBox{0, 0, camera.width + 1, camera.height + 1});
 }
 
 void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
