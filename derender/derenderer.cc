@@ -433,11 +433,11 @@ MeshPath PrepareMeshPath(const Session& session, const DerenderOptions& options)
   // The ray-tracing scene and (visibility auto) the convexity verdict at the same time: on a 400 k-face
   // mesh without a scan sidecar the hull alone takes seconds.
   bool auto_shadow_rays = false;
-  tbb::parallel_invoke(
-      [&] { path.mesh = std::make_unique<MeshSample>(mesh, session.sample.world_from_mesh, file); },
-      [&] {
-        if (visibility == Visibility::kAuto) auto_shadow_rays = NeedsShadowRays(file, mesh, &path.visibility_reason);
-      });
+  tbb::parallel_invoke([&] { path.mesh = std::make_unique<MeshSample>(mesh, session.sample.world_from_mesh, file); },
+                       [&] {
+                         if (visibility == Visibility::kAuto)
+                           auto_shadow_rays = NeedsShadowRays(file, mesh, &path.visibility_reason);
+                       });
   switch (visibility) {
     case Visibility::kOn:
       path.shadow_rays = true;

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <unordered_map>
 
-#include <nlohmann/json.hpp>
 #include <tbb/parallel_invoke.h>
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "core/logging.h"

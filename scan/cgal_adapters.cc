@@ -90,7 +90,8 @@ HullDistances ConvexHullDistances(const std::vector<Eigen::Vector3d>& points) {
   if (!inside.empty()) {
     std::vector<Triangle> triangles;
     triangles.reserve(hull_triangles.size());
-    for (const auto& t : hull_triangles) triangles.emplace_back(hull_points[t[0]], hull_points[t[1]], hull_points[t[2]]);
+    for (const auto& t : hull_triangles)
+      triangles.emplace_back(hull_points[t[0]], hull_points[t[1]], hull_points[t[2]]);
     TriangleTree tree(triangles.begin(), triangles.end());
     // Built here, before the queries share it across threads (queries on a built tree only read).
     tree.build();
