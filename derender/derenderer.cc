@@ -12,6 +12,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/concurrent_queue.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
@@ -25,6 +26,7 @@
 #include "core/sample_file.h"
 #include "derender/analytic_sample.h"
 #include "derender/colour_chart.h"
+#include "derender/huge_pages.h"
 #include "derender/light_calibration.h"
 #include "derender/mesh_sample.h"
 #include "derender/photo_mask.h"
@@ -103,6 +105,37 @@ PixelBox SampleBox(const Camera& camera, const Rigid3d& camera_from_world, const
   box.y0 = std::clamp(static_cast<int>(std::floor(y_min)) - 2, 0, camera.height);
   box.y1 = std::clamp(static_cast<int>(std::ceil(y_max)) + 2, 0, camera.height);
   return box;
+}
+
+// PixelRays (derenderer.h) for the pixels inside `box` only; the others are left unset (Eigen does
+// not initialize them, so their pages are never touched).
+std::vector<Eigen::Vector2f> PixelRaysInBox(const Camera& camera, const PixelBox& box) {
+  std::vector<Eigen::Vector2f> rays(size_t(camera.width) * camera.height);
+  if (box.Empty()) return rays;
+  tbb::parallel_for(tbb::blocked_range<int>(box.y0, box.y1), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      for (int x = box.x0; x < box.x1; ++x) {
+        rays[size_t(y) * camera.width + x] = camera.CamPlaneFromImage(Eigen::Vector2d(x + 0.5, y + 0.5)).cast<float>();
+      }
+    }
+  });
+  return rays;
+}
+
+// PixelCornerRays (derenderer.h) for the corners inside `box` (corner coordinates, [x0, x1) x [y0, y1)
+// of the (width + 1) x (height + 1) grid) only; the others are left unset.
+std::vector<Eigen::Vector2f> PixelCornerRaysInBox(const Camera& camera, const PixelBox& box) {
+  const int columns = camera.width + 1;
+  std::vector<Eigen::Vector2f> rays(size_t(columns) * (camera.height + 1));
+  if (box.Empty()) return rays;
+  tbb::parallel_for(tbb::blocked_range<int>(box.y0, box.y1), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      for (int x = box.x0; x < box.x1; ++x) {
+        rays[size_t(y) * columns + x] = camera.CamPlaneFromImage(Eigen::Vector2d(x, y)).cast<float>();
+      }
+    }
+  });
+  return rays;
 }
 
 // The radiometric tests of a pixel (per-channel flags from radiance_image.h): kNumReasons when any
@@ -352,7 +385,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
   });
   size_t total = samples->size();
   for (const auto& block : block_samples) total += block.size();
-  samples->reserve(total);
+  ReserveWithHugePages(samples, total);
   for (size_t b = 0; b < blocks; ++b) {
     samples->insert(samples->end(), block_samples[b].begin(), block_samples[b].end());
     for (int r = 0; r < kNumReasons; ++r) stats->counts[r] += block_stats[b].counts[r];
@@ -411,9 +444,16 @@ MeshPath PrepareMeshPath(const Session& session, const DerenderOptions& options)
   }
   if (!fs::is_regular_file(file)) ThrowError(where, file + " is not a file");
   const ScanMesh mesh = ReadTriangleMeshFile(file);
-  path.mesh = std::make_unique<MeshSample>(mesh, session.sample.world_from_mesh, file);
   const Visibility visibility = options.visibility.value_or(session.sample.visibility);
   const std::string source = options.visibility ? "option" : "session";
+  // The ray-tracing scene and (visibility auto) the convexity verdict at the same time: on a 400 k-face
+  // mesh without a scan sidecar the hull alone takes seconds.
+  bool auto_shadow_rays = false;
+  tbb::parallel_invoke([&] { path.mesh = std::make_unique<MeshSample>(mesh, session.sample.world_from_mesh, file); },
+                       [&] {
+                         if (visibility == Visibility::kAuto)
+                           auto_shadow_rays = NeedsShadowRays(file, mesh, &path.visibility_reason);
+                       });
   switch (visibility) {
     case Visibility::kOn:
       path.shadow_rays = true;
@@ -424,7 +464,7 @@ MeshPath PrepareMeshPath(const Session& session, const DerenderOptions& options)
       path.visibility_reason = "off (" + source + ")";
       break;
     case Visibility::kAuto:
-      path.shadow_rays = NeedsShadowRays(file, mesh, &path.visibility_reason);
+      path.shadow_rays = auto_shadow_rays;
       break;
   }
   if (session.targets) {
@@ -433,7 +473,18 @@ MeshPath PrepareMeshPath(const Session& session, const DerenderOptions& options)
     if (!quads.empty()) path.occluders = std::make_unique<QuadOccluders>(quads);
   }
   if (options.mask_mixed_pixels) {
-    path.corner_rays = PixelCornerRays(session.camera);
+    // Corner rays only where a photo's sample box reads them (its pixels' corners x .. x + 1, y .. y + 1).
+    PixelBox corners{session.camera.width + 1, session.camera.height + 1, 0, 0};
+    for (const PhotoSpec& photo : session.photos) {
+      if (photo.role == PhotoRole::kTargets || !photo.camera_from_world) continue;
+      const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, *path.mesh);
+      if (box.Empty()) continue;
+      corners.x0 = std::min(corners.x0, box.x0);
+      corners.y0 = std::min(corners.y0, box.y0);
+      corners.x1 = std::max(corners.x1, box.x1 + 1);
+      corners.y1 = std::max(corners.y1, box.y1 + 1);
+    }
+    path.corner_rays = PixelCornerRaysInBox(session.camera, corners);
     path.half_diagonal = 0.5 * std::hypot(1.0 / session.camera.FocalX(), 1.0 / session.camera.FocalY());
   }
   Log(1, "mesh " + file + ": " + std::to_string(path.mesh->NumPoints()) + " points, " +
@@ -480,7 +531,17 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   }
   session.CheckPhotos();
 
-  const std::vector<Eigen::Vector2f> rays = PixelRays(session.camera);
+  // The rays of the pixels some photo's box holds (the per-pixel loops read no others): undistorting
+  // every pixel of the camera costs more than the geometry of the sample's pixels.
+  PixelBox ray_box{session.camera.width, session.camera.height, 0, 0};
+  for (const PixelBox& box : boxes) {
+    if (box.Empty()) continue;
+    ray_box.x0 = std::min(ray_box.x0, box.x0);
+    ray_box.y0 = std::min(ray_box.y0, box.y0);
+    ray_box.x1 = std::max(ray_box.x1, box.x1);
+    ray_box.y1 = std::max(ray_box.y1, box.y1);
+  }
+  const std::vector<Eigen::Vector2f> rays = PixelRaysInBox(session.camera, ray_box);
   const RadianceReader reader(session);
   // Each photo (exposure group) is linearized only inside the pixel box that can see the sample (the
   // per-pixel loops below trace nothing outside it). A TBB pipeline keeps a few photos in flight, so
@@ -497,7 +558,9 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     ExposureTally exposure;  // analytic path
     double decode_s = 0.0;
   };
-  const size_t tokens = size_t(std::max(2, 2 * tbb::this_task_arena::max_concurrency()));
+  // One photo in flight per thread and one more waiting its turn in the in-order merge: each token
+  // holds full-frame buffers (tens of MB whose first touch costs page faults), so no more than that.
+  const size_t tokens = size_t(std::max(2, tbb::this_task_arena::max_concurrency() + 1));
   std::vector<std::unique_ptr<PhotoWork>> work(tokens);
   tbb::concurrent_queue<PhotoWork*> idle;
   for (auto& w : work) {
@@ -511,7 +574,7 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     if (!box.Empty())
       box_pixels += uint64_t((box.x1 - box.x0 + stride - 1) / stride) * ((box.y1 - box.y0 + stride - 1) / stride);
   }
-  result.samples.reserve(box_pixels);
+  ReserveWithHugePages(&result.samples, box_pixels);
   ProgressBar progress("photos", groups.size());
   size_t next_group = 0;
   tbb::parallel_pipeline(
@@ -539,14 +602,14 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
         reader.ReadWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1}, &w->decoded,
                           &w->image, &w->decode_s);
         w->image.mask = ReadGroupMask(session, groups[g]);
+        // Room for every examined pixel: reserved once per buffer (regrowth copies and page faults
+        // cost more than the per-pixel geometry).
+        ReserveWithHugePages(&w->samples, PixelsPerImage(session.camera, options.pixel_stride));
         if (mesh_path) {
           DerenderMeshPhoto(session, groups[g].front(), w->image, rays, *mesh_path, options, &w->samples,
                             &w->mesh_stats);
           AddCounts(w->mesh_stats.counts, &w->rejected);
         } else {
-          // Room for every examined pixel: reserved once per buffer (regrowth copies and page
-          // faults cost more than the per-pixel geometry).
-          w->samples.reserve(PixelsPerImage(session.camera, options.pixel_stride));
           DerenderPhoto(session, groups[g].front(), w->image, rays, sample, options, &w->samples, &w->rejected,
                         &w->exposure);
         }
@@ -650,28 +713,11 @@ std::string DerenderSummary::BriefReport() const {
 }
 
 std::vector<Eigen::Vector2f> PixelRays(const Camera& camera) {
-  std::vector<Eigen::Vector2f> rays(size_t(camera.width) * camera.height);
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      for (int x = 0; x < camera.width; ++x) {
-        rays[size_t(y) * camera.width + x] = camera.CamPlaneFromImage(Eigen::Vector2d(x + 0.5, y + 0.5)).cast<float>();
-      }
-    }
-  });
-  return rays;
+  return PixelRaysInBox(camera, PixelBox{0, 0, camera.width, camera.height});
 }
 
 std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera) {
-  const int columns = camera.width + 1;
-  std::vector<Eigen::Vector2f> rays(size_t(columns) * (camera.height + 1));
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height + 1), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      for (int x = 0; x < columns; ++x) {
-        rays[size_t(y) * columns + x] = camera.CamPlaneFromImage(Eigen::Vector2d(x, y)).cast<float>();
-      }
-    }
-  });
-  return rays;
+  return PixelCornerRaysInBox(camera, PixelBox{0, 0, camera.width + 1, camera.height + 1});
 }
 
 void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
@@ -692,13 +738,13 @@ void DerenderPhoto(const Session& session, size_t photo_index, const RadianceIma
   const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, sample);
   const int x_start = (box.x0 + stride - 1) / stride * stride, y_start = (box.y0 + stride - 1) / stride * stride;
   uint64_t traced = 0;
+  SurfaceHit hit;  // reused: Intersect sets every field it reports
   for (int y = y_start; y < box.y1; y += stride) {
     for (int x = x_start; x < box.x1; x += stride) {
       ++traced;
       const Eigen::Vector2f& xy = rays[size_t(y) * image.width + x];
       const Eigen::Vector3d direction =
           (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
-      SurfaceHit hit;
       if (!sample.Intersect(camera_center, direction, &hit)) {
         ++counts[kOff];
         continue;

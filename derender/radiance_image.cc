@@ -14,6 +14,7 @@
 #include "core/image_io.h"
 #include "core/linear_image.h"
 #include "core/logging.h"
+#include "derender/huge_pages.h"
 
 namespace fs = std::filesystem;
 
@@ -120,11 +121,14 @@ struct RadianceReader::Impl {
   RadiometrySpec radiometry;
   std::string directory;
   int width = 0, height = 0;
+  bool linear = false;            // a linear response: file values are the signal (no call per value)
   bool table = false;             // use the lookup table (non-linear responses)
+  double quantization_step = 0.0;  // one file step, 1 / (2^bits - 1), with a noise model of bits > 0
   std::vector<double> to_linear;  // response^-1 at kTableIntervals + 1 nodes over [0, 1]
   std::shared_ptr<const FlatField> flat;
 
   double ToLinear(double encoded) const {
+    if (linear) return encoded;  // Response::ToLinear of a linear response
     if (!table || !(encoded >= kTableStart && encoded <= 1.0)) return radiometry.response.ToLinear(encoded);
     const double x = encoded * kTableIntervals;
     const int i = std::min(static_cast<int>(x), kTableIntervals - 1);
@@ -140,7 +144,7 @@ struct RadianceReader::Impl {
     const double read = noise.read_noise_e / noise.full_well_e;
     double variance = std::max(signal, 0.0) / noise.full_well_e + read * read;
     if (noise.bits > 0) {
-      const double step = 1.0 / (std::ldexp(1.0, noise.bits) - 1.0);
+      const double step = quantization_step;
       const double slope =
           (ToLinear(std::min(encoded + 0.5 * step, 1.0)) - ToLinear(std::max(encoded - 0.5 * step, 0.0))) / step;
       variance += (step * slope) * (step * slope) / 12.0;
@@ -155,7 +159,11 @@ RadianceReader::RadianceReader(const Session& session) : impl_(std::make_unique<
   impl.directory = session.directory;
   impl.width = session.camera.width;
   impl.height = session.camera.height;
-  impl.table = session.radiometry.response.kind != Response::Kind::kLinear;
+  impl.linear = session.radiometry.response.kind == Response::Kind::kLinear;
+  impl.table = !impl.linear;
+  if (session.radiometry.noise && session.radiometry.noise->bits > 0) {
+    impl.quantization_step = 1.0 / (std::ldexp(1.0, session.radiometry.noise->bits) - 1.0);
+  }
   if (impl.table) {
     impl.to_linear.resize(kTableIntervals + 1);
     for (int i = 0; i <= kTableIntervals; ++i) {
@@ -191,6 +199,7 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
   for (size_t e = 0; e < m; ++e) {
     const std::string path = ResolvePath(impl.directory, exposures[e].file);
     Timer timer;
+    ReserveWithHugePages(&images[e].pixels, 3 * size_t(impl.width) * impl.height);
     ReadImage(path, &images[e]);
     if (decode_s) *decode_s += timer.ElapsedSeconds();
     if (images[e].width != impl.width || images[e].height != impl.height) {
@@ -209,6 +218,8 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
   const size_t n = size_t(impl.width) * impl.height;
   // Sized once; every pixel of the window is written below (sigma and exposures_used included), so
   // nothing needs clearing between photos.
+  ReserveWithHugePages(&out.radiance, 3 * n);
+  ReserveWithHugePages(&out.sigma, 3 * n);
   out.radiance.resize(3 * n);
   out.sigma.resize(3 * n);
   out.flags.resize(n);

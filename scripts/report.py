@@ -808,6 +808,33 @@ draw();
 """
 
 
+_JOBS = []  # the figure functions, inherited by the forked workers of run_figures
+
+
+def _run_job(index):
+    return _JOBS[index]()
+
+
+def run_figures(jobs, explorer_job):
+    """Runs the figure functions (name -> function returning the figure's file name) in forked worker
+    processes, one per CPU this process may use, in the order given (the slowest first balances them),
+    while this process writes the explorer; returns ({name: file name}, the explorer's result). The
+    figures are the same as run one after another (each function draws and saves its own figure with
+    its own random generator); only the wall time changes. One CPU: no workers."""
+    workers = min(len(jobs), len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1)
+    if workers <= 1:
+        return {name: job() for name, job in jobs.items()}, explorer_job()
+    import concurrent.futures
+    import multiprocessing
+    _JOBS[:] = list(jobs.values())
+    context = multiprocessing.get_context("fork")
+    with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+        futures = [pool.submit(_run_job, i) for i in range(len(_JOBS))]
+        explorer = explorer_job()
+        names = [future.result() for future in futures]
+    return dict(zip(jobs.keys(), names)), explorer
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit("usage: report.py RUN_DIR OUT_DIR")
@@ -823,19 +850,20 @@ def main():
     models = data.get("models", [])
     title = data.get("title") or os.path.basename(os.path.abspath(run_dir))
 
-    figures = {
-        "coverage": coverage_figure(s, out),
-        "plane": incidence_plane_figure(data, models, out),
-        "reciprocity_curves": reciprocity_curves_figure(data, out),
-        "reciprocity": consistency_figure(c, "reciprocity", "Reciprocity: each sample against the measured sample "
-                                          "nearest its reciprocal point f(te, ti, -dphi)", out),
-        "bilateral": consistency_figure(c, "bilateral_symmetry", "Bilateral symmetry: each sample against the "
-                                        "measured sample nearest f(ti, te, -dphi)", out),
-        "difference": photo_difference_figure(data, out),
-        "timings": timings_figure(times, side.get("counts", {}), out),
-        "bands": truth_bands_figure(t, out),
+    jobs = {
+        # The slowest first (the coverage and incidence-plane figures take the most CPU on the demo).
+        "coverage": lambda: coverage_figure(s, out),
+        "plane": lambda: incidence_plane_figure(data, models, out),
+        "reciprocity": lambda: consistency_figure(c, "reciprocity", "Reciprocity: each sample against the measured "
+                                                  "sample nearest its reciprocal point f(te, ti, -dphi)", out),
+        "bilateral": lambda: consistency_figure(c, "bilateral_symmetry", "Bilateral symmetry: each sample against "
+                                                "the measured sample nearest f(ti, te, -dphi)", out),
+        "reciprocity_curves": lambda: reciprocity_curves_figure(data, out),
+        "difference": lambda: photo_difference_figure(data, out),
+        "timings": lambda: timings_figure(times, side.get("counts", {}), out),
+        "bands": lambda: truth_bands_figure(t, out),
     }
-    explorer = write_explorer(data, out, title)
+    figures, explorer = run_figures(jobs, lambda: write_explorer(data, out, title))
     rows = headline_rows(s, side, c, t, r, data, times)
     table = "\n".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>" for k, v in rows)
     explorer_link = (f'<p><a href="{explorer}">Open the BRDF explorer</a> (explorer.html beside this file: '
