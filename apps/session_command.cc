@@ -40,7 +40,7 @@ void AddSessionCommand(CLI::App& app) {
                    "Photos of the white reference (its card's markers pose it in `ibrdf align`); it measures the "
                    "light's intensity")
       ->check(CLI::ExistingFile);
-  init->add_option("--white-size", args->white_size, "The white reference's size (metres, the patch's side)");
+  init->add_option("--white-size-m", args->white_size, "The white reference's size (metres, the patch's side)");
   init->add_option("--white-reflectance", args->white_reflectance,
                    "The white reference's albedo R G B (default 0.99: Spectralon)")
       ->expected(3);

@@ -95,7 +95,7 @@ void AddSynthCommand(CLI::App& app) {
              "the first light, from the first camera: the session's colour_chart block, for `ibrdf colour`");
   c.add_flag("--colour-chart-detect", args->chart_detect,
              "With --colour-chart: leave the corner patches out of the session (`ibrdf colour` must detect the chart)");
-  add("--colour-chart-pitch", o.colour.chart_pitch, "With --colour-chart: patch centre to centre, metres");
+  add("--colour-chart-pitch-m", o.colour.chart_pitch, "With --colour-chart: patch centre to centre, metres");
   add("--colour-chart-exposure", o.colour.chart_exposure_scale,
       "With --colour-chart: the chart photo's exposure relative to its auto-exposure (> 1.25 clips the white)");
   add("--colour-space", args->colour_space, "With --colour-chart: the colour_chart block's target space")

@@ -358,7 +358,7 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
       white["size"] = *options.white_size;
     } else {
       white["size"] = nullptr;
-      result.missing.push_back("the white reference's size (metres, the patch's side): pass --white-size S");
+      result.missing.push_back("the white reference's size (metres, the patch's side): pass --white-size-m S");
     }
     if (!(json.contains("targets") && json["targets"].contains("white_reference"))) {
       white["center"] = nullptr;

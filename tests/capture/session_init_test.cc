@@ -169,7 +169,7 @@ TEST(SessionInit, WhiteReferencePhotosNeedNoPoseWithTheCardsMarkers) {
   EXPECT_FALSE(draft.complete);
   std::string missing;
   for (const std::string& line : draft.missing) missing += line + "\n";
-  EXPECT_NE(missing.find("--white-size"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("--white-size-m"), std::string::npos) << missing;
   EXPECT_NE(missing.find("centre and normal"), std::string::npos) << missing;
   EXPECT_EQ(missing.find("--light-intensity"), std::string::npos) << missing;
 
