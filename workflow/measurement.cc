@@ -61,6 +61,7 @@ class Planner {
   std::string manifest_path;  // the input session (synth's for a recipe)
   std::string current;        // the manifest the next stage reads
   std::string truth_path;     // truth.json beside the input session, if any
+  std::string material_name;  // the fitted materials' name: the recipe's, else the input session's folder
 
  private:
   const MeasurementOptions& options_;
@@ -194,8 +195,12 @@ void Planner::SampleStages() {
   pass("--radius-h-deg", options_.radius_h_deg, -1.0);
   pass("--radius-d-deg", options_.radius_d_deg, -1.0);
   if (!options_.fits) reconstruct.arguments.push_back("--no-fits");
-  reconstruct.arguments.insert(reconstruct.arguments.end(), options_.reconstruct_args.begin(),
-                               options_.reconstruct_args.end());
+  // The input's name, not that of the stage folder (align/, colour/) whose session the samples came from.
+  const std::vector<std::string>& extra = options_.reconstruct_args;
+  if (!material_name.empty() && std::find(extra.begin(), extra.end(), "--name") == extra.end()) {
+    reconstruct.arguments.insert(reconstruct.arguments.end(), {"--name", material_name});
+  }
+  reconstruct.arguments.insert(reconstruct.arguments.end(), extra.begin(), extra.end());
   Execute(reconstruct);
 
   Stage report = MakeStage("report", {"report", run_->run_dir(), "--out", At("report"), "--overwrite"}, {},
@@ -275,6 +280,7 @@ std::string RunMeasurement(const MeasurementInput& input, const MeasurementOptio
   plan.manifest_path = input.manifest_path;
   if (input.recipe) plan.Synth(*input.recipe);
   const fs::path session_dir = fs::path(plan.manifest_path).parent_path();
+  plan.material_name = input.recipe ? input.recipe->name : session_dir.filename().string();
   if (fs::exists(session_dir / "truth.json")) plan.truth_path = (session_dir / "truth.json").string();
   plan.current = plan.manifest_path;
   plan.Scan();
