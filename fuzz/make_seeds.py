@@ -143,3 +143,26 @@ put("corpus", "merl", "wrong_dims.binary", struct.pack("<3i", 90, 90, 360) + b"\
 put("regressions", "merl", "negative_dims.binary", struct.pack("<3i", -90, 90, 180))
 put("regressions", "merl", "short.binary", b"\x5a")
 print("seeds written under", here)
+
+# RGL .bsdf tensor files (issue 14): header "tensor_file\0", version 1.0, field count, then per field
+# name length, name, rank, dtype, offset, shape; data at the offsets (core/tensor_file.cc).
+def tensor_file(fields, version=(1, 0)):
+    header = b"tensor_file\0" + bytes(version) + struct.pack("<I", len(fields))
+    size = len(header) + sum(2 + len(n) + 2 + 1 + 8 + 8 * len(shape) for n, _, shape, _ in fields)
+    out, blobs, offset = bytearray(header), b"", (size + 7) // 8 * 8
+    for name, dtype, shape, data in fields:
+        out += struct.pack("<H", len(name)) + name.encode() + struct.pack("<HBQ", len(shape), dtype, offset)
+        out += b"".join(struct.pack("<Q", s) for s in shape)
+        blobs += data + b"\0" * ((-len(data)) % 8)
+        offset += len(data) + (-len(data)) % 8
+    return bytes(out) + b"\0" * ((size + 7) // 8 * 8 - size) + blobs
+
+
+floats = lambda values: struct.pack("<%df" % len(values), *values)
+text = b"a small tensor file"
+put("corpus", "bsdf", "fields.bsdf",
+    tensor_file([("description", 1, [len(text)], text), ("theta_i", 10, [2], floats([0.0, 1.5])),
+                 ("phi_i", 10, [1], floats([0.0]))]))
+put("corpus", "bsdf", "empty_fields.bsdf", tensor_file([]))
+put("regressions", "bsdf", "version_2.bsdf", tensor_file([], version=(2, 0)))
+put("regressions", "bsdf", "past_the_end.bsdf", tensor_file([("theta_i", 10, [1 << 40], b"")]))
