@@ -1,6 +1,7 @@
 // The analytic derenderer against synthetic sessions with known BRDFs (the foundation issue's bounds).
 #include "derender/derenderer.h"
 
+#include <cstdio>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -182,11 +183,22 @@ TEST(Derender, SaturatedPixelsAreRejectedAndCounted) {
   const Session session = Session::Load(MakeSession(dir / "s", options, *material));
   const DerenderResult result = DerenderAnalytic(session, DerenderOptions());
   EXPECT_GT(result.summary.rejected.at("saturated"), 0u);
+  // A pixel clipped in some channels is kept with those flagged (valid 0, sigma 0); every measured
+  // channel is exact (noise-free), so no clipped value is counted as measured.
+  size_t flagged = 0;
   for (const BrdfSample& s : result.samples) {
     const Eigen::Vector3d truth = material->Eval(Eigen::Vector3d(s.wi[0], s.wi[1], s.wi[2]).normalized(),
                                                  Eigen::Vector3d(s.wo[0], s.wo[1], s.wo[2]).normalized());
-    ASSERT_NEAR(s.brdf[0] / truth[0], 1.0, 1e-3) << "a clipped value slipped through";
+    for (int c = 0; c < 3; ++c) {
+      if (!s.valid[c]) {
+        ++flagged;
+        ASSERT_EQ(s.sigma[c], 0.0f);
+        continue;
+      }
+      ASSERT_NEAR(s.brdf[c] / truth[c], 1.0, 1e-3) << "a clipped value slipped through (channel " << c << ")";
+    }
   }
+  std::printf("%zu channels flagged as clipped\n", flagged);
 }
 
 TEST(Derender, StrideAndGrazingLimitsReduceSamples) {
@@ -247,8 +259,19 @@ TEST(Derender, NonFinitePixelsAreRejectedNotPropagated) {
   }
   WriteImage(session.PhotoPath(0), image, PixelFormat::kFloat);
   const DerenderResult result = DerenderAnalytic(session, DerenderOptions());
-  EXPECT_EQ(result.summary.rejected.at("non_finite"), 100u);
-  for (const BrdfSample& s : result.samples) ASSERT_TRUE(std::isfinite(s.brdf[1]));
+  // Only green is poisoned: the 100 pixels keep their red and blue, green flagged as not measured
+  // (per-channel validity, issue 13) with a finite value and sigma 0.
+  EXPECT_EQ(result.summary.rejected.at("non_finite"), 0u);
+  size_t flagged = 0;
+  for (const BrdfSample& s : result.samples) {
+    for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(s.brdf[c]) && std::isfinite(s.sigma[c]));
+    if (s.valid[1] == 0) {
+      ++flagged;
+      EXPECT_EQ(s.sigma[1], 0.0f);
+      EXPECT_TRUE(s.valid[0] && s.valid[2]);
+    }
+  }
+  EXPECT_EQ(flagged, 100u);
 }
 
 TEST(Derender, SidecarHasUnitsCountsAndSession) {
