@@ -127,6 +127,7 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
   object.String("name", "");
   object.String("description", "");
   object.String("source", "");
+  object.String("colour_space", "");  // the values' colour space (fits state their samples'); informative
   const std::string model = object.String("model");
   std::unique_ptr<BrdfModel> brdf;
   if (model == "lambertian") {

@@ -17,7 +17,8 @@
 //               pure Lambertian is then representable; Schlick's term stays non-zero at grazing)
 //   merl:       "file": "x.binary"  a MERL table (core/merl_brdf.h), looked up as the MERL reader does
 //   rgl_bsdf:   "file": "x.bsdf"    an RGL tensor file (core/rgl_bsdf.h), evaluated as brdf-loader does
-// plus optional "name" and "description" strings.
+// plus optional "name", "description", "source" and "colour_space" strings (the last: the space the
+// values are in, e.g. "linear sRGB (D65) ..." or "camera RGB ..."; fits state their samples').
 #pragma once
 
 #include <cstdint>

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <limits>
 #include <random>
@@ -423,7 +424,7 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
   return result;
 }
 
-nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& name) {
+nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& name, const std::string& colour_space) {
   IBRDF_CHECK(fit.brdf != nullptr);
   nlohmann::json json = fit.brdf->ToJson();
   char description[256];
@@ -433,6 +434,7 @@ nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& nam
                 fit.model.c_str(), fit.samples_used, 100.0 * fit.rel_rms);
   json["name"] = name;
   json["description"] = description;
+  json["colour_space"] = colour_space.empty() ? "unknown (not stated with the samples)" : colour_space;
   return json;
 }
 
@@ -499,7 +501,96 @@ PlasticParameters PlasticFromGgx(const Eigen::Vector3d& diffuse_albedo, const Ei
   return p;
 }
 
-RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::string& name) {
+double ComplexFresnel(double cos_theta_i, double eta, double k) {
+  using Complex = std::complex<double>;
+  const double c = std::clamp(cos_theta_i, 0.0, 1.0);
+  const Complex n(eta, k);
+  const Complex sin2_t = (1.0 - c * c) / (n * n);
+  const Complex cos_t = std::sqrt(1.0 - sin2_t);
+  const Complex r_parl = (n * c - cos_t) / (n * c + cos_t);
+  const Complex r_perp = (c - n * cos_t) / (c + n * cos_t);
+  return 0.5 * (std::norm(r_parl) + std::norm(r_perp));
+}
+
+namespace {
+// The (eta, k) whose amount * ComplexFresnel is closest to `target` (sampled at theta_d 0, 1, ..., 70
+// degrees) in relative least squares: a log-spaced grid, then a pattern search in (log eta, k).
+std::pair<Eigen::Vector2d, double> FitConductorIor(const std::vector<double>& cosines,
+                                                   const std::vector<double>& target, double amount) {
+  const auto cost = [&](double log_eta, double k) {
+    if (k < 0.0) return std::numeric_limits<double>::infinity();
+    double sum = 0.0;
+    for (size_t j = 0; j < cosines.size(); ++j) {
+      const double r =
+          (amount * ComplexFresnel(cosines[j], std::exp(log_eta), k) - target[j]) / std::max(target[j], 1e-4);
+      sum += r * r;
+    }
+    return sum / double(cosines.size());
+  };
+  double best_log_eta = 0.0, best_k = 0.0, best = cost(0.0, 0.0);  // eta 1, k 0: no reflection
+  for (int i = 0; i < 60; ++i) {
+    const double log_eta = std::log(0.02) + (std::log(8.0) - std::log(0.02)) * i / 59.0;
+    for (int j = 0; j < 61; ++j) {
+      const double k = j == 0 ? 0.0 : 0.01 * std::pow(800.0, (j - 1) / 59.0);
+      const double value = cost(log_eta, k);
+      if (value < best) best = value, best_log_eta = log_eta, best_k = k;
+    }
+  }
+  for (double step = 0.05; step > 1e-6;) {
+    bool improved = false;
+    const double moves[4][2] = {{step, 0.0}, {-step, 0.0}, {0.0, step}, {0.0, -step}};
+    for (const auto& move : moves) {
+      const double value = cost(best_log_eta + move[0], best_k + move[1]);
+      if (value < best) best = value, best_log_eta += move[0], best_k += move[1], improved = true;
+    }
+    if (!improved) step *= 0.5;
+  }
+  return {Eigen::Vector2d(std::exp(best_log_eta), best_k), std::sqrt(best)};
+}
+}  // namespace
+
+PbrtMixParameters PbrtMixFromGgx(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& f0, double alpha,
+                                 bool dielectric) {
+  PbrtMixParameters p;
+  p.alpha = alpha;
+  p.amount = std::clamp(1.0 - diffuse_albedo.maxCoeff(), 0.0, 1.0);
+  if (p.amount < 1.0) p.reflectance = (diffuse_albedo / (1.0 - p.amount)).cwiseMin(1.0).cwiseMax(0.0);
+  std::vector<double> cosines;
+  for (int degrees = 0; degrees <= 70; ++degrees) cosines.push_back(std::cos(degrees * M_PI / 180.0));
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> target;
+    for (double cosine : cosines) {
+      target.push_back(dielectric ? DielectricFresnel(cosine, IorFromF0(f0[c]))
+                                  : f0[c] + (1.0 - f0[c]) * std::pow(1.0 - cosine, 5.0));
+    }
+    if (p.amount <= 0.0) {  // a diffuse albedo of 1: no room for the specular term
+      p.fresnel_rel_rms[c] = f0[c] > 0.0 ? 1.0 : 0.0;
+      continue;
+    }
+    const auto [ior, rms] = FitConductorIor(cosines, target, p.amount);
+    p.eta[c] = ior[0];
+    p.k[c] = ior[1];
+    p.fresnel_rel_rms[c] = rms;
+  }
+  return p;
+}
+
+namespace {
+// The snippet lines stating the values' colour space (the samples'), with a warning where a renderer
+// would misread them: renderers take "rgb" parameters as linear sRGB.
+std::vector<std::string> ColourSpaceLines(const std::string& colour_space) {
+  const std::string space = colour_space.empty() ? "unknown (not stated with the samples)" : colour_space;
+  std::vector<std::string> lines = {"Colour space of the values: " + space + "."};
+  if (space.rfind("linear sRGB", 0) != 0) {
+    lines.push_back("WARNING: not linear sRGB, but the renderer reads rgb values as linear sRGB: colours will be");
+    lines.push_back("off. Measure a colour chart with the session (ibrdf colour) to get linear sRGB samples.");
+  }
+  return lines;
+}
+}  // namespace
+
+RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::string& name,
+                                   const std::string& colour_space) {
   IBRDF_CHECK(ggx_fit.brdf != nullptr);
   const GgxParameters p = ReadGgx(*ggx_fit.brdf);
   RendererSnippets out;
@@ -510,6 +601,8 @@ RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::str
   char header[320];
   std::snprintf(header, sizeof(header), "GGX fit by ibrdf reconstruct (relative RMS %.2f %% against %zu samples)",
                 100.0 * ggx_fit.rel_rms, ggx_fit.samples_used);
+  std::string colour_xml;
+  for (const std::string& line : ColourSpaceLines(colour_space)) colour_xml += "<!-- " + line + " -->\n";
   if (metal) {
     out.kind = "conductor";
     // pbrt-v4's conductor with "reflectance" r uses eta = 1, k = 2 sqrt(r) / sqrt(1 - r): its Fresnel
@@ -518,15 +611,16 @@ RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::str
     Eigen::Vector3d k;
     for (int c = 0; c < 3; ++c) k[c] = 2.0 * std::sqrt(r[c]) / std::sqrt(1.0 - r[c]);
     pbrt << "# pbrt-v4: " << header << ".\n# A conductor keeping the fitted colour (F0 = reflectance); the fitted"
-         << " diffuse albedo\n# (" << Rgb(p.diffuse, " ") << ") is left out.\n"
-         << "MakeNamedMaterial \"" << name << "\"\n"
+         << " diffuse albedo\n# (" << Rgb(p.diffuse, " ") << ") is left out.\n";
+    for (const std::string& line : ColourSpaceLines(colour_space)) pbrt << "# " << line << "\n";
+    pbrt << "MakeNamedMaterial \"" << name << "\"\n"
          << "    \"string type\" \"conductor\"\n"
          << "    \"rgb reflectance\" [ " << Rgb(r, " ") << " ]\n"
          << "    \"float roughness\" " << p.alpha << "\n"
          << "    \"bool remaproughness\" false\n";
     mitsuba << "<!-- Mitsuba 3: " << header << ". A rough conductor keeping the fitted colour:\n"
             << "     eta = 1 and k = 2 sqrt(F0) / sqrt(1 - F0) give Fresnel F0 at normal incidence. -->\n"
-            << "<bsdf type=\"roughconductor\" id=\"" << name << "\">\n"
+            << colour_xml << "<bsdf type=\"roughconductor\" id=\"" << name << "\">\n"
             << "    <string name=\"distribution\" value=\"ggx\"/>\n"
             << "    <float name=\"alpha\" value=\"" << p.alpha << "\"/>\n"
             << "    <rgb name=\"eta\" value=\"1, 1, 1\"/>\n"
@@ -535,18 +629,35 @@ RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::str
   } else {
     out.kind = "plastic";
     const PlasticParameters plastic = PlasticFromGgx(p.diffuse, p.f0, p.alpha);
-    pbrt << "# pbrt-v4: " << header << ".\n# A coated diffuse: the base albedo is the fitted diffuse ("
-         << Rgb(p.diffuse, " ") << ")\n# inverted for the coating's transmission (roughplastic's closed form),"
-         << " one IOR from the mean F0.\n"
-         << "MakeNamedMaterial \"" << name << "\"\n"
-         << "    \"string type\" \"coateddiffuse\"\n"
-         << "    \"rgb reflectance\" [ " << Rgb(plastic.base_albedo, " ") << " ]\n"
+    const PbrtMixParameters mix = PbrtMixFromGgx(p.diffuse, p.f0, p.alpha, p.fresnel == "dielectric");
+    char amount[32], fresnel_rms[160];
+    std::snprintf(amount, sizeof(amount), "%.6g", mix.amount);
+    std::snprintf(fresnel_rms, sizeof(fresnel_rms), "%.1f %%, %.1f %%, %.1f %%", 100.0 * mix.fresnel_rel_rms[0],
+                  100.0 * mix.fresnel_rel_rms[1], 100.0 * mix.fresnel_rel_rms[2]);
+    pbrt << "# pbrt-v4: " << header << ".\n"
+         << "# A mix: pbrt-v4 picks \"" << name << "-specular\" with probability amount at each shading point,\n"
+         << "# so the rendered BRDF is (1 - amount) diffuse + amount conductor, the fitted\n"
+         << "# diffuse (" << Rgb(p.diffuse, " ") << ") / pi plus its GGX specular term (alpha " << p.alpha << ", "
+         << (p.fresnel == "dielectric" ? "dielectric" : "Schlick") << " Fresnel of F0 " << Rgb(p.f0, " ") << ").\n"
+         << "# The conductor's eta + i k make amount x Fresnel the fitted Fresnel over 0 to 70 degrees\n"
+         << "# (relative RMS " << fresnel_rms << " for R, G, B); its Fresnel rises to 1 at grazing.\n";
+    for (const std::string& line : ColourSpaceLines(colour_space)) pbrt << "# " << line << "\n";
+    pbrt << "MakeNamedMaterial \"" << name << "-diffuse\"\n"
+         << "    \"string type\" \"diffuse\"\n"
+         << "    \"rgb reflectance\" [ " << Rgb(mix.reflectance, " ") << " ]\n"
+         << "MakeNamedMaterial \"" << name << "-specular\"\n"
+         << "    \"string type\" \"conductor\"\n"
+         << "    \"rgb eta\" [ " << Rgb(mix.eta, " ") << " ]\n"
+         << "    \"rgb k\" [ " << Rgb(mix.k, " ") << " ]\n"
          << "    \"float roughness\" " << p.alpha << "\n"
          << "    \"bool remaproughness\" false\n"
-         << "    \"float eta\" " << plastic.eta << "\n";
+         << "MakeNamedMaterial \"" << name << "\"\n"
+         << "    \"string type\" \"mix\"\n"
+         << "    \"string materials\" [ \"" << name << "-diffuse\" \"" << name << "-specular\" ]\n"
+         << "    \"float amount\" " << amount << "\n";
     mitsuba << "<!-- Mitsuba 3: " << header << ". A rough plastic: the diffuse reflectance is the fitted\n"
             << "     diffuse (" << Rgb(p.diffuse, " ") << ") inverted for the coating, one IOR from the mean F0. -->\n"
-            << "<bsdf type=\"roughplastic\" id=\"" << name << "\">\n"
+            << colour_xml << "<bsdf type=\"roughplastic\" id=\"" << name << "\">\n"
             << "    <string name=\"distribution\" value=\"ggx\"/>\n"
             << "    <float name=\"alpha\" value=\"" << p.alpha << "\"/>\n"
             << "    <float name=\"int_ior\" value=\"" << plastic.eta << "\"/>\n"

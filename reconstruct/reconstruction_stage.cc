@@ -251,13 +251,15 @@ std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, con
                                      const std::string& name, const std::string& tmp, ReconstructResult* result,
                                      nlohmann::json* timings) {
   Timer timer;
+  const nlohmann::json& space = result->summary["colour_space"];
+  const std::string colour_space = space.is_string() ? space.get<std::string>() : space.is_null() ? "" : space.dump();
   ModelFitResult lafortune = FitLafortune(samples, options);
   Log(1, lafortune.BriefReport());
-  WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, name + "-lafortune"));
+  WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, name + "-lafortune", colour_space));
   ModelFitResult ggx = FitGgx(samples, options);
   Log(1, ggx.BriefReport());
-  WriteJsonFile(tmp + "/ggx.json", FitMaterialJson(ggx, name + "-ggx"));
-  const RendererSnippets snippets = RendererMaterials(ggx, name);
+  WriteJsonFile(tmp + "/ggx.json", FitMaterialJson(ggx, name + "-ggx", colour_space));
+  const RendererSnippets snippets = RendererMaterials(ggx, name, colour_space);
   WriteText(tmp + "/" + snippets.pbrt_file, snippets.pbrt);
   WriteText(tmp + "/" + snippets.mitsuba_file, snippets.mitsuba);
   (*timings)["fits_s"] = timer.ElapsedSeconds();
