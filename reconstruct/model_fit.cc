@@ -384,28 +384,28 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
       if (std::isfinite(s.sigma[c])) minimum[c] = std::min(minimum[c], s.value[c]);
     }
   }
-  // Three alpha starts for each of the two Fresnel variants, all six solves in parallel. The
-  // dielectric variant's second block is s = sqrt(F0) (GgxResidual).
+  // Three alpha starts for each of the two Fresnel variants, all six solves in parallel (ranked on a
+  // subset, like the Lafortune starts). The dielectric variant's second block is s = sqrt(F0)
+  // (GgxResidual).
   const double alpha_starts[3] = {0.05, 0.2, 0.5};
   constexpr int kStarts = 3, kVariants = 2;
   std::array<std::array<double, 7>, kStarts * kVariants> solutions;
   std::array<double, kStarts * kVariants> costs;
-  tbb::parallel_for(0, kStarts * kVariants, [&](int job) {
-    const int start = job % kStarts;
-    const bool dielectric = job / kStarts == 0;
-    double* diffuse = solutions[job].data();
-    double* f0 = diffuse + 3;
-    double* alpha = diffuse + 6;
-    alpha[0] = alpha_starts[start];
-    for (int c = 0; c < 3; ++c) {
-      diffuse[c] = std::max(0.0, 0.8 * M_PI * minimum[c]);
-      f0[c] = dielectric ? 0.2 : 0.04;  // sqrt(0.04) for the dielectric
-    }
-    ceres::Problem problem;
-    for (const FitSample& s : picked) {
+  // One variant's solve from `p` over `fitted` (indices into `picked`); a `ranking` solve (a start on
+  // the subset, as the Lafortune fit's) stops at options.start_tolerance.
+  const auto solve = [&](bool dielectric, const std::vector<size_t>& fitted, double* p, bool ranking) {
+    double* diffuse = p;
+    double* f0 = p + 3;
+    double* alpha = p + 6;
+    ceres::Problem::Options problem_options;
+    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::HuberLoss huber(options.huber_scale);
+    ceres::Problem problem(problem_options);
+    for (size_t i : fitted) {
+      const FitSample& s = picked[i];
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<GgxResidual, 3, 3, 3, 1>(
                                    new GgxResidual(s.wi, s.wo, s.value, s.sigma, dielectric)),
-                               new ceres::HuberLoss(options.huber_scale), diffuse, f0, alpha);
+                               &huber, diffuse, f0, alpha);
     }
     for (int c = 0; c < 3; ++c) {
       problem.SetParameterLowerBound(diffuse, c, 0.0);
@@ -415,19 +415,52 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
     problem.SetParameterLowerBound(alpha, 0, 0.002);
     problem.SetParameterUpperBound(alpha, 0, 1.0);
     ceres::Solver::Summary summary;
-    ceres::Solve(SolverOptions(options), &problem, &summary);
-    costs[job] = summary.final_cost;
+    ceres::Solver::Options solver = SolverOptions(options);
+    if (ranking) solver.function_tolerance = solver.parameter_tolerance = options.start_tolerance;
+    ceres::Solve(solver, &problem, &summary);
+    return summary.final_cost;
+  };
+  std::vector<size_t> all(picked.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  std::vector<size_t> subset = all;
+  const bool two_phase = options.start_samples > 0 && options.start_samples < picked.size();
+  if (two_phase) {
+    std::mt19937_64 rng(options.seed + 2);
+    std::shuffle(subset.begin(), subset.end(), rng);
+    subset.resize(options.start_samples);
+    result.start_samples = subset.size();
+  }
+  tbb::parallel_for(0, kStarts * kVariants, [&](int job) {
+    const int start = job % kStarts;
+    const bool dielectric = job / kStarts == 0;
+    double* p = solutions[job].data();
+    p[6] = alpha_starts[start];
+    for (int c = 0; c < 3; ++c) {
+      p[c] = std::max(0.0, 0.8 * M_PI * minimum[c]);
+      p[3 + c] = dielectric ? 0.2 : 0.04;  // sqrt(0.04) for the dielectric
+    }
+    costs[job] = solve(dielectric, subset, p, two_phase);
   });
   result.starts = kStarts * kVariants;
-  // The best start of each variant, then the variant with the lower relative RMS.
+  // The best start of each variant (refined on all samples after a ranking on the subset), then the
+  // variant with the lower relative RMS.
+  std::array<int, kVariants> winners;
+  for (int variant = 0; variant < kVariants; ++variant) {
+    winners[variant] = variant * kStarts;
+    for (int job = winners[variant] + 1; job < (variant + 1) * kStarts; ++job) {
+      if (costs[job] < costs[winners[variant]]) winners[variant] = job;
+    }
+  }
+  if (two_phase) {
+    tbb::parallel_for(0, kVariants, [&](int variant) {
+      costs[winners[variant]] = solve(variant == 0, all, solutions[winners[variant]].data(), false);
+    });
+  }
   std::unique_ptr<BrdfModel> best_model;
   int best_job = -1;
   double best_rms = std::numeric_limits<double>::infinity();
   for (int variant = 0; variant < kVariants; ++variant) {
-    int chosen = variant * kStarts;
-    for (int job = chosen + 1; job < (variant + 1) * kStarts; ++job) {
-      if (costs[job] < costs[chosen]) chosen = job;
-    }
+    const int chosen = winners[variant];
     const double* p = solutions[chosen].data();
     const bool dielectric = variant == 0;
     Eigen::Vector3d f0(p[3], p[4], p[5]);

@@ -26,8 +26,9 @@ struct ModelFitOptions {
   double absolute_floor = 1e-4;  // and at least this (1/sr)
   double huber_scale = 3.0;      // Huber loss threshold, in sigmas
   int max_iterations = 200;      // per Ceres solve
-  // Lafortune: the starting points are compared on a random subset of at most this many of the fitted
-  // samples (fixed seed); each channel's best is then refined on all of them (0: every start on all).
+  // The starting points are compared on a random subset of at most this many of the fitted samples
+  // (fixed seed); the best (Lafortune: per channel; GGX: per Fresnel variant) is then refined on all
+  // of them (0: every start solved on all).
   size_t start_samples = 4000;
   double start_tolerance = 1e-6;  // Ceres function and parameter tolerance of those solves (ranking only)
   double max_theta_deg = 80.0;    // samples beyond this theta_i or theta_e are left out
@@ -46,7 +47,7 @@ struct ModelFitResult {
   double final_cost = 0.0;   // Ceres cost, summed over the channel fits
   double rel_rms = 0.0;      // RMS of (f_fit - f) / f over the samples used and channels
   int starts = 0;            // initial guesses tried (the best is kept)
-  size_t start_samples = 0;  // Lafortune: the samples the starts were ranked on (0: all of them)
+  size_t start_samples = 0;  // the samples the starts were ranked on (0: all of them)
   // Parameters that ended at a bound of the fit ("n lobe 1 G at 2000"): reported, never silent.
   std::vector<std::string> at_bound;
   // The largest directional albedo over a dense grid of incidence directions on the whole hemisphere
