@@ -66,6 +66,11 @@ void AddReconstructCommand(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--lobes", o.fit.lafortune_lobes, "Lafortune lobes (1 to 3)")->capture_default_str();
   command->add_option("--fit-samples", o.fit.max_samples, "Samples used by the model fits")->capture_default_str();
+  command
+      ->add_option("--fit-start-samples", o.fit.start_samples,
+                   "The fits' starting points are ranked on this many of them, the best refined on all (0: every "
+                   "start on all)")
+      ->capture_default_str();
   command->add_flag("--no-fits", args->no_fits, "Skip the Lafortune and GGX fits");
   command->add_flag("--no-bsdf", args->no_bsdf,
                     "Skip NAME.bsdf (the RGL tensor file of Mitsuba 3's and pbrt-v4's measured material)");
@@ -116,7 +121,7 @@ void AddReconstructCommand(CLI::App& app) {
     }
     RequireValidOptions(options.selection, "--bandwidth-scales/--bandwidth-samples");
     RequireValidOptions(options.tabulate, "--max-theta-deg/--min-effective-samples");
-    RequireValidOptions(options.fit, "--lobes/--fit-samples");
+    RequireValidOptions(options.fit, "--lobes/--fit-samples/--fit-start-samples");
     if (options.eval_only && options.eval_file.empty()) ThrowError("--eval-only", "needs --eval POINTS.npy");
     ReconstructFile(args->samples, options, args->out);
   });
