@@ -651,7 +651,13 @@ namespace {
 // The snippet lines stating the values' colour space (the samples'), with a warning where a renderer
 // would misread them: renderers take "rgb" parameters as linear sRGB.
 std::vector<std::string> ColourSpaceLines(const std::string& colour_space) {
-  const std::string space = colour_space.empty() ? "unknown (not stated with the samples)" : colour_space;
+  std::string space = colour_space.empty() ? "unknown (not stated with the samples)" : colour_space;
+  for (char& c : space) {
+    if (c == '\n' || c == '\r') c = ' ';  // one comment line per line
+  }
+  for (size_t at = space.find("--"); at != std::string::npos; at = space.find("--", at)) {
+    space.replace(at, 2, "- -");  // "--" may not appear inside an XML comment
+  }
   std::vector<std::string> lines = {"Colour space of the values: " + space + "."};
   if (space.rfind("linear sRGB", 0) != 0) {
     lines.push_back("WARNING: not linear sRGB, but the renderer reads rgb values as linear sRGB: colours will be");

@@ -293,6 +293,11 @@ TEST(RendererSnippets, StateTheColourSpaceAndWarnWhenNotLinearSrgb) {
   const std::string srgb = "linear sRGB (D65): camera RGB through the colour chart's matrix (see \"colour\")";
   const std::string camera = "camera RGB, linear (the session's response inverted, black level subtracted)";
   const std::string xyz = "CIE XYZ (D65): camera RGB through the colour chart's matrix (see \"colour\")";
+  // A space from elsewhere with a line break and "--" keeps each snippet's comments well-formed.
+  const RendererSnippets odd = RendererMaterials(fit, "m", "camera RGB\n--raw");
+  EXPECT_NE(odd.pbrt.find("# Colour space of the values: camera RGB - -raw."), std::string::npos) << odd.pbrt;
+  EXPECT_NE(odd.mitsuba.find("<!-- Colour space of the values: camera RGB - -raw. -->"), std::string::npos)
+      << odd.mitsuba;
   for (const std::string& space : {srgb, camera, xyz, std::string()}) {
     for (bool metal : {false, true}) {
       if (metal) fit.brdf = std::make_unique<GgxBrdf>(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.95, 0.64, 0.54), 0.2);
