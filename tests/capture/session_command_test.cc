@@ -35,10 +35,12 @@ TEST(SessionCommand, ChartPhotosBecomeTheColourChartBlock) {
   for (size_t i = 0; i < truth.photos.size(); ++i) photos += " " + truth.PhotoPath(i);
   for (const Eigen::Vector2d& p : *chart.corners) corners += " " + std::to_string(p.x()) + " " + std::to_string(p.y());
   const std::string chart_photo = (fs::path(truth.directory) / chart.photos[0].file).string();
+  // The markers' layout (the photos would be posed by `ibrdf align`; the chart photo needs no pose).
+  ASSERT_EQ(RunIbrdf("targets --out " + scratch / "targets" + " --no-charuco --dpi 72").exit_code, 0);
   const std::string scene =
       " --light-position-m 1.2 0 0 --light-intensity 1 0.8 0.55 --sample-radius-m 0.04"
       " --sample-center-m 0 0 0 --camera " +
-      scratch / "s/session.json";
+      scratch / "s/session.json" + " --targets " + scratch / "targets/targets.json";
 
   const auto init = RunIbrdf("session init" + photos + " --out " + scratch / "init" + scene + " --chart-photos " +
                                  chart_photo + " --chart-corners" + corners,
