@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 #include <ceres/ceres.h>
@@ -83,6 +84,134 @@ double UnlitLimbEdge(const std::vector<double>& profile, double step) {
   return -1.0;
 }
 
+// S(z) = integral of phi(u) sqrt(max(z + u, 0)) du (phi the standard normal density): a square-root
+// profile seen through a Gaussian blur of unit sigma, tabulated once (z from -8 to 100 in steps of
+// 0.005; beyond, its expansion sqrt(z) (1 - 1 / (8 z^2))).
+double BlurredSqrt(double z) {
+  constexpr double kLow = -8.0, kHigh = 100.0, kStep = 0.005;
+  static const std::vector<double> table = [] {
+    std::vector<double> values(static_cast<size_t>((kHigh - kLow) / kStep) + 2);
+    for (size_t i = 0; i < values.size(); ++i) {
+      const double zi = kLow + kStep * i;
+      // Substituting w = sqrt(zi + u) removes the root's singularity: u = w^2 - zi, du = 2 w dw.
+      const double w_max = std::sqrt(std::max(zi + 9.0, 0.0));
+      constexpr int kNodes = 600;
+      double sum = 0.0;
+      for (int k = 0; k < kNodes; ++k) {
+        const double w = w_max * (k + 0.5) / kNodes;
+        const double u = w * w - zi;
+        sum += std::exp(-0.5 * u * u) * 2.0 * w * w;
+      }
+      values[i] = sum * w_max / kNodes / std::sqrt(2.0 * M_PI);
+    }
+    return values;
+  }();
+  if (z <= kLow) return 0.0;
+  if (z >= kHigh) return std::sqrt(z) * (1.0 - 1.0 / (8.0 * z * z));
+  const double u = (z - kLow) / kStep;
+  const size_t i = static_cast<size_t>(u);
+  return table[i] + (u - i) * (table[i + 1] - table[i]);
+}
+
+// The limb model along a profile, blurred: columns (edge level, square root, ramp, background) at
+// positions xs for the edge `edge` and the blur `sigma` (pixels), and the least-squares levels;
+// returns the residuals' sum of squares (and the residuals and levels when asked).
+double LimbModelResiduals(const std::vector<double>& xs, const std::vector<double>& ys, double edge, double sigma,
+                          Eigen::VectorXd* residuals, Eigen::Vector4d* levels) {
+  const int n = static_cast<int>(xs.size());
+  Eigen::MatrixXd design(n, 4);
+  const double root_sigma = std::sqrt(sigma);
+  for (int i = 0; i < n; ++i) {
+    const double z = (edge - xs[i]) / sigma;  // depth inside the contour, in blur sigmas
+    const double cdf = 0.5 * std::erfc(-z / std::sqrt(2.0));
+    const double pdf = std::exp(-0.5 * z * z) / std::sqrt(2.0 * M_PI);
+    design(i, 0) = cdf;
+    design(i, 1) = root_sigma * BlurredSqrt(z);
+    design(i, 2) = sigma * (z * cdf + pdf);
+    design(i, 3) = 1.0 - cdf;
+  }
+  const Eigen::Map<const Eigen::VectorXd> y(ys.data(), n);
+  const Eigen::Vector4d x = (design.transpose() * design).ldlt().solve(design.transpose() * y);
+  const Eigen::VectorXd r = y - design * x;
+  if (residuals) *residuals = r;
+  if (levels) *levels = x;
+  return x.allFinite() ? r.squaredNorm() : std::numeric_limits<double>::infinity();
+}
+
+// The limb's edge refined by its radiance profile (LimbEdgeOptions in sphere_fit.h): from the first
+// guess `edge` (pixels along the profile, outwards), the profile over [edge - inside_px, edge +
+// outside_px] is fitted by the limb I(d) = a + b sqrt(d) + c d at depth d inside the contour (the
+// shading of any smooth BRDF near a contour is a series in sqrt(d): the normal's component towards the
+// camera grows like sqrt(2 d / R)), the background as a level outside, both seen through a Gaussian
+// blur of fitted sigma (the lens, the pixel's footprint, the interpolation); the levels are linear, the
+// edge and the blur found by Gauss-Newton. Returns the edge in pixels along the profile, or -1 where
+// the model does not hold (a lit limb whose level at the contour is not positive: the terminator
+// crosses it; a blur beyond max_blur_px; no convergence; a move of more than max_shift_px).
+double RefineLimbEdge(const std::vector<double>& profile, double step, double edge, bool lit,
+                      const LimbEdgeOptions& options) {
+  const double length = step * (profile.size() - 1);
+  if (edge - options.inside_px < 0.0 || edge + options.outside_px > length) return -1.0;
+  std::vector<double> xs, ys;
+  for (size_t i = 0; i < profile.size(); ++i) {
+    const double x = step * i;
+    if (x >= edge - options.inside_px && x <= edge + options.outside_px) {
+      xs.push_back(x);
+      ys.push_back(profile[i]);
+    }
+  }
+  const double first_guess = edge;
+  double log_sigma = std::log(0.5);
+  double lambda = 1e-3;
+  Eigen::VectorXd r;
+  double cost = LimbModelResiduals(xs, ys, edge, std::exp(log_sigma), &r, nullptr);
+  if (!std::isfinite(cost)) return -1.0;
+  bool converged = false;
+  for (int iteration = 0; iteration < 50 && !converged; ++iteration) {
+    // Forward differences of the projected residuals in (edge, log sigma).
+    constexpr double kDelta = 1e-4;
+    Eigen::VectorXd r_edge, r_sigma;
+    LimbModelResiduals(xs, ys, edge + kDelta, std::exp(log_sigma), &r_edge, nullptr);
+    LimbModelResiduals(xs, ys, edge, std::exp(log_sigma + kDelta), &r_sigma, nullptr);
+    Eigen::MatrixXd jacobian(r.size(), 2);
+    jacobian.col(0) = (r_edge - r) / kDelta;
+    jacobian.col(1) = (r_sigma - r) / kDelta;
+    const Eigen::Matrix2d jtj = jacobian.transpose() * jacobian;
+    const Eigen::Vector2d jtr = jacobian.transpose() * r;
+    bool improved = false;
+    for (int attempt = 0; attempt < 10 && !improved; ++attempt) {
+      Eigen::Matrix2d damped = jtj;
+      damped.diagonal() *= 1.0 + lambda;
+      Eigen::Vector2d move = -damped.ldlt().solve(jtr);
+      if (!move.allFinite()) return -1.0;
+      move = move.cwiseMax(-0.5).cwiseMin(0.5);
+      const double trial_log_sigma = std::clamp(log_sigma + move[1], std::log(0.05), std::log(options.max_blur_px));
+      Eigen::VectorXd trial_r;
+      const double trial = LimbModelResiduals(xs, ys, edge + move[0], std::exp(trial_log_sigma), &trial_r, nullptr);
+      if (trial <= cost) {
+        converged = std::abs(move[0]) < 1e-5 && std::abs(trial_log_sigma - log_sigma) < 1e-4;
+        edge += move[0];
+        log_sigma = trial_log_sigma;
+        r = trial_r;
+        cost = trial;
+        lambda = std::max(lambda * 0.3, 1e-9);
+        improved = true;
+      } else {
+        lambda *= 10.0;
+      }
+    }
+    if (!improved) converged = true;  // no descent left: a minimum to the step's precision
+    if (std::abs(edge - first_guess) > options.max_shift_px) return -1.0;
+  }
+  if (!converged) return -1.0;
+  if (!(std::exp(log_sigma) < 0.99 * options.max_blur_px)) return -1.0;
+  Eigen::Vector4d levels;
+  LimbModelResiduals(xs, ys, edge, std::exp(log_sigma), nullptr, &levels);
+  // A lit limb whose level at the contour is not above zero: the terminator crosses the limb there (the
+  // shading's clamp is not in the model) and the contour has no contrast.
+  if (lit && !(levels[0] > 0.0)) return -1.0;
+  return edge;
+}
+
 // The unit vector from the closest point of `ray` to `center`: the derivative of the ray's distance to
 // the centre with respect to the centre (minus the limb's outward normal at the tangent point).
 Eigen::Vector3d TowardsCenter(const TangentRay& ray, const Eigen::Vector3d& center) {
@@ -155,6 +284,15 @@ bool SphereFitOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GT(tolerance, 0.0);
   IBRDF_CHECK_OPTION_GT(max_limb_balance, 0.0);
   IBRDF_CHECK_OPTION_GE(max_radius_amplification, 1.0);
+  return limb_edge.Check(why);
+}
+
+bool LimbEdgeOptions::Check(std::string* why) const {
+  IBRDF_CHECK_OPTION_GE(inside_px, 2.0);
+  IBRDF_CHECK_OPTION_GE(outside_px, 2.0);
+  IBRDF_CHECK_OPTION_GT(max_shift_px, 0.0);
+  IBRDF_CHECK_OPTION_GT(max_blur_px, 0.1);
+  IBRDF_CHECK_OPTION_GE(arc_px, 0.0);
   return true;
 }
 
@@ -176,27 +314,51 @@ std::string SphereFit::BriefReport() const {
 
 std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& camera,
                                               const Rigid3d& camera_from_world, const Eigen::Vector3d& center,
-                                              double radius, int lines, double band_px) {
+                                              double radius, int lines, double band_px, const LimbEdgeOptions& edge) {
   std::vector<Eigen::Vector2d> points;
   const Eigen::Vector3d c = camera_from_world * center;
   if (!(c.z() > radius)) return points;
   const Eigen::Vector2d center_px = camera.ImageFromCamera(c);
   const double radius_px = camera.FocalX() * radius / std::sqrt(c.squaredNorm() - radius * radius);
   const double step = 0.25;
+  // The first guess searches the band with 3 pixels each side for the levels; the refinement needs
+  // its fit window beyond the guess (which may lie up to 3 pixels beyond the band).
+  const double inner = edge.enabled ? edge.inside_px + 3.0 : 3.0;
+  const double outer = edge.enabled ? edge.outside_px + 3.0 : 3.0;
+  const int skip = static_cast<int>(std::round((inner - 3.0) / step));
+  const int arc_samples = edge.enabled ? static_cast<int>(std::round(edge.arc_px / 0.5)) : 0;
   for (int k = 0; k < lines; ++k) {
     const double angle = 2.0 * M_PI * k / lines;
     const Eigen::Vector2d direction(std::cos(angle), std::sin(angle));
-    // Search the band around the predicted silhouette, with room for the inside and outside levels.
-    const double s0 = radius_px - band_px - 3.0, s1 = radius_px + band_px + 3.0;
-    std::vector<double> profile;
-    for (double s = s0; s <= s1; s += step)
-      profile.push_back(BilinearLuminance(image, center_px.x() + s * direction.x(), center_px.y() + s * direction.y()));
+    const double s0 = radius_px - band_px - 3.0 - step * skip, s1 = radius_px + band_px + outer;
+    std::vector<double> profile(static_cast<size_t>(std::round((s1 - s0) / step)) + 1);
+    for (size_t i = 0; i < profile.size(); ++i) {
+      const double s = s0 + step * i;
+      double sum = 0.0;
+      for (int j = -arc_samples; j <= arc_samples; ++j) {
+        const double a = angle + 0.5 * j / std::max(s, 1.0);
+        sum += BilinearLuminance(image, center_px.x() + s * std::cos(a), center_px.y() + s * std::sin(a));
+      }
+      profile[i] = sum / (2 * arc_samples + 1);
+    }
     if (std::any_of(profile.begin(), profile.end(), [](double v) { return !std::isfinite(v); })) continue;
-    double edge = LitLimbEdge(profile, step);
-    if (edge < 0.0) edge = UnlitLimbEdge(profile, step);
-    if (edge < 0.0) continue;
-    edge += s0;
-    points.push_back(center_px + edge * direction);
+    // The first guess: the band with 3 pixels each side, as the threshold edge finds it.
+    const int count = static_cast<int>(std::round((2.0 * band_px + 6.0) / step)) + 1;
+    if (skip + count > static_cast<int>(profile.size())) continue;
+    const std::vector<double> band(profile.begin() + skip, profile.begin() + skip + count);
+    bool lit = true;
+    double guess = LitLimbEdge(band, step);
+    if (guess < 0.0) {
+      lit = false;
+      guess = UnlitLimbEdge(band, step);
+    }
+    if (guess < 0.0) continue;
+    double position = guess + step * skip;
+    if (edge.enabled) {
+      position = RefineLimbEdge(profile, step, position, lit, edge);
+      if (position < 0.0) continue;
+    }
+    points.push_back(center_px + (s0 + position) * direction);
   }
   return points;
 }
@@ -286,8 +448,8 @@ SphereFit FitSphereToSilhouettes(const Camera& camera, const std::vector<Silhoue
       const double radius_px =
           camera.FocalX() * fit.radius / std::sqrt(std::max(c.squaredNorm() - fit.radius * fit.radius, 1e-12));
       const double band = round == 0 ? bands_px[0] * radius_px : bands_px[round];
-      for (const Eigen::Vector2d& p :
-           SilhouettePoints(*photo.image, camera, pose, fit.center, fit.radius, options.silhouette_lines, band)) {
+      for (const Eigen::Vector2d& p : SilhouettePoints(*photo.image, camera, pose, fit.center, fit.radius,
+                                                       options.silhouette_lines, band, options.limb_edge)) {
         rays.push_back(RayThroughPixel(camera, pose, p));
       }
     }

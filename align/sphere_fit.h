@@ -24,6 +24,25 @@
 
 namespace ibrdf {
 
+// How a limb point is placed once a radial profile's threshold edge has found it (SilhouettePoints):
+// the profile around it is fitted by the limb's shading I(d) = a + b sqrt(d) + c d at depth d inside
+// the contour (near a contour the normal's component towards the camera grows like sqrt(d), so a lit
+// limb darkens steeply to its edge and a threshold sits inside it) and the background's level, both
+// seen through a Gaussian blur whose sigma is fitted with the edge (the lens, the pixel's footprint,
+// the interpolation): no renderer's or camera's convention is assumed.
+struct LimbEdgeOptions {
+  bool enabled = true;        // false: the threshold edge (the mid level of the steepest drop) alone
+  double inside_px = 8.0;     // the fit's reach inside the first guess, pixels
+  double outside_px = 5.0;    // and outside it
+  double max_shift_px = 1.5;  // a refined edge further from the first guess is dropped (no model)
+  double max_blur_px = 3.0;   // a fitted blur sigma reaching this is dropped (not an edge)
+  // Each profile sample is the mean of samples 0.5 px apart along the arc through it about the
+  // sphere's projected centre (parallel to the silhouette), this many pixels each side: it averages
+  // over the pixel grid's phase along the limb (0: the radial line alone).
+  double arc_px = 1.5;
+  bool Check(std::string* why) const;
+};
+
 // Options of FitSphereToSilhouettes and FitSphereToTangentRays (the defaults are the align stage's).
 struct SphereFitOptions {
   int silhouette_lines = 360;         // radial search lines per photo
@@ -43,6 +62,7 @@ struct SphereFitOptions {
   // the noise alone trades centre against radius.
   double max_limb_balance = 0.3;
   double max_radius_amplification = 3.0;
+  LimbEdgeOptions limb_edge;  // the limb point's model (above)
   bool Check(std::string* why) const;
 };
 
@@ -85,12 +105,14 @@ struct SphereFit {
 
 // Silhouette edge points of a sphere (centre `center`, radius `radius`, world frame) in one photo:
 // along `lines` radial lines from the sphere's projected centre, within `band_px` of its predicted
-// silhouette, the sharpest drop from a lit limb to the dark background, located at sub-pixel precision
-// where the profile crosses the mid level. Edges against anything bright (the platform) or on the unlit
-// side (no contrast) are skipped. Pixels, COLMAP convention.
+// silhouette, the sharpest drop from a lit limb to the dark background (or rise from an unlit limb to a
+// brighter one), found where the profile crosses the mid level and refined by the limb's profile
+// (LimbEdgeOptions). Edges against anything bright (the platform) or without contrast are skipped.
+// Pixels, COLMAP convention.
 std::vector<Eigen::Vector2d> SilhouettePoints(const Image& image, const Camera& camera,
                                               const Rigid3d& camera_from_world, const Eigen::Vector3d& center,
-                                              double radius, int lines, double band_px);
+                                              double radius, int lines, double band_px,
+                                              const LimbEdgeOptions& edge = LimbEdgeOptions());
 
 // The ray through pixel `p` of a camera at `camera_from_world`.
 TangentRay RayThroughPixel(const Camera& camera, const Rigid3d& camera_from_world, const Eigen::Vector2d& p);

@@ -29,6 +29,7 @@ void AddSessionCommand(CLI::App& app) {
     std::vector<double> light_position, light_intensity, sample_center;
     double sample_radius = 0.0, white_size = 0.0;
     std::vector<double> white_reflectance;
+    std::vector<double> chart_corners;
   };
   auto args = std::make_shared<Args>();
   SessionInitOptions& o = args->o;
@@ -44,6 +45,14 @@ void AddSessionCommand(CLI::App& app) {
   init->add_option("--white-reflectance", args->white_reflectance,
                    "The white reference's albedo R G B (default 0.99: Spectralon)")
       ->expected(3);
+  init->add_option("--chart-photos", o.chart_photos,
+                   "Photos of a ColorChecker Classic 24 under the session's light (one view; `ibrdf colour` fits the "
+                   "matrix to linear sRGB)")
+      ->check(CLI::ExistingFile);
+  init->add_option("--chart-corners", args->chart_corners,
+                   "Pixel centres X Y of the chart's patches 1, 6, 24 and 19 (top-left, top-right, bottom-right, "
+                   "bottom-left); without them `ibrdf colour` detects the chart (OpenCV mcc)")
+      ->expected(8);
   init->add_option("--targets", o.targets_file, "The markers' layout: targets.json from `ibrdf targets`")
       ->check(CLI::ExistingFile);
   init->add_option("--camera", o.camera_file, "A JSON file with a calibrated \"camera\" block (e.g. a session.json)")
@@ -81,6 +90,12 @@ void AddSessionCommand(CLI::App& app) {
     if (args->sample_radius > 0.0) options.sample_radius = args->sample_radius;
     if (args->white_size != 0.0) options.white_size = args->white_size;
     options.white_reflectance = Vector(args->white_reflectance);
+    if (args->chart_corners.size() == 8) {
+      std::array<Eigen::Vector2d, 4> corners;
+      for (int k = 0; k < 4; ++k)
+        corners[k] = Eigen::Vector2d(args->chart_corners[2 * k], args->chart_corners[2 * k + 1]);
+      options.chart_corners = corners;
+    }
     RequireValidOptions(options, "ibrdf session init");
     const SessionInitResult result = InitSession(options, args->out);
     for (const std::string& line : result.assumptions) std::cout << "assumed: " << line << "\n";

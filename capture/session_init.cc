@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/colour.h"
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/json_reader.h"
@@ -84,6 +85,9 @@ bool SessionInitOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION(!white_size || *white_size > 0.0);
   IBRDF_CHECK_OPTION(!white_reflectance ||
                      ((white_reflectance->array() > 0.0).all() && (white_reflectance->array() <= 1.0).all()));
+  IBRDF_CHECK_OPTION(!chart_corners || !chart_photos.empty());
+  IBRDF_CHECK_OPTION(!chart_corners || std::all_of(chart_corners->begin(), chart_corners->end(),
+                                                   [](const Eigen::Vector2d& p) { return p.allFinite(); }));
   return true;
 }
 
@@ -131,7 +135,7 @@ int GroupBrackets(const SessionInitOptions& options, std::vector<InitPhoto>* pho
   int direction = 0;  // +1 lengthening, -1 shortening exposures in the open bracket
   const InitPhoto* previous = nullptr;
   for (InitPhoto& photo : *photos) {
-    if (photo.target || photo.white) continue;
+    if (photo.target || photo.white || photo.chart) continue;
     bool join = false;
     if (previous && options.bracket_size > 1) {
       join = size < options.bracket_size;
@@ -175,15 +179,17 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
   if (!options.Check(&why)) ThrowError("session init options", why);
   SessionInitResult result;
   // Every photo's metadata.
-  for (int pass = 0; pass < 3; ++pass) {
+  for (int pass = 0; pass < 4; ++pass) {
     for (const std::string& file : pass == 0   ? options.photos
                                    : pass == 1 ? options.target_photos
-                                               : options.white_photos) {
+                                   : pass == 2 ? options.white_photos
+                                               : options.chart_photos) {
       InitPhoto photo;
       photo.file = file;
       photo.metadata = ReadPhotoMetadata(file);
       photo.target = pass == 1;
       photo.white = pass == 2;
+      photo.chart = pass == 3;
       result.photos.push_back(photo);
     }
   }
@@ -338,15 +344,32 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
       "black level 0 and no saturation level stated (integer photos clip at full scale, float photos never; "
       "camera RAW: the file's black and white levels are applied when decoding)");
   // Photos.
-  nlohmann::json photos = nlohmann::json::array(), white_photos = nlohmann::json::array();
+  nlohmann::json photos = nlohmann::json::array(), white_photos = nlohmann::json::array(),
+                 chart_photos = nlohmann::json::array();
   for (const InitPhoto& photo : result.photos) {
     nlohmann::json entry = {{"file", RelativeTo(photo.file, out_dir)}, {"exposure_s", *photo.metadata.exposure_s}};
     if (photo.gain != 1.0) entry["gain"] = photo.gain;
     if (photo.target) entry["role"] = "targets";
     if (photo.bracket >= 0) entry["bracket"] = photo.bracket;
-    (photo.white ? white_photos : photos).push_back(entry);
+    (photo.white ? white_photos : photo.chart ? chart_photos : photos).push_back(entry);
   }
   json["photos"] = photos;
+  // The colour chart: its photos (exposure and gain from EXIF like the others) and, when given, its
+  // corner patches; `ibrdf colour` fits the matrix (and detects the chart without corners).
+  if (!chart_photos.empty()) {
+    nlohmann::json chart = {{"chart", kColorCheckerClassic24},
+                            {"space", ColourSpaceName(ColourSpace::kLinearSrgb)},
+                            {"photos", chart_photos}};
+    if (options.chart_corners) {
+      for (const Eigen::Vector2d& p : *options.chart_corners) chart["corners"].push_back({p.x(), p.y()});
+    }
+    json["colour_chart"] = chart;
+    result.assumptions.push_back(
+        "colour chart: a ColorChecker Classic 24 under the session's light, corrected into linear sRGB; " +
+        std::string(options.chart_corners ? "located by the corner patches given"
+                                          : "no corner patches given, so `ibrdf colour` detects it (OpenCV mcc)") +
+        "; run `ibrdf colour` on the session to fit its matrix before `ibrdf derender`");
+  }
   // The white reference: posed by `ibrdf align` from the white card's markers, when the targets have them.
   if (!white_photos.empty()) {
     nlohmann::json white = {{"photos", white_photos}};

@@ -9,6 +9,7 @@
 // The capture library sits on core only: no OpenCV, Ceres or Embree in this light path.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,7 +31,13 @@ struct SessionInitOptions {
   std::vector<std::string> white_photos;
   std::optional<double> white_size;
   std::optional<Eigen::Vector3d> white_reflectance;
-  std::string name;                        // the session's name (empty: the output folder's name)
+  // Photos of a colour chart (the colour_chart block, a ColorChecker Classic 24 under the session's
+  // light; the exposures of one view): `ibrdf colour` then fits the matrix to linear sRGB. The chart's
+  // corner patches (pixel centres of patches 1, 6, 24 and 19: top-left, top-right, bottom-right,
+  // bottom-left) when given; absent, `ibrdf colour` detects the chart (OpenCV mcc).
+  std::vector<std::string> chart_photos;
+  std::optional<std::array<Eigen::Vector2d, 4>> chart_corners;
+  std::string name;  // the session's name (empty: the output folder's name)
   // The camera: a JSON file holding a "camera" block (a session.json, an aligned session, or the
   // block itself: {"model": "OPENCV", "width": .., "height": .., "params": [..]}). Empty: a pinhole
   // guess from EXIF (focal length x focal-plane resolution, or the 35 mm equivalent focal length, or
@@ -68,6 +75,7 @@ struct InitPhoto {
   PhotoMetadata metadata;
   bool target = false;  // role "targets"
   bool white = false;   // a white-reference photo
+  bool chart = false;   // a colour-chart photo
   int bracket = -1;     // bracket id, -1: none
   double gain = 1.0;    // ISO / base ISO
 };

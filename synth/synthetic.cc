@@ -734,7 +734,10 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
         SurfaceHit hit;
         return truth->Intersect(origin, direction, &hit) && hit.t < t;
       };
-      CompositeTargets(session.camera, *photo.camera_from_world, *target_scene, sample_in_front, mask, &image);
+      // Supersampled, a pixel on the sample's silhouette holds the sample's share of its area, so the
+      // platform adds the rest (its uncovered share); a pixel-centre render keeps the sample's pixels whole.
+      CompositeTargets(session.camera, *photo.camera_from_world, *target_scene, sample_in_front,
+                       effects.supersample > 1 ? std::vector<uint8_t>() : mask, &image);
     }
     ApplyVignetting(session.camera, effects.vignetting, &image);
     // The sensor (synthetic_radiometry.h): one random stream per (seed, photo, row).

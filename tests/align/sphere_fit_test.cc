@@ -1,10 +1,12 @@
 // The sphere fit (align/sphere_fit.h) on small exact inputs: exact tangent rays (and the rays through
 // exact silhouette pixels) give the sphere exactly, outliers are rejected in the last round, small
 // rendered images of a bright sphere on black give it to a fraction of a millimetre; too few
-// silhouette points leave the sphere as given, with the reason; bad options are an error.
+// silhouette points leave the sphere as given, with the reason; bad options are an error; the limb
+// model places the edge of a limb that darkens towards its contour where the threshold edge cannot.
 #include "align/sphere_fit.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include <gtest/gtest.h>
 
@@ -149,6 +151,71 @@ TEST(SphereFit, KnownSphereFromRenderedSilhouettes) {
   EXPECT_LT((fit.center - kCenter).norm(), 0.2e-3) << fit.BriefReport();
   EXPECT_NEAR(fit.radius, kRadius, 0.1e-3) << fit.BriefReport();
   EXPECT_GT(fit.silhouette_points, 2 * lines);
+}
+
+// A disk image of a lit limb whose level falls like the square root of the depth inside the contour
+// (a sphere's shading near its contour): `level` + `slope` sqrt(d) inside, 0.02 outside, each pixel the
+// mean of 8 x 8 points (a sensor's pixel), then a Gaussian blur of `blur` pixels (0: none).
+Image RenderLimbDisk(const Eigen::Vector2d& centre, double radius, double level, double slope, double blur) {
+  Image image(400, 400, 1);
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      double sum = 0.0;
+      for (int sy = 0; sy < 8; ++sy) {
+        for (int sx = 0; sx < 8; ++sx) {
+          const double d = radius - (Eigen::Vector2d(x + (sx + 0.5) / 8, y + (sy + 0.5) / 8) - centre).norm();
+          sum += d > 0.0 ? level + slope * std::sqrt(d) : 0.02;
+        }
+      }
+      image.at(x, y, 0) = static_cast<float>(sum / 64.0);
+    }
+  }
+  if (blur <= 0.0) return image;
+  Image blurred = image;
+  for (int y = 5; y + 5 < image.height; ++y) {
+    for (int x = 5; x + 5 < image.width; ++x) {
+      double sum = 0.0, weights = 0.0;
+      for (int dy = -4; dy <= 4; ++dy) {
+        for (int dx = -4; dx <= 4; ++dx) {
+          const double w = std::exp(-0.5 * (dx * dx + dy * dy) / (blur * blur));
+          sum += w * image.at(x + dx, y + dy, 0);
+          weights += w;
+        }
+      }
+      blurred.at(x, y, 0) = static_cast<float>(sum / weights);
+    }
+  }
+  return blurred;
+}
+
+// The lit limb's edge: where the level falls steeply towards the contour, the threshold edge sits
+// inside it (by 0.3 px and more); the limb model puts it on the contour, sharp or blurred.
+TEST(SphereFit, LimbModelFindsTheContourOfADarkeningLimb) {
+  const Camera camera = Camera::Create(CameraModelId::kPinhole, 400, 400, {1000, 1000, 200.3, 200.7});
+  const double distance = 1.0, radius = 0.055;
+  const double radius_px = 1000.0 * radius / std::sqrt(distance * distance - radius * radius);
+  const Eigen::Vector2d centre(200.3, 200.7);
+  const Rigid3d identity(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  LimbEdgeOptions threshold;
+  threshold.enabled = false;
+  for (const double blur : {0.0, 0.7, 1.2}) {
+    const Image image = RenderLimbDisk(centre, radius_px, 0.05, 0.4, blur);
+    for (const bool model : {false, true}) {
+      const std::vector<Eigen::Vector2d> points =
+          SilhouettePoints(image, camera, identity, Eigen::Vector3d(0.0, 0.0, distance), radius, 360, 1.5,
+                           model ? LimbEdgeOptions() : threshold);
+      ASSERT_GT(points.size(), 200u) << "blur " << blur << (model ? ", limb model" : ", threshold");
+      double inside = 0.0;
+      for (const Eigen::Vector2d& p : points) inside += (radius_px - (p - centre).norm()) / points.size();
+      std::printf("blur %.1f px, %s: %zu points, mean %.4f px inside the contour\n", blur,
+                  model ? "limb model" : "threshold", points.size(), inside);
+      if (model) {
+        EXPECT_LT(std::abs(inside), blur > 0.0 ? 0.03 : 0.1) << "blur " << blur;
+      } else {
+        EXPECT_GT(inside, 0.3) << "blur " << blur;  // the bias the model removes
+      }
+    }
+  }
 }
 
 // Degenerate: fewer rays than a sphere needs, or photos without a silhouette (all black): not
