@@ -10,6 +10,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include "core/brdf_coords.h"
 #include "core/brdf_model.h"
@@ -48,9 +49,10 @@ void LoadEvalPoints(const std::string& eval_file, StageInputs* inputs) {
   inputs->eval_theta_d.resize(shape[0]);
   for (size_t i = 0; i < shape[0]; ++i) {
     // Validated where read: a point outside the angles' ranges would be answered, wrongly.
-    if (!(points[3 * i] >= 0 && points[3 * i] <= M_PI / 2 && points[3 * i + 1] >= 0 &&
-          points[3 * i + 1] <= M_PI / 2 && std::abs(points[3 * i + 2]) <= M_PI)) {
-      ThrowError(eval_file, "row " + std::to_string(i) + ": expected theta_i, theta_e in [0, pi/2] and delta_phi in [-pi, pi]");
+    if (!(points[3 * i] >= 0 && points[3 * i] <= M_PI / 2 && points[3 * i + 1] >= 0 && points[3 * i + 1] <= M_PI / 2 &&
+          std::abs(points[3 * i + 2]) <= M_PI)) {
+      ThrowError(eval_file,
+                 "row " + std::to_string(i) + ": expected theta_i, theta_e in [0, pi/2] and delta_phi in [-pi, pi]");
     }
     inputs->eval_wi[i] = FromSpherical(points[3 * i], 0.0);
     inputs->eval_wo[i] = FromSpherical(points[3 * i + 1], points[3 * i + 2]);
@@ -136,11 +138,10 @@ void EvaluatePoints(const LocalRegression& regression, const StageInputs& inputs
   Log(1, "evaluated " + std::to_string(n) + " points: " + domain.Brief() + "; " + counts.Brief());
 }
 
-// The MERL table, its .npy forms, domain.npy and the table's sidecar brdf.json, scored against the
-// truth when there is one.
-void TabulateAndScore(const LocalRegression& regression, const ReconstructOptions& options, const BrdfModel* truth,
-                      const BrdfModel* fill_model, const std::string& tmp, ReconstructResult* result,
-                      nlohmann::json* timings, MerlTable* table_out, std::vector<uint8_t>* domain_out) {
+// The MERL table, its .npy forms, domain.npy and the table's sidecar brdf.json.
+void Tabulate(const LocalRegression& regression, const ReconstructOptions& options, const BrdfModel* fill_model,
+              const std::string& tmp, ReconstructResult* result, nlohmann::json* timings, MerlTable* table_out,
+              std::vector<uint8_t>* domain_out) {
   nlohmann::json& summary = result->summary;
   TabulateSummary tabulated;
   std::vector<float> ess;
@@ -196,22 +197,31 @@ void TabulateAndScore(const LocalRegression& regression, const ReconstructOption
   result->cells_interpolated = tabulated.domain.interpolated;
   result->cells_unmeasured = tabulated.domain.unmeasured;
   result->cells_filled = tabulated.domain.filled;
-  if (!truth) return;
-  // Scored over the valid cells (measured or interpolated), the measured ones alone, and every cell
-  // holding a value (filled ones included).
+}
+
+// The table scored against the truth over the valid cells (measured or interpolated), the measured ones
+// alone and every cell holding a value (filled ones included), and random MERL lookups; into `summary`
+// (its own object: this runs beside the .bsdf export) and `result`'s score.
+void Score(const MerlTable& table, const std::vector<uint8_t>& domain, const BrdfModel& truth,
+           const ReconstructOptions& options, nlohmann::json* summary, ReconstructResult* result) {
   std::vector<uint8_t> measured_only(domain.size());
   for (size_t i = 0; i < domain.size(); ++i) measured_only[i] = domain[i] == uint8_t(DomainClass::kMeasured);
-  const ReconstructionError error = CompareTableWithTruth(table, *truth, 80.0, &domain);
-  summary["error_against_truth"] = ToJson(error);
-  summary["error_against_truth"]["truth"] = options.truth_file;
-  summary["error_against_truth"]["domain"] = "theta_i, theta_e <= 80 deg; cells measured or interpolated (domain.npy)";
+  MerlLookupCheck lookups;
+  std::vector<ReconstructionError> errors;
+  tbb::task_group group;
+  group.run([&] { lookups = CheckMerlLookups(table, truth); });
+  errors = CompareTableWithTruth(table, truth, 80.0, {&domain, &measured_only, nullptr});
+  group.wait();
+  const ReconstructionError& error = errors[0];
+  (*summary)["error_against_truth"] = ToJson(error);
+  (*summary)["error_against_truth"]["truth"] = options.truth_file;
+  (*summary)["error_against_truth"]["domain"] =
+      "theta_i, theta_e <= 80 deg; cells measured or interpolated (domain.npy)";
   Log(1, "against the truth (theta <= 80, measured and interpolated cells): " + error.Brief());
-  summary["error_against_truth_measured"] = ToJson(CompareTableWithTruth(table, *truth, 80.0, &measured_only));
-  const ReconstructionError all = CompareTableWithTruth(table, *truth, 80.0);
-  summary["error_against_truth_all_tabulated"] = ToJson(all);
-  Log(1, "against the truth (theta <= 80, every cell holding a value): " + all.Brief());
-  const MerlLookupCheck lookups = CheckMerlLookups(table, *truth);
-  summary["merl_lookups_against_truth"] = ToJson(lookups);
+  (*summary)["error_against_truth_measured"] = ToJson(errors[1]);
+  (*summary)["error_against_truth_all_tabulated"] = ToJson(errors[2]);
+  Log(1, "against the truth (theta <= 80, every cell holding a value): " + errors[2].Brief());
+  (*summary)["merl_lookups_against_truth"] = ToJson(lookups);
   Log(1, lookups.Brief());
   result->scored = true;
   result->error_against_truth = error;
@@ -251,12 +261,18 @@ std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, con
                                      const std::string& name, const std::string& tmp, ReconstructResult* result,
                                      nlohmann::json* timings) {
   Timer timer;
-  ModelFitResult lafortune = FitLafortune(samples, options);
-  Log(1, lafortune.BriefReport());
-  WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, name + "-lafortune"));
-  ModelFitResult ggx = FitGgx(samples, options);
+  // The two fits side by side (each runs its starts in parallel too).
+  ModelFitResult lafortune, ggx;
+  tbb::task_group group;
+  group.run([&] {
+    lafortune = FitLafortune(samples, options);
+    Log(1, lafortune.BriefReport());
+    WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, name + "-lafortune"));
+  });
+  ggx = FitGgx(samples, options);
   Log(1, ggx.BriefReport());
   WriteJsonFile(tmp + "/ggx.json", FitMaterialJson(ggx, name + "-ggx"));
+  group.wait();
   const RendererSnippets snippets = RendererMaterials(ggx, name);
   WriteText(tmp + "/" + snippets.pbrt_file, snippets.pbrt);
   WriteText(tmp + "/" + snippets.mitsuba_file, snippets.mitsuba);
@@ -477,23 +493,66 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
   timings["build_s"] = timer.ElapsedSeconds();
   result.samples_used = regression.size();
   result.points = regression.points();
+  // The fits run beside the evaluation and tabulation (both TBB-parallel: the two share the cores),
+  // unless --fill model needs the chosen fit first. They write into their own result and timings,
+  // merged after.
   std::unique_ptr<BrdfModel> chosen;
-  if (options.fits && !options.eval_only) {
-    chosen = FitModels(samples, options.fit, MaterialName(options, samples_file), tmp, &result, &timings);
+  ReconstructResult fitted;
+  nlohmann::json fit_timings;
+  const bool fits = options.fits && !options.eval_only;
+  const bool fill_with_model = options.tabulate.fill == FillMode::kModel;
+  const std::string name = MaterialName(options, samples_file);
+  auto fit = [&] { chosen = FitModels(samples, options.fit, name, tmp, &fitted, &fit_timings); };
+  tbb::task_group fitting;
+  if (fits && fill_with_model) fit();
+  if (fits && !fill_with_model) fitting.run(fit);
+  MerlTable table;
+  std::vector<uint8_t> domain;
+  try {
+    const BrdfModel* fill_model = fill_with_model ? chosen.get() : nullptr;
+    if (!inputs.eval_wi.empty()) {
+      EvaluatePoints(regression, inputs, options, fill_model, tmp, &result.summary, &timings);
+      result.eval_points = inputs.eval_wi.size();
+    }
+    result.summary["regression"] = RegressionJson(options, result.regression, regression);
+    if (!options.eval_only) Tabulate(regression, options, fill_model, tmp, &result, &timings, &table, &domain);
+  } catch (...) {
+    fitting.wait();  // rethrows a fit's error, if any; otherwise the tabulation's below
+    throw;
   }
-  const BrdfModel* fill_model = options.tabulate.fill == FillMode::kModel ? chosen.get() : nullptr;
-  if (!inputs.eval_wi.empty()) {
-    EvaluatePoints(regression, inputs, options, fill_model, tmp, &result.summary, &timings);
-    result.eval_points = inputs.eval_wi.size();
+  fitting.wait();
+  if (fitted.fitted) {
+    result.summary["fits"] = fitted.summary["fits"];
+    result.fitted = true;
+    result.lafortune_rel_rms = fitted.lafortune_rel_rms;
+    result.ggx_rel_rms = fitted.ggx_rel_rms;
+    result.chosen_model = fitted.chosen_model;
+    timings["fits_s"] = fit_timings["fits_s"];
   }
-  result.summary["regression"] = RegressionJson(options, result.regression, regression);
   if (!options.eval_only) {
-    MerlTable table;
-    std::vector<uint8_t> domain;
-    TabulateAndScore(regression, options, inputs.truth.get(), fill_model, tmp, &result, &timings, &table, &domain);
-    if (options.bsdf) {
-      ExportBsdf(regression, options, chosen.get(), table, domain, MaterialName(options, samples_file), samples_file,
-                 tmp, &result, &timings);
+    // The score against the truth beside the .bsdf export (its own summary object, merged after).
+    nlohmann::json score;
+    tbb::task_group scoring;
+    if (inputs.truth) {
+      scoring.run([&] {
+        const Timer score_timer;
+        Score(table, domain, *inputs.truth, options, &score, &result);
+        score["score_s"] = score_timer.ElapsedSeconds();
+      });
+    }
+    try {
+      if (options.bsdf) {
+        ExportBsdf(regression, options, chosen.get(), table, domain, name, samples_file, tmp, &result, &timings);
+      }
+    } catch (...) {
+      scoring.wait();
+      throw;
+    }
+    scoring.wait();
+    if (inputs.truth) {
+      timings["score_s"] = score["score_s"];
+      score.erase("score_s");
+      for (auto& [key, value] : score.items()) result.summary[key] = value;
     }
   }
   result.total_s = total.ElapsedSeconds();
