@@ -5,9 +5,9 @@
 #include <cstdio>
 #include <random>
 
-#include <nlohmann/json.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "core/statistics.h"
