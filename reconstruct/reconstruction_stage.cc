@@ -138,16 +138,22 @@ void EvaluatePoints(const LocalRegression& regression, const StageInputs& inputs
   Log(1, "evaluated " + std::to_string(n) + " points: " + domain.Brief() + "; " + counts.Brief());
 }
 
-// The MERL table, its .npy forms, domain.npy and the table's sidecar brdf.json.
+// What WriteTable writes besides the table and its domain.
+struct TableFiles {
+  std::vector<float> effective_samples;  // per cell
+  nlohmann::json sidecar;                // brdf.json
+};
+
+// The MERL table and its domain (into `table_out`, `domain_out`), its summary and its sidecar
+// (`files`, written by WriteTable).
 void Tabulate(const LocalRegression& regression, const ReconstructOptions& options, const BrdfModel* fill_model,
-              const std::string& tmp, ReconstructResult* result, nlohmann::json* timings, MerlTable* table_out,
-              std::vector<uint8_t>* domain_out) {
+              ReconstructResult* result, nlohmann::json* timings, MerlTable* table_out,
+              std::vector<uint8_t>* domain_out, TableFiles* files) {
   nlohmann::json& summary = result->summary;
   TabulateSummary tabulated;
-  std::vector<float> ess;
+  std::vector<float>& ess = files->effective_samples;
   std::vector<uint8_t>& domain = *domain_out;
   *table_out = TabulateMerl(regression, options.tabulate, &tabulated, &ess, &domain, fill_model);
-  const MerlTable& table = *table_out;
   (*timings)["tabulate_s"] = tabulated.seconds;
   Log(1, "regression: " + std::to_string(regression.size()) + " samples in " + std::to_string(regression.points()) +
              " points, " + tabulated.reliability.Brief());
@@ -159,11 +165,6 @@ void Tabulate(const LocalRegression& regression, const ReconstructOptions& optio
                     : std::to_string(tabulated.domain.filled) + " of them filled by --fill " +
                           FillModeName(options.tabulate.fill) + ": invented values, recorded in brdf.json"));
   }
-  Timer timer;
-  WriteMerl(tmp + "/brdf.binary", table);
-  WriteNpyArray(tmp + "/brdf.npy", MerlToArray(table), {90, 90, 180, 3});
-  WriteNpyArray(tmp + "/effective_samples.npy", ess, {90, 90, 180});
-  WriteBytes(tmp + "/domain.npy", domain, {90, 90, 180});
   nlohmann::json table_json = {{"cells_measured", tabulated.domain.measured},
                                {"cells_interpolated", tabulated.domain.interpolated},
                                {"cells_unmeasured", tabulated.domain.unmeasured},
@@ -177,19 +178,18 @@ void Tabulate(const LocalRegression& regression, const ReconstructOptions& optio
                                  {"max_centroid_offset_kernel_radii", options.tabulate.domain.max_centroid_offset},
                                  {"theta_d_margin_deg", options.tabulate.domain.theta_d_margin_deg}}}};
   if (!tabulated.fill_model.empty()) table_json["fill_model"] = tabulated.fill_model;
-  WriteJsonFile(tmp + "/brdf.json",
-                {{"format", "ibrdf-merl-table"},
-                 {"version", 1},
-                 {"files", {"brdf.binary", "brdf.npy", "domain.npy", "effective_samples.npy"}},
-                 {"domain_classes", {{"0", "unmeasured"}, {"1", "interpolated"}, {"2", "measured"}}},
-                 {"unmeasured_value", options.tabulate.fill == FillMode::kNone
-                                          ? "-1 (MERL's no data)"
-                                          : std::string("filled by ") + FillModeName(options.tabulate.fill) +
-                                                " where possible (domain.npy 0 with a value >= 0: invented), else -1"},
-                 {"table", table_json},
-                 {"colour_space", summary.value("colour_space", nlohmann::json())},
-                 {"colour", summary.value("colour", nlohmann::json())}});
-  (*timings)["write_s"] = timer.ElapsedSeconds();
+  files->sidecar = {
+      {"format", "ibrdf-merl-table"},
+      {"version", 1},
+      {"files", {"brdf.binary", "brdf.npy", "domain.npy", "effective_samples.npy"}},
+      {"domain_classes", {{"0", "unmeasured"}, {"1", "interpolated"}, {"2", "measured"}}},
+      {"unmeasured_value", options.tabulate.fill == FillMode::kNone
+                               ? "-1 (MERL's no data)"
+                               : std::string("filled by ") + FillModeName(options.tabulate.fill) +
+                                     " where possible (domain.npy 0 with a value >= 0: invented), else -1"},
+      {"table", table_json},
+      {"colour_space", summary.value("colour_space", nlohmann::json())},
+      {"colour", summary.value("colour", nlohmann::json())}};
   summary["regression"]["reliability"] = ToJson(tabulated.reliability);
   summary["table"] = table_json;
   result->tabulated = true;
@@ -197,6 +197,18 @@ void Tabulate(const LocalRegression& regression, const ReconstructOptions& optio
   result->cells_interpolated = tabulated.domain.interpolated;
   result->cells_unmeasured = tabulated.domain.unmeasured;
   result->cells_filled = tabulated.domain.filled;
+}
+
+// brdf.binary, brdf.npy, effective_samples.npy, domain.npy and brdf.json into `tmp`; returns the seconds.
+double WriteTable(const MerlTable& table, const std::vector<uint8_t>& domain, const TableFiles& files,
+                  const std::string& tmp) {
+  const Timer timer;
+  WriteMerl(tmp + "/brdf.binary", table);
+  WriteNpyArray(tmp + "/brdf.npy", MerlToArray(table), {90, 90, 180, 3});
+  WriteNpyArray(tmp + "/effective_samples.npy", files.effective_samples, {90, 90, 180});
+  WriteBytes(tmp + "/domain.npy", domain, {90, 90, 180});
+  WriteJsonFile(tmp + "/brdf.json", files.sidecar);
+  return timer.ElapsedSeconds();
 }
 
 // The table scored against the truth over the valid cells (measured or interpolated), the measured ones
@@ -371,22 +383,33 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
     if (domain[flat] == uint8_t(DomainClass::kMeasured)) cells.push_back(flat);
   }
   const size_t stride = std::max<size_t>(1, cells.size() / 200000);
+  // Each checked cell's band (-1: beyond 80 degrees) and relative errors (-1: no positive table value),
+  // TBB-parallel; gathered in cell order after.
+  const size_t checked = (cells.size() + stride - 1) / stride;
+  std::vector<int8_t> cell_band(checked, -1);
+  std::vector<Eigen::Vector3d> cell_errors(checked);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, checked, 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t m = range.begin(); m != range.end(); ++m) {
+      const size_t flat = cells[m * stride];
+      const int i_h = int(flat / (size_t(kMerlThetaD) * kMerlPhiD)), i_d = int(flat / kMerlPhiD % kMerlThetaD),
+                i_p = int(flat % kMerlPhiD);
+      Eigen::Vector3d wi, wo;
+      FromHalfDiff(MerlCellCentre(i_h, i_d, i_p), &wi, &wo);
+      const double theta_max = std::acos(std::min(wi.z(), wo.z())) * 180 / M_PI;
+      if (theta_max > 80.0) continue;
+      const Eigen::Vector3d t = table.Cell(flat), g = written.Eval(wi, wo);
+      cell_band[m] = static_cast<int8_t>(theta_max < 25.0 ? 0 : theta_max < 50.0 ? 1 : 2);
+      for (int c = 0; c < 3; ++c) cell_errors[m][c] = t[c] > 0.0 ? std::abs(g[c] - t[c]) / t[c] : -1.0;
+    }
+  });
   std::vector<double> errors;
   std::vector<std::vector<double>> band_errors(3);  // theta_max 0-25, 25-50, 50-80 degrees
-  for (size_t n = 0; n < cells.size(); n += stride) {
-    const size_t flat = cells[n];
-    const int i_h = int(flat / (size_t(kMerlThetaD) * kMerlPhiD)), i_d = int(flat / kMerlPhiD % kMerlThetaD),
-              i_p = int(flat % kMerlPhiD);
-    Eigen::Vector3d wi, wo;
-    FromHalfDiff(MerlCellCentre(i_h, i_d, i_p), &wi, &wo);
-    const double theta_max = std::acos(std::min(wi.z(), wo.z())) * 180 / M_PI;
-    if (theta_max > 80.0) continue;
-    const Eigen::Vector3d t = table.Cell(flat), g = written.Eval(wi, wo);
-    const int band = theta_max < 25.0 ? 0 : theta_max < 50.0 ? 1 : 2;
+  for (size_t m = 0; m < checked; ++m) {
+    if (cell_band[m] < 0) continue;
     for (int c = 0; c < 3; ++c) {
-      if (!(t[c] > 0.0)) continue;
-      errors.push_back(std::abs(g[c] - t[c]) / t[c]);
-      band_errors[band].push_back(errors.back());
+      if (cell_errors[m][c] < 0.0) continue;
+      errors.push_back(cell_errors[m][c]);
+      band_errors[cell_band[m]].push_back(errors.back());
     }
   }
   auto quantile = [](std::vector<double> v, double q) {
@@ -508,6 +531,7 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
   if (fits && !fill_with_model) fitting.run(fit);
   MerlTable table;
   std::vector<uint8_t> domain;
+  TableFiles table_files;
   try {
     const BrdfModel* fill_model = fill_with_model ? chosen.get() : nullptr;
     if (!inputs.eval_wi.empty()) {
@@ -515,7 +539,9 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
       result.eval_points = inputs.eval_wi.size();
     }
     result.summary["regression"] = RegressionJson(options, result.regression, regression);
-    if (!options.eval_only) Tabulate(regression, options, fill_model, tmp, &result, &timings, &table, &domain);
+    if (!options.eval_only) {
+      Tabulate(regression, options, fill_model, &result, &timings, &table, &domain, &table_files);
+    }
   } catch (...) {
     fitting.wait();  // rethrows a fit's error, if any; otherwise the tabulation's below
     throw;
@@ -530,9 +556,12 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
     timings["fits_s"] = fit_timings["fits_s"];
   }
   if (!options.eval_only) {
-    // The score against the truth beside the .bsdf export (its own summary object, merged after).
+    // The table's files and the score against the truth beside the .bsdf export (the score into its own
+    // summary object, merged after).
     nlohmann::json score;
     tbb::task_group scoring;
+    double write_s = 0.0;
+    scoring.run([&] { write_s = WriteTable(table, domain, table_files, tmp); });
     if (inputs.truth) {
       scoring.run([&] {
         const Timer score_timer;
@@ -549,6 +578,7 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
       throw;
     }
     scoring.wait();
+    timings["write_s"] = write_s;
     if (inputs.truth) {
       timings["score_s"] = score["score_s"];
       score.erase("score_s");
