@@ -56,10 +56,12 @@ struct Mirror {
 // Degree 1 and 0 use leading blocks of the same matrices, because the basis is nested: 1, x, y, z, x^2,
 // y^2, z^2, xy, xz, yz. A point is a bin of `count` samples at its centroid with their mean
 // value: it adds count * w to the weights and count * w^2 to the squared weights, as that many samples
-// at one place would. Only the upper triangle of the normal matrix is accumulated. The estimate's
-// variance g' A2 g (A2 the normal matrix with squared weights) is not accumulated as a matrix: each
-// point's count * w^2 and basis row are kept (`rows`, a per-thread buffer) and Variance(g) sums
-// count * w^2 (basis . g)^2 over them, 11 multiply-adds a point instead of 55 (docs/decisions.md,
+// at one place would. The search keeps each point's weights, basis row and mean value (`rows`, a
+// per-thread buffer); Accumulate() then sums the upper triangle of the normal matrix and the right-hand
+// sides row by row with the sums in registers (each element summed over the points in the order the
+// search found them, as adding them point by point did: the same bits). The estimate's variance
+// g' A2 g (A2 the normal matrix with squared weights) is not accumulated as a matrix: Variance(g) sums
+// count * w^2 (basis . g)^2 over the rows, 11 multiply-adds a point instead of 55 (docs/decisions.md,
 // "Reconstruct speed").
 struct NormalEquations {
   const Point* cloud = nullptr;
@@ -76,11 +78,17 @@ struct NormalEquations {
   Mirror mirror{1, 1};
   float radius = 1.0f;  // of the support in scaled units (the growth factor)
   float radius_squared = 1.0f;
+  // Only count the samples with non-zero weight and sum their weights (sum_w, count, points), and stop
+  // the search once count >= enough_count with a positive sum: whether a support suffices.
+  bool count_only = false;
+  uint32_t enough_count = 0;
 
-  double a[kMaxCoefficients][kMaxCoefficients] = {};  // upper triangle (j >= i) only
-  double b[kMaxCoefficients][3] = {};
-  // Per point with non-zero weight: count * w^2, then its basis row (kRowSize doubles a point).
-  static constexpr int kRowSize = kMaxCoefficients + 1;
+  double a[kMaxCoefficients][kMaxCoefficients] = {};  // upper triangle (j >= i) only; by Accumulate()
+  double b[kMaxCoefficients][3] = {};                 // by Accumulate()
+  // Per point with non-zero weight: count * w^2, count * w, its basis row and its mean value (kRowSize
+  // doubles a point).
+  static constexpr int kSquaredWeight = 0, kWeight = 1, kBasis = 2, kMean = kBasis + kMaxCoefficients;
+  static constexpr int kRowSize = kMean + 3;
   std::vector<double>* rows = nullptr;
   size_t rows_used = 0;  // doubles of `rows` in use
   double sum_w = 0.0, sum_w2 = 0.0;
@@ -128,6 +136,12 @@ struct NormalEquations {
     const double t = 1.0 - r * r * r;
     const double w = t * t * t;
     if (!(w > 0.0)) return true;
+    if (count_only) {
+      sum_w += n * w;
+      count += static_cast<uint32_t>(n);
+      ++points;
+      return !(count >= enough_count && sum_w > 0.0);  // false stops the search: the support suffices
+    }
     const double dx = ox, dy = oy, dz = oz;
     const double basis[kMaxCoefficients] = {1.0, dx, dy, dz, dx * dx, dy * dy, dz * dz, dx * dy, dx * dz, dy * dz};
     for (int c = 0; c < 3; ++c) {
@@ -135,18 +149,13 @@ struct NormalEquations {
       high[c] = points == 0 ? point.high[c] : std::max(high[c], point.high[c]);
     }
     const double nw = n * w, nw2 = nw * w;
-    for (int i = 0; i < kMaxCoefficients; ++i) {
-      const double wb = nw * basis[i];
-      for (int j = i; j < kMaxCoefficients; ++j) a[i][j] += wb * basis[j];
-      b[i][0] += wb * mean[0];
-      b[i][1] += wb * mean[1];
-      b[i][2] += wb * mean[2];
-    }
     if (rows_used + kRowSize > rows->size()) rows->resize(std::max<size_t>(2 * rows->size(), 64 * kRowSize));
     double* row = rows->data() + rows_used;
     rows_used += kRowSize;
-    row[0] = nw2;
-    std::copy(std::begin(basis), std::end(basis), row + 1);
+    row[kSquaredWeight] = nw2;
+    row[kWeight] = nw;
+    std::copy(std::begin(basis), std::end(basis), row + kBasis);
+    for (int c = 0; c < 3; ++c) row[kMean + c] = mean[c];
     if (static_cast<int64_t>(index) == self) {
       for (int i = 0; i < kMaxCoefficients; ++i) self_basis[i] += w * basis[i];
     }
@@ -157,14 +166,41 @@ struct NormalEquations {
     ++points;
     return true;
   }
+  // Row I of `a` (j >= I) and of `b` from the kept rows.
+  template <int I>
+  void AccumulateRow() {
+    constexpr int kColumns = kMaxCoefficients - I;
+    double sum[kColumns] = {}, rhs[3] = {};
+    for (size_t p = 0; p < rows_used; p += kRowSize) {
+      const double* row = rows->data() + p;
+      const double wb = row[kWeight] * row[kBasis + I];
+      for (int j = 0; j < kColumns; ++j) sum[j] += wb * row[kBasis + I + j];
+      for (int c = 0; c < 3; ++c) rhs[c] += wb * row[kMean + c];
+    }
+    for (int j = 0; j < kColumns; ++j) a[I][I + j] = sum[j];
+    for (int c = 0; c < 3; ++c) b[I][c] = rhs[c];
+  }
+  // The normal equations (a, b) of the points the last full search found.
+  void Accumulate() {
+    AccumulateRow<0>();
+    AccumulateRow<1>();
+    AccumulateRow<2>();
+    AccumulateRow<3>();
+    AccumulateRow<4>();
+    AccumulateRow<5>();
+    AccumulateRow<6>();
+    AccumulateRow<7>();
+    AccumulateRow<8>();
+    AccumulateRow<9>();
+  }
   // g' A2 g for the leading m coefficients g (A2: the normal matrix with squared weights).
   double Variance(const double* g, int m) const {
     double variance = 0.0;
     for (size_t p = 0; p < rows_used; p += kRowSize) {
       const double* row = rows->data() + p;
       double t = 0.0;
-      for (int i = 0; i < m; ++i) t += row[1 + i] * g[i];
-      variance += row[0] * t * t;
+      for (int i = 0; i < m; ++i) t += row[kBasis + i] * g[i];
+      variance += row[kSquaredWeight] * t * t;
     }
     return variance;
   }
@@ -547,9 +583,12 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
   }
   if (self >= 0 && size_t(self) < size()) eq.self = impl.sample_point[size_t(self)];
   const nanoflann::SearchParams params(32, 0.0f, false);
-  float growth = 1.0f;
-  for (;;) {
+  eq.enough_count = static_cast<uint32_t>(std::max(options_.min_neighbors, 0));
+  // One pass over the support of radius `growth` (every mirror image); false when a count-only pass
+  // stopped early because the support suffices.
+  auto search = [&](float growth, bool count_only) {
     eq.Reset();
+    eq.count_only = count_only;
     eq.radius = growth;
     eq.radius_squared = growth * growth;
     for (const Mirror& m : impl.mirrors) {
@@ -560,11 +599,25 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
       eq.query[2] = z;
       eq.mirror = m;
       impl.tree->findNeighbors(eq, eq.query, params);
+      if (count_only && eq.count >= eq.enough_count && eq.sum_w > 0.0) return;
     }
-    if (int(eq.count) >= options_.min_neighbors && eq.sum_w > 0.0) break;
-    if (growth >= options_.max_growth) break;
+  };
+  // The given radius is accumulated at once (most evaluations end there). A grown support is first
+  // only counted (the search stops as soon as it suffices) and accumulated once, at the radius that
+  // suffices or the largest: the same equations as accumulating at every step, at a fraction of the
+  // cost where the support has to grow far.
+  float growth = 1.0f;
+  search(growth, false);
+  for (;;) {
+    const bool enough = int(eq.count) >= options_.min_neighbors && eq.sum_w > 0.0;
+    if (enough || growth >= options_.max_growth) {
+      if (eq.count_only && eq.sum_w > 0.0) search(growth, false);
+      break;
+    }
     growth = std::min<float>(growth * 1.5f, float(options_.max_growth));
+    search(growth, true);
   }
+  eq.Accumulate();
   if (!(eq.sum_w > 0.0)) return estimate;  // unsupported: value 0, degree -1
 
   estimate.neighbors = eq.count;
