@@ -325,8 +325,22 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
       theta_d[i] = angles.theta_d;
       uvw[i] = RegressionCoordinates(angles);
     }
-    ReliabilityCounts counts;
-    const std::vector<Estimate> estimates = regression.EvaluateMany(uvw, &counts);
+    // A node beyond the samples' theta_d range is unmeasured whatever its estimate; with a fit to fill
+    // it the estimate is not needed, so it is not computed (as in the tabulation): such nodes (near
+    // retro-reflection, at grazing angles) are the regression's most expensive, its support grown.
+    const double margin = options.tabulate.domain.theta_d_margin_deg * M_PI / 180.0;
+    std::vector<size_t> evaluated;
+    std::vector<Eigen::Vector3d> evaluated_uvw;
+    for (size_t i = 0; i < n; ++i) {
+      const bool beyond =
+          theta_d[i] < regression.theta_d_min() - margin || theta_d[i] > regression.theta_d_max() + margin;
+      if (beyond && chosen) continue;
+      evaluated.push_back(i);
+      evaluated_uvw.push_back(uvw[i]);
+    }
+    const std::vector<Estimate> some = regression.EvaluateMany(evaluated_uvw, nullptr);
+    std::vector<Estimate> estimates(n);  // default: unsupported, so unmeasured
+    for (size_t k = 0; k < evaluated.size(); ++k) estimates[evaluated[k]] = some[k];
     f->assign(n, Eigen::Vector3d::Zero());
     for (size_t i = 0; i < n; ++i) {
       const Estimate& e = estimates[i];
