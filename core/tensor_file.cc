@@ -2,7 +2,6 @@
 
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <sstream>
 
 #include "core/error.h"
@@ -12,14 +11,6 @@ namespace ibrdf {
 namespace {
 
 constexpr char kMagic[12] = "tensor_file";  // with its terminating zero: 12 bytes
-
-template <typename T>
-bool ReadValue(const std::vector<char>& bytes, size_t* pos, T* value) {
-  if (*pos + sizeof(T) > bytes.size()) return false;
-  std::memcpy(value, bytes.data() + *pos, sizeof(T));
-  *pos += sizeof(T);
-  return true;
-}
 
 template <typename T>
 void AppendValue(std::vector<char>* out, T value) {
@@ -101,36 +92,50 @@ TensorField BytesField(const std::vector<uint8_t>& bytes) {
 TensorField TextField(const std::string& text) { return BytesField(std::vector<uint8_t>(text.begin(), text.end())); }
 
 TensorFile ReadTensorFile(const std::string& path) {
+  // The header is parsed from the stream and each field's data read straight into the field (no copy
+  // of the whole file in memory).
   std::ifstream in(path, std::ios::binary);
   if (!in) ThrowError(path, "cannot open the tensor file");
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  size_t pos = 0;
+  in.seekg(0, std::ios::end);
+  const std::streamoff end = in.tellg();
+  if (end < 0) ThrowError(path, "cannot read the tensor file's size");
+  const size_t size = static_cast<size_t>(end);
+  in.seekg(0);
+  size_t pos = 0, stream_pos = 0;  // where the next read starts; where the stream stands
+  // Reads `count` bytes at `pos` (advancing it); false when they run past the end of the file.
+  auto read = [&](void* out, size_t count) {
+    if (pos + count > size) return false;
+    if (stream_pos != pos) in.seekg(std::streamoff(pos));
+    in.read(static_cast<char*>(out), std::streamsize(count));
+    if (!in) ThrowError(path, "read failed at byte " + std::to_string(pos));
+    pos += count;
+    stream_pos = pos;
+    return true;
+  };
+  auto value = [&](auto* v) { return read(v, sizeof(*v)); };
   char magic[12];
   uint8_t version[2];
   uint32_t n_fields = 0;
-  if (bytes.size() < 18) ThrowError(path, "not a tensor file: " + std::to_string(bytes.size()) + " bytes (truncated?)");
-  std::memcpy(magic, bytes.data(), 12);
-  pos = 12;
+  if (size < 18) ThrowError(path, "not a tensor file: " + std::to_string(size) + " bytes (truncated?)");
+  read(magic, 12);
   if (std::memcmp(magic, kMagic, 12) != 0) ThrowError(path, "not a tensor file: the header is not \"tensor_file\"");
-  ReadValue(bytes, &pos, &version[0]);
-  ReadValue(bytes, &pos, &version[1]);
+  value(&version[0]);
+  value(&version[1]);
   if (version[0] != 1 || version[1] != 0) {
     ThrowError(path, "tensor file version " + std::to_string(version[0]) + "." + std::to_string(version[1]) +
                          " (expected 1.0)");
   }
-  ReadValue(bytes, &pos, &n_fields);
+  value(&n_fields);
   TensorFile file;
   for (uint32_t i = 0; i < n_fields; ++i) {
     const std::string where = path + ": field " + std::to_string(i);
     uint16_t name_length = 0, rank = 0;
     uint8_t dtype = 0;
     uint64_t offset = 0;
-    if (!ReadValue(bytes, &pos, &name_length) || pos + name_length > bytes.size()) {
-      ThrowError(where, "truncated field header");
-    }
-    const std::string name(bytes.data() + pos, name_length);
-    pos += name_length;
-    if (!ReadValue(bytes, &pos, &rank) || !ReadValue(bytes, &pos, &dtype) || !ReadValue(bytes, &pos, &offset)) {
+    if (!value(&name_length) || pos + name_length > size) ThrowError(where, "truncated field header");
+    std::string name(name_length, '\0');
+    read(name.data(), name_length);
+    if (!value(&rank) || !value(&dtype) || !value(&offset)) {
       ThrowError(where + " \"" + name + "\"", "truncated field header");
     }
     TensorField field;
@@ -142,19 +147,25 @@ TensorFile ReadTensorFile(const std::string& path) {
     // Overflow-safe size: every dimension and the product stay within the file's size.
     uint64_t total = TensorTypeSize(field.dtype);
     for (uint16_t d = 0; d < rank; ++d) {
-      if (!ReadValue(bytes, &pos, &field.shape[d])) ThrowError(where + " \"" + name + "\"", "truncated shape");
-      if (field.shape[d] != 0 && total > bytes.size() / field.shape[d])
-        total = bytes.size() + 1;
+      if (!value(&field.shape[d])) ThrowError(where + " \"" + name + "\"", "truncated shape");
+      if (field.shape[d] != 0 && total > size / field.shape[d])
+        total = size + 1;
       else
         total *= field.shape[d];
     }
-    if (offset > bytes.size() || total > bytes.size() - offset) {
+    if (offset > size || total > size - offset) {
       ThrowError(where + " \"" + name + "\"", field.Describe() + " at offset " + std::to_string(offset) +
-                                                  " runs past the end of the file (" + std::to_string(bytes.size()) +
+                                                  " runs past the end of the file (" + std::to_string(size) +
                                                   " bytes; truncated?)");
     }
-    field.data.assign(bytes.begin() + std::ptrdiff_t(offset), bytes.begin() + std::ptrdiff_t(offset + total));
-    if (!file.emplace(name, std::move(field)).second) ThrowError(where, "duplicate field \"" + name + "\"");
+    if (file.count(name)) ThrowError(where, "duplicate field \"" + name + "\"");
+    // The data in place; the header continues after the shape.
+    const size_t header_pos = pos;
+    field.data.resize(size_t(total));
+    pos = size_t(offset);
+    read(field.data.data(), size_t(total));
+    pos = header_pos;
+    file.emplace(name, std::move(field));
   }
   return file;
 }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <tbb/parallel_for.h>
+
 #include "core/error.h"
 #include "core/logging.h"
 #include "core/piecewise_linear_2d.h"
@@ -93,13 +95,13 @@ TensorFile BuildRglBsdf(const BrdfBatch& brdf, const std::string& description, c
     for (int b = 0; b < n_p; ++b) m_dirs.push_back(weight * Direction(theta, (b + 0.5) / n_p * 2 * kPi - kPi));
   }
   std::vector<float> sigma(2 * size_t(n_ndf));
-  for (int j = 0; j < n_ndf; ++j) {
+  tbb::parallel_for(0, n_ndf, [&](int j) {
     const double u = double(j) / (n_ndf - 1);
     const Eigen::Vector3d wi = Direction(u * u * kPi / 2, 0.0);
     double s = 0.0;
     for (const Eigen::Vector3d& m : m_dirs) s += std::max(0.0, wi.dot(m));
     sigma[j] = sigma[n_ndf + j] = float(s);
-  }
+  });
   const PiecewiseLinear2D ndf_table(static_cast<uint32_t>(n_ndf), 2, ndf.data(), {}, false, false);
   const PiecewiseLinear2D sigma_table(static_cast<uint32_t>(n_ndf), 2, sigma.data(), {}, false, false);
 
@@ -108,7 +110,7 @@ TensorFile BuildRglBsdf(const BrdfBatch& brdf, const std::string& description, c
   for (int k = 0; k < n_theta; ++k) theta_i[k] = float(double(k) / (n_theta - 1) * options.max_theta_i_deg * kPi / 180);
   const std::vector<float> phi_i = {0.0f};
   std::vector<float> vndf(size_t(n_theta) * n_vndf * n_vndf);
-  for (int k = 0; k < n_theta; ++k) {
+  tbb::parallel_for(0, n_theta, [&](int k) {
     const Eigen::Vector3d wi = Direction(theta_i[k], 0.0);
     for (int y = 0; y < n_vndf; ++y) {
       const double phi = (2.0 * y / (n_vndf - 1) - 1.0) * kPi;
@@ -120,16 +122,21 @@ TensorFile BuildRglBsdf(const BrdfBatch& brdf, const std::string& description, c
             float(dm * std::max(0.0, wi.dot(Direction(theta, phi))) * 2 * kPi * kPi * u * std::sin(theta));
       }
     }
-  }
+  });
   const PiecewiseLinear2D vndf_warp(static_cast<uint32_t>(n_vndf), static_cast<uint32_t>(n_vndf), vndf.data(),
                                     {phi_i, theta_i});
 
-  // The rgb nodes: the half vector each node of the square maps to, its mirror direction, the BRDF.
+  // The rgb nodes: the half vector each node of the square maps to, its mirror direction, the BRDF
+  // (per incidence angle in parallel, then joined in order).
   const size_t slice = size_t(n_rgb) * n_rgb;
-  std::vector<Eigen::Vector3d> wi_list, wo_list, f_list;
-  std::vector<size_t> node_of;  // flat (k, node) index of each evaluation
+  struct Nodes {
+    std::vector<Eigen::Vector3d> wi, wo;
+    std::vector<size_t> node_of;  // flat (k, node) index of each evaluation
+  };
+  std::vector<Nodes> per_theta(n_theta);
   std::vector<double> scale(size_t(n_theta) * slice, 0.0);
-  for (int k = 0; k < n_theta; ++k) {
+  tbb::parallel_for(0, n_theta, [&](int k) {
+    Nodes& nodes = per_theta[k];
     const float params[2] = {0.0f, theta_i[k]};
     const Eigen::Vector3d wi = Direction(theta_i[k], 0.0);
     const double four_sigma = 4.0 * sigma_table.Eval(Eigen::Vector2f(std::sqrt(theta_i[k] * float(2 / kPi)), 0.5f));
@@ -143,11 +150,18 @@ TensorFile BuildRglBsdf(const BrdfBatch& brdf, const std::string& description, c
         if (wo.z() <= 0.0) continue;
         const double ndf_m = ndf_table.Eval(u_m);
         scale[size_t(k) * slice + size_t(y) * n_rgb + x] = wo.z() * four_sigma / ndf_m;
-        wi_list.push_back(wi);
-        wo_list.push_back(wo.normalized());
-        node_of.push_back(size_t(k) * slice + size_t(y) * n_rgb + x);
+        nodes.wi.push_back(wi);
+        nodes.wo.push_back(wo.normalized());
+        nodes.node_of.push_back(size_t(k) * slice + size_t(y) * n_rgb + x);
       }
     }
+  });
+  std::vector<Eigen::Vector3d> wi_list, wo_list, f_list;
+  std::vector<size_t> node_of;
+  for (const Nodes& nodes : per_theta) {
+    wi_list.insert(wi_list.end(), nodes.wi.begin(), nodes.wi.end());
+    wo_list.insert(wo_list.end(), nodes.wo.begin(), nodes.wo.end());
+    node_of.insert(node_of.end(), nodes.node_of.begin(), nodes.node_of.end());
   }
   brdf(wi_list, wo_list, &f_list);
   evaluations += wi_list.size();

@@ -24,11 +24,21 @@ constexpr double kDegree = M_PI / 180.0;
 constexpr int kMaxCoefficients = 10;
 constexpr int kCoefficients[3] = {1, 4, 10};
 
-// The point cloud as nanoflann wants it: scaled canonical coordinates, 3 floats a point.
+// One point of the regression (a bin of samples, or one sample without binning), packed into one cache
+// line: the kd-tree's distance test and the normal equations read the same 64 bytes.
+struct alignas(64) Point {
+  float xyz[3];    // centroid, scaled canonical coordinates
+  float value[3];  // mean value (log f in log space)
+  float low[3];    // range of its samples' values
+  float high[3];
+  uint32_t count;  // samples
+};
+
+// The point cloud as nanoflann wants it.
 struct Cloud {
-  std::vector<float> xyz;
-  size_t kdtree_get_point_count() const { return xyz.size() / 3; }
-  float kdtree_get_pt(size_t index, size_t dim) const { return xyz[3 * index + dim]; }
+  std::vector<Point> points;
+  size_t kdtree_get_point_count() const { return points.size(); }
+  float kdtree_get_pt(size_t index, size_t dim) const { return points[index].xyz[dim]; }
   template <class Box>
   bool kdtree_get_bbox(Box&) const {
     return false;
@@ -42,16 +52,19 @@ struct Mirror {
   float su, sv;
 };
 
-// Accumulates the weighted normal equations of a degree-2 fit directly from the kd-tree's radius search
-// (no neighbour list is stored). Degree 1 and 0 use leading blocks of the same matrices, because the
-// basis is nested: 1, x, y, z, x^2, y^2, z^2, xy, xz, yz. A point is a bin of `counts[index]` samples
-// at its centroid with their mean value: it adds count * w to the weights and count * w^2 to the
-// squared weights, as that many samples at one place would.
+// Accumulates the weighted normal equations of a degree-2 fit directly from the kd-tree's radius search.
+// Degree 1 and 0 use leading blocks of the same matrices, because the basis is nested: 1, x, y, z, x^2,
+// y^2, z^2, xy, xz, yz. A point is a bin of `count` samples at its centroid with their mean
+// value: it adds count * w to the weights and count * w^2 to the squared weights, as that many samples
+// at one place would. The search keeps each point's weights, basis row and mean value (`rows`, a
+// per-thread buffer); Accumulate() then sums the upper triangle of the normal matrix and the right-hand
+// sides row by row with the sums in registers (each element summed over the points in the order the
+// search found them, as adding them point by point did: the same bits). The estimate's variance
+// g' A2 g (A2 the normal matrix with squared weights) is not accumulated as a matrix: Variance(g) sums
+// count * w^2 (basis . g)^2 over the rows, 11 multiply-adds a point instead of 55 (docs/decisions.md,
+// "Reconstruct speed").
 struct NormalEquations {
-  const float* xyz = nullptr;
-  const float* values = nullptr;     // mean value of each point
-  const float* ranges = nullptr;     // low[3], high[3] of each point's samples
-  const uint32_t* counts = nullptr;  // samples of each point
+  const Point* cloud = nullptr;
   // Leave-one-out: the point holding the left-out sample, and that sample's position and value, which
   // are taken out of the point's statistics.
   int64_t exclude = -1;
@@ -65,10 +78,19 @@ struct NormalEquations {
   Mirror mirror{1, 1};
   float radius = 1.0f;  // of the support in scaled units (the growth factor)
   float radius_squared = 1.0f;
+  // Only count the samples with non-zero weight and sum their weights (sum_w, count, points), and stop
+  // the search once count >= enough_count with a positive sum: whether a support suffices.
+  bool count_only = false;
+  uint32_t enough_count = 0;
 
-  double a[kMaxCoefficients][kMaxCoefficients] = {};
-  double a2[kMaxCoefficients][kMaxCoefficients] = {};  // with squared weights: the estimate's variance
-  double b[kMaxCoefficients][3] = {};
+  double a[kMaxCoefficients][kMaxCoefficients] = {};  // upper triangle (j >= i) only; by Accumulate()
+  double b[kMaxCoefficients][3] = {};                 // by Accumulate()
+  // Per point with non-zero weight: count * w^2, count * w, its basis row and its mean value (kRowSize
+  // doubles a point).
+  static constexpr int kSquaredWeight = 0, kWeight = 1, kBasis = 2, kMean = kBasis + kMaxCoefficients;
+  static constexpr int kRowSize = kMean + 3;
+  std::vector<double>* rows = nullptr;
+  size_t rows_used = 0;  // doubles of `rows` in use
   double sum_w = 0.0, sum_w2 = 0.0;
   float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};                   // range of the neighbours' values
   uint32_t count = 0;                                              // samples with non-zero weight
@@ -81,9 +103,10 @@ struct NormalEquations {
   bool full() const { return true; }
   bool addPoint(float distance_squared, uint32_t index) {
     if (distance_squared >= radius_squared) return true;
-    const float* p = xyz + 3 * size_t(index);
-    const float* f = values + 3 * size_t(index);
-    double n = counts[index];
+    const Point& point = cloud[index];
+    const float* p = point.xyz;
+    const float* f = point.value;
+    double n = point.count;
     float position[3] = {p[0], p[1], p[2]};
     float mean[3] = {f[0], f[1], f[2]};
     if (static_cast<int64_t>(index) == exclude) {
@@ -99,31 +122,40 @@ struct NormalEquations {
       distance_squared = static_cast<float>(d2);
       if (distance_squared >= radius_squared) return true;
     }
-    const double r = std::sqrt(double(distance_squared)) / radius;
+    // Offsets in support radii; the divisions are skipped at the given radius (growth 1), where they
+    // would divide by 1.
+    double r = std::sqrt(double(distance_squared));
+    float ox = mirror.su * (position[0] - query[0]), oy = mirror.sv * (position[1] - query[1]),
+          oz = position[2] - query[2];
+    if (radius != 1.0f) {
+      r /= radius;
+      ox /= radius;
+      oy /= radius;
+      oz /= radius;
+    }
     const double t = 1.0 - r * r * r;
     const double w = t * t * t;
     if (!(w > 0.0)) return true;
-    const double dx = mirror.su * (position[0] - query[0]) / radius;
-    const double dy = mirror.sv * (position[1] - query[1]) / radius;
-    const double dz = (position[2] - query[2]) / radius;
+    if (count_only) {
+      sum_w += n * w;
+      count += static_cast<uint32_t>(n);
+      ++points;
+      return !(count >= enough_count && sum_w > 0.0);  // false stops the search: the support suffices
+    }
+    const double dx = ox, dy = oy, dz = oz;
     const double basis[kMaxCoefficients] = {1.0, dx, dy, dz, dx * dx, dy * dy, dz * dz, dx * dy, dx * dz, dy * dz};
-    const float* range = ranges + 6 * size_t(index);
     for (int c = 0; c < 3; ++c) {
-      low[c] = points == 0 ? range[c] : std::min(low[c], range[c]);
-      high[c] = points == 0 ? range[3 + c] : std::max(high[c], range[3 + c]);
+      low[c] = points == 0 ? point.low[c] : std::min(low[c], point.low[c]);
+      high[c] = points == 0 ? point.high[c] : std::max(high[c], point.high[c]);
     }
     const double nw = n * w, nw2 = nw * w;
-    for (int i = 0; i < kMaxCoefficients; ++i) {
-      const double wb = nw * basis[i];
-      const double w2b = nw2 * basis[i];
-      for (int j = i; j < kMaxCoefficients; ++j) {
-        a[i][j] += wb * basis[j];
-        a2[i][j] += w2b * basis[j];
-      }
-      b[i][0] += wb * mean[0];
-      b[i][1] += wb * mean[1];
-      b[i][2] += wb * mean[2];
-    }
+    if (rows_used + kRowSize > rows->size()) rows->resize(std::max<size_t>(2 * rows->size(), 64 * kRowSize));
+    double* row = rows->data() + rows_used;
+    rows_used += kRowSize;
+    row[kSquaredWeight] = nw2;
+    row[kWeight] = nw;
+    std::copy(std::begin(basis), std::end(basis), row + kBasis);
+    for (int c = 0; c < 3; ++c) row[kMean + c] = mean[c];
     if (static_cast<int64_t>(index) == self) {
       for (int i = 0; i < kMaxCoefficients; ++i) self_basis[i] += w * basis[i];
     }
@@ -134,9 +166,47 @@ struct NormalEquations {
     ++points;
     return true;
   }
+  // Row I of `a` (j >= I) and of `b` from the kept rows.
+  template <int I>
+  void AccumulateRow() {
+    constexpr int kColumns = kMaxCoefficients - I;
+    double sum[kColumns] = {}, rhs[3] = {};
+    for (size_t p = 0; p < rows_used; p += kRowSize) {
+      const double* row = rows->data() + p;
+      const double wb = row[kWeight] * row[kBasis + I];
+      for (int j = 0; j < kColumns; ++j) sum[j] += wb * row[kBasis + I + j];
+      for (int c = 0; c < 3; ++c) rhs[c] += wb * row[kMean + c];
+    }
+    for (int j = 0; j < kColumns; ++j) a[I][I + j] = sum[j];
+    for (int c = 0; c < 3; ++c) b[I][c] = rhs[c];
+  }
+  // The normal equations (a, b) of the points the last full search found.
+  void Accumulate() {
+    AccumulateRow<0>();
+    AccumulateRow<1>();
+    AccumulateRow<2>();
+    AccumulateRow<3>();
+    AccumulateRow<4>();
+    AccumulateRow<5>();
+    AccumulateRow<6>();
+    AccumulateRow<7>();
+    AccumulateRow<8>();
+    AccumulateRow<9>();
+  }
+  // g' A2 g for the leading m coefficients g (A2: the normal matrix with squared weights).
+  double Variance(const double* g, int m) const {
+    double variance = 0.0;
+    for (size_t p = 0; p < rows_used; p += kRowSize) {
+      const double* row = rows->data() + p;
+      double t = 0.0;
+      for (int i = 0; i < m; ++i) t += row[kBasis + i] * g[i];
+      variance += row[kSquaredWeight] * t * t;
+    }
+    return variance;
+  }
   void Reset() {
+    rows_used = 0;
     for (auto& row : a) std::fill(std::begin(row), std::end(row), 0.0);
-    for (auto& row : a2) std::fill(std::begin(row), std::end(row), 0.0);
     for (auto& row : b) std::fill(std::begin(row), std::end(row), 0.0);
     std::fill(std::begin(self_basis), std::end(self_basis), 0.0);
     sum_w = sum_w2 = 0.0;
@@ -148,10 +218,7 @@ struct NormalEquations {
 }  // namespace
 
 struct LocalRegression::Impl {
-  Cloud cloud;                   // the points: bin centroids (every sample without binning), scaled
-  std::vector<float> values;     // 3 a point: mean value (log f in log space)
-  std::vector<float> ranges;     // 6 a point: low[3], high[3] of its samples' values
-  std::vector<uint32_t> counts;  // samples a point
+  Cloud cloud;  // the points: bin centroids (every sample without binning), scaled
   // Every kept sample (scaled, folded coordinates and value) and the point it went to, for
   // leave-one-out.
   std::vector<float> sample_xyz, sample_values;
@@ -409,9 +476,9 @@ LocalRegression::LocalRegression(const std::vector<BrdfSample>& all_samples, con
   for (size_t begin = 0; begin < kept;) {
     size_t end = begin + 1;
     while (end < kept && keyed[end].first == keyed[begin].first) ++end;
-    const uint32_t point = static_cast<uint32_t>(impl.counts.size());
+    const uint32_t point = static_cast<uint32_t>(impl.cloud.points.size());
     double centroid[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
-    float low[3], high[3];
+    float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};
     for (size_t r = begin; r < end; ++r) {
       const uint32_t i = keyed[r].second;
       impl.sample_point[i] = point;
@@ -424,17 +491,17 @@ LocalRegression::LocalRegression(const std::vector<BrdfSample>& all_samples, con
       }
     }
     const double count = double(end - begin);
-    for (int k = 0; k < 3; ++k) impl.cloud.xyz.push_back(static_cast<float>(centroid[k] / count));
-    for (int k = 0; k < 3; ++k) impl.values.push_back(static_cast<float>(mean[k] / count));
-    for (int k = 0; k < 3; ++k) impl.ranges.push_back(low[k]);
-    for (int k = 0; k < 3; ++k) impl.ranges.push_back(high[k]);
-    impl.counts.push_back(static_cast<uint32_t>(end - begin));
+    Point& p = impl.cloud.points.emplace_back();
+    for (int k = 0; k < 3; ++k) {
+      p.xyz[k] = static_cast<float>(centroid[k] / count);
+      p.value[k] = static_cast<float>(mean[k] / count);
+      p.low[k] = low[k];
+      p.high[k] = high[k];
+    }
+    p.count = static_cast<uint32_t>(end - begin);
     begin = end;
   }
-  impl.cloud.xyz.shrink_to_fit();
-  impl.values.shrink_to_fit();
-  impl.ranges.shrink_to_fit();
-  impl.counts.shrink_to_fit();
+  impl.cloud.points.shrink_to_fit();
   if (kept > 0) {
     float low = xyz[2], high = xyz[2];
     for (size_t i = 1; i < kept; ++i) {
@@ -454,7 +521,7 @@ LocalRegression::~LocalRegression() = default;
 
 size_t LocalRegression::size() const { return impl_->sample_values.size() / 3; }
 
-size_t LocalRegression::points() const { return impl_->counts.size(); }
+size_t LocalRegression::points() const { return impl_->cloud.points.size(); }
 
 double LocalRegression::theta_d_min() const { return impl_->theta_d_min; }
 
@@ -506,10 +573,9 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
   const float z = static_cast<float>(uvw_in[2] * impl.scale_d);
 
   NormalEquations eq;
-  eq.xyz = impl.cloud.xyz.data();
-  eq.values = impl.values.data();
-  eq.ranges = impl.ranges.data();
-  eq.counts = impl.counts.data();
+  thread_local std::vector<double> rows;  // reused across evaluations: no allocation per fit
+  eq.rows = &rows;
+  eq.cloud = impl.cloud.points.data();
   if (exclude >= 0 && size_t(exclude) < size()) {
     eq.exclude = impl.sample_point[size_t(exclude)];
     eq.exclude_xyz = &impl.sample_xyz[3 * size_t(exclude)];
@@ -517,9 +583,12 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
   }
   if (self >= 0 && size_t(self) < size()) eq.self = impl.sample_point[size_t(self)];
   const nanoflann::SearchParams params(32, 0.0f, false);
-  float growth = 1.0f;
-  for (;;) {
+  eq.enough_count = static_cast<uint32_t>(std::max(options_.min_neighbors, 0));
+  // One pass over the support of radius `growth` (every mirror image); false when a count-only pass
+  // stopped early because the support suffices.
+  auto search = [&](float growth, bool count_only) {
     eq.Reset();
+    eq.count_only = count_only;
     eq.radius = growth;
     eq.radius_squared = growth * growth;
     for (const Mirror& m : impl.mirrors) {
@@ -530,11 +599,25 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
       eq.query[2] = z;
       eq.mirror = m;
       impl.tree->findNeighbors(eq, eq.query, params);
+      if (count_only && eq.count >= eq.enough_count && eq.sum_w > 0.0) return;
     }
-    if (int(eq.count) >= options_.min_neighbors && eq.sum_w > 0.0) break;
-    if (growth >= options_.max_growth) break;
+  };
+  // The given radius is accumulated at once (most evaluations end there). A grown support is first
+  // only counted (the search stops as soon as it suffices) and accumulated once, at the radius that
+  // suffices or the largest: the same equations as accumulating at every step, at a fraction of the
+  // cost where the support has to grow far.
+  float growth = 1.0f;
+  search(growth, false);
+  for (;;) {
+    const bool enough = int(eq.count) >= options_.min_neighbors && eq.sum_w > 0.0;
+    if (enough || growth >= options_.max_growth) {
+      if (eq.count_only && eq.sum_w > 0.0) search(growth, false);
+      break;
+    }
     growth = std::min<float>(growth * 1.5f, float(options_.max_growth));
+    search(growth, true);
   }
+  eq.Accumulate();
   if (!(eq.sum_w > 0.0)) return estimate;  // unsupported: value 0, degree -1
 
   estimate.neighbors = eq.count;
@@ -555,13 +638,9 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
     } else {
       if (estimate.effective_samples < options_.min_samples_per_coefficient * m) continue;
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a(m, m);
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a2(m, m);
       Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxCoefficients, 3> b(m, 3);
       for (int i = 0; i < m; ++i) {
-        for (int j = i; j < m; ++j) {
-          a(i, j) = a(j, i) = eq.a[i][j];
-          a2(i, j) = a2(j, i) = eq.a2[i][j];
-        }
+        for (int j = i; j < m; ++j) a(i, j) = a(j, i) = eq.a[i][j];
         for (int c = 0; c < 3; ++c) b(i, c) = eq.b[i][c];
       }
       const Eigen::LDLT<decltype(a)> ldlt(a);
@@ -575,7 +654,7 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
           Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCoefficients, 1>::Zero(m);
       e1[0] = 1.0;
       const auto g = ldlt.solve(e1).eval();
-      const double variance = g.dot(a2 * g);
+      const double variance = eq.Variance(g.data(), m);
       if (!(variance > 0.0) || 1.0 / variance < options_.min_fit_samples) continue;
       fit_samples = 1.0 / variance;
       for (int i = 0; i < m; ++i) self_weight += eq.self_basis[i] * g[i];

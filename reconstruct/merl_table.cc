@@ -53,7 +53,10 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
   if (fill_model && options.fill == FillMode::kModel) local.fill_model = fill_model->ModelName();
   local.theta_d_min_deg = regression.theta_d_min() * 180.0 / M_PI;
   local.theta_d_max_deg = regression.theta_d_max() * 180.0 / M_PI;
-  for (int i = 0; i < kMerlThetaH; ++i) {
+  // Per theta_h row in parallel, joined in flat index order.
+  std::vector<std::vector<size_t>> row_cells(kMerlThetaH);
+  std::vector<uint64_t> row_below(kMerlThetaH, 0);
+  tbb::parallel_for(0, kMerlThetaH, [&](int i) {
     for (int j = 0; j < kMerlThetaD; ++j) {
       for (int k = 0; k < kMerlPhiD; ++k) {
         const HalfDiffAngles angles = MerlCellCentre(i, j, k);
@@ -61,13 +64,17 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
         FromHalfDiff(angles, &wi, &wo);
         const bool inside = wi.z() > cos_limit && wo.z() > cos_limit && wi.z() > 0.0 && wo.z() > 0.0;
         if (!inside) {
-          ++local.cells_below_horizon;
+          ++row_below[i];
           continue;
         }
         if (k >= phi_count) continue;
-        cells.push_back(MerlFlatIndex(i, j, k));
+        row_cells[i].push_back(MerlFlatIndex(i, j, k));
       }
     }
+  });
+  for (int i = 0; i < kMerlThetaH; ++i) {
+    local.cells_below_horizon += row_below[i];
+    cells.insert(cells.end(), row_cells[i].begin(), row_cells[i].end());
   }
   if (effective_samples) effective_samples->assign(kMerlCells, 0.0f);
   if (domain) domain->assign(kMerlCells, 0);

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <random>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -19,11 +21,15 @@ struct Cell {
   size_t flat;
 };
 
-// Cell centres with both directions within the theta limit.
+// Cell centres with both directions within the theta limit, in flat index order (theta_h rows
+// TBB-parallel, then joined).
 std::vector<Cell> Cells(double max_theta_deg, int stride) {
   const double cos_limit = std::cos(max_theta_deg * M_PI / 180.0);
-  std::vector<Cell> cells;
-  for (int i = 0; i < kMerlThetaH; i += stride) {
+  std::vector<std::vector<Cell>> rows((kMerlThetaH + stride - 1) / stride);
+  tbb::parallel_for(size_t(0), rows.size(), [&](size_t row) {
+    const int i = int(row) * stride;
+    std::vector<Cell>& cells = rows[row];
+    cells.reserve(size_t(kMerlThetaD) * kMerlPhiD);
     for (int j = 0; j < kMerlThetaD; j += stride) {
       for (int k = 0; k < kMerlPhiD; k += stride) {
         Cell cell;
@@ -34,7 +40,12 @@ std::vector<Cell> Cells(double max_theta_deg, int stride) {
         cells.push_back(cell);
       }
     }
-  }
+  });
+  size_t total = 0;
+  for (const std::vector<Cell>& row : rows) total += row.size();
+  std::vector<Cell> cells;
+  cells.reserve(total);
+  for (const std::vector<Cell>& row : rows) cells.insert(cells.end(), row.begin(), row.end());
   return cells;
 }
 
@@ -113,17 +124,42 @@ ReconstructionError CompareRegressionWithTruth(const LocalRegression& regression
 
 ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfModel& truth, double max_theta_deg,
                                           const std::vector<uint8_t>* measured_domain) {
-  IBRDF_CHECK(!measured_domain || measured_domain->size() == kMerlCells);
-  Accumulator accumulator;
-  for (const Cell& cell : Cells(max_theta_deg, 1)) {
-    const bool outside_domain = measured_domain && !(*measured_domain)[cell.flat];
-    if (!table.Measured(cell.flat) || outside_domain) {
-      accumulator.Outside();
-      continue;
+  return CompareTableWithTruth(table, truth, max_theta_deg, std::vector<const std::vector<uint8_t>*>{measured_domain})
+      .front();
+}
+
+std::vector<ReconstructionError> CompareTableWithTruth(const MerlTable& table, const BrdfModel& truth,
+                                                       double max_theta_deg,
+                                                       const std::vector<const std::vector<uint8_t>*>& domains) {
+  for (const std::vector<uint8_t>* domain : domains) IBRDF_CHECK(!domain || domain->size() == kMerlCells);
+  const std::vector<Cell> cells = Cells(max_theta_deg, 1);
+  // The truth where some comparison scores the cell; the sums below run in cell order, as one
+  // comparison alone would.
+  auto scored = [&](const Cell& cell, const std::vector<uint8_t>* domain) {
+    return table.Measured(cell.flat) && (!domain || (*domain)[cell.flat]);
+  };
+  std::vector<Eigen::Vector3d> truth_values(cells.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t n = range.begin(); n != range.end(); ++n) {
+      const Cell& cell = cells[n];
+      bool needed = false;
+      for (const std::vector<uint8_t>* domain : domains) needed = needed || scored(cell, domain);
+      if (needed) truth_values[n] = truth.Eval(cell.wi, cell.wo);
     }
-    accumulator.Add(table.Cell(cell.flat), truth.Eval(cell.wi, cell.wo), cell.angles.theta_h);
-  }
-  return accumulator.Finish();
+  });
+  std::vector<ReconstructionError> errors(domains.size());
+  tbb::parallel_for(size_t(0), domains.size(), [&](size_t d) {
+    Accumulator accumulator;
+    for (size_t n = 0; n < cells.size(); ++n) {
+      if (!scored(cells[n], domains[d])) {
+        accumulator.Outside();
+        continue;
+      }
+      accumulator.Add(table.Cell(cells[n].flat), truth_values[n], cells[n].angles.theta_h);
+    }
+    errors[d] = accumulator.Finish();
+  });
+  return errors;
 }
 
 nlohmann::json ToJson(const ReconstructionError& error) {

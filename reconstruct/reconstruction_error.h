@@ -45,6 +45,12 @@ ReconstructionError CompareRegressionWithTruth(const LocalRegression& regression
 // `measured_domain` (from TabulateMerl) when it is given; without it every tabulated cell is scored.
 ReconstructionError CompareTableWithTruth(const MerlTable& table, const BrdfModel& truth, double max_theta_deg = 80.0,
                                           const std::vector<uint8_t>* measured_domain = nullptr);
+// Several such comparisons of one table at once, one per entry of `domains` (nullptr: every tabulated
+// cell): the cell centres and the truth are evaluated once (TBB-parallel); each result equals
+// CompareTableWithTruth with that domain.
+std::vector<ReconstructionError> CompareTableWithTruth(const MerlTable& table, const BrdfModel& truth,
+                                                       double max_theta_deg,
+                                                       const std::vector<const std::vector<uint8_t>*>& domains);
 
 nlohmann::json ToJson(const ReconstructionError& error);
 

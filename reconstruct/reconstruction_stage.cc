@@ -10,6 +10,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include "core/brdf_coords.h"
 #include "core/brdf_model.h"
@@ -48,9 +49,10 @@ void LoadEvalPoints(const std::string& eval_file, StageInputs* inputs) {
   inputs->eval_theta_d.resize(shape[0]);
   for (size_t i = 0; i < shape[0]; ++i) {
     // Validated where read: a point outside the angles' ranges would be answered, wrongly.
-    if (!(points[3 * i] >= 0 && points[3 * i] <= M_PI / 2 && points[3 * i + 1] >= 0 &&
-          points[3 * i + 1] <= M_PI / 2 && std::abs(points[3 * i + 2]) <= M_PI)) {
-      ThrowError(eval_file, "row " + std::to_string(i) + ": expected theta_i, theta_e in [0, pi/2] and delta_phi in [-pi, pi]");
+    if (!(points[3 * i] >= 0 && points[3 * i] <= M_PI / 2 && points[3 * i + 1] >= 0 && points[3 * i + 1] <= M_PI / 2 &&
+          std::abs(points[3 * i + 2]) <= M_PI)) {
+      ThrowError(eval_file,
+                 "row " + std::to_string(i) + ": expected theta_i, theta_e in [0, pi/2] and delta_phi in [-pi, pi]");
     }
     inputs->eval_wi[i] = FromSpherical(points[3 * i], 0.0);
     inputs->eval_wo[i] = FromSpherical(points[3 * i + 1], points[3 * i + 2]);
@@ -136,17 +138,22 @@ void EvaluatePoints(const LocalRegression& regression, const StageInputs& inputs
   Log(1, "evaluated " + std::to_string(n) + " points: " + domain.Brief() + "; " + counts.Brief());
 }
 
-// The MERL table, its .npy forms, domain.npy and the table's sidecar brdf.json, scored against the
-// truth when there is one.
-void TabulateAndScore(const LocalRegression& regression, const ReconstructOptions& options, const BrdfModel* truth,
-                      const BrdfModel* fill_model, const std::string& tmp, ReconstructResult* result,
-                      nlohmann::json* timings, MerlTable* table_out, std::vector<uint8_t>* domain_out) {
+// What WriteTable writes besides the table and its domain.
+struct TableFiles {
+  std::vector<float> effective_samples;  // per cell
+  nlohmann::json sidecar;                // brdf.json
+};
+
+// The MERL table and its domain (into `table_out`, `domain_out`), its summary and its sidecar
+// (`files`, written by WriteTable).
+void Tabulate(const LocalRegression& regression, const ReconstructOptions& options, const BrdfModel* fill_model,
+              ReconstructResult* result, nlohmann::json* timings, MerlTable* table_out,
+              std::vector<uint8_t>* domain_out, TableFiles* files) {
   nlohmann::json& summary = result->summary;
   TabulateSummary tabulated;
-  std::vector<float> ess;
+  std::vector<float>& ess = files->effective_samples;
   std::vector<uint8_t>& domain = *domain_out;
   *table_out = TabulateMerl(regression, options.tabulate, &tabulated, &ess, &domain, fill_model);
-  const MerlTable& table = *table_out;
   (*timings)["tabulate_s"] = tabulated.seconds;
   Log(1, "regression: " + std::to_string(regression.size()) + " samples in " + std::to_string(regression.points()) +
              " points, " + tabulated.reliability.Brief());
@@ -158,11 +165,6 @@ void TabulateAndScore(const LocalRegression& regression, const ReconstructOption
                     : std::to_string(tabulated.domain.filled) + " of them filled by --fill " +
                           FillModeName(options.tabulate.fill) + ": invented values, recorded in brdf.json"));
   }
-  Timer timer;
-  WriteMerl(tmp + "/brdf.binary", table);
-  WriteNpyArray(tmp + "/brdf.npy", MerlToArray(table), {90, 90, 180, 3});
-  WriteNpyArray(tmp + "/effective_samples.npy", ess, {90, 90, 180});
-  WriteBytes(tmp + "/domain.npy", domain, {90, 90, 180});
   nlohmann::json table_json = {{"cells_measured", tabulated.domain.measured},
                                {"cells_interpolated", tabulated.domain.interpolated},
                                {"cells_unmeasured", tabulated.domain.unmeasured},
@@ -176,19 +178,18 @@ void TabulateAndScore(const LocalRegression& regression, const ReconstructOption
                                  {"max_centroid_offset_kernel_radii", options.tabulate.domain.max_centroid_offset},
                                  {"theta_d_margin_deg", options.tabulate.domain.theta_d_margin_deg}}}};
   if (!tabulated.fill_model.empty()) table_json["fill_model"] = tabulated.fill_model;
-  WriteJsonFile(tmp + "/brdf.json",
-                {{"format", "ibrdf-merl-table"},
-                 {"version", 1},
-                 {"files", {"brdf.binary", "brdf.npy", "domain.npy", "effective_samples.npy"}},
-                 {"domain_classes", {{"0", "unmeasured"}, {"1", "interpolated"}, {"2", "measured"}}},
-                 {"unmeasured_value", options.tabulate.fill == FillMode::kNone
-                                          ? "-1 (MERL's no data)"
-                                          : std::string("filled by ") + FillModeName(options.tabulate.fill) +
-                                                " where possible (domain.npy 0 with a value >= 0: invented), else -1"},
-                 {"table", table_json},
-                 {"colour_space", summary.value("colour_space", nlohmann::json())},
-                 {"colour", summary.value("colour", nlohmann::json())}});
-  (*timings)["write_s"] = timer.ElapsedSeconds();
+  files->sidecar = {
+      {"format", "ibrdf-merl-table"},
+      {"version", 1},
+      {"files", {"brdf.binary", "brdf.npy", "domain.npy", "effective_samples.npy"}},
+      {"domain_classes", {{"0", "unmeasured"}, {"1", "interpolated"}, {"2", "measured"}}},
+      {"unmeasured_value", options.tabulate.fill == FillMode::kNone
+                               ? "-1 (MERL's no data)"
+                               : std::string("filled by ") + FillModeName(options.tabulate.fill) +
+                                     " where possible (domain.npy 0 with a value >= 0: invented), else -1"},
+      {"table", table_json},
+      {"colour_space", summary.value("colour_space", nlohmann::json())},
+      {"colour", summary.value("colour", nlohmann::json())}};
   summary["regression"]["reliability"] = ToJson(tabulated.reliability);
   summary["table"] = table_json;
   result->tabulated = true;
@@ -196,22 +197,43 @@ void TabulateAndScore(const LocalRegression& regression, const ReconstructOption
   result->cells_interpolated = tabulated.domain.interpolated;
   result->cells_unmeasured = tabulated.domain.unmeasured;
   result->cells_filled = tabulated.domain.filled;
-  if (!truth) return;
-  // Scored over the valid cells (measured or interpolated), the measured ones alone, and every cell
-  // holding a value (filled ones included).
+}
+
+// brdf.binary, brdf.npy, effective_samples.npy, domain.npy and brdf.json into `tmp`; returns the seconds.
+double WriteTable(const MerlTable& table, const std::vector<uint8_t>& domain, const TableFiles& files,
+                  const std::string& tmp) {
+  const Timer timer;
+  WriteMerl(tmp + "/brdf.binary", table);
+  WriteNpyArray(tmp + "/brdf.npy", MerlToArray(table), {90, 90, 180, 3});
+  WriteNpyArray(tmp + "/effective_samples.npy", files.effective_samples, {90, 90, 180});
+  WriteBytes(tmp + "/domain.npy", domain, {90, 90, 180});
+  WriteJsonFile(tmp + "/brdf.json", files.sidecar);
+  return timer.ElapsedSeconds();
+}
+
+// The table scored against the truth over the valid cells (measured or interpolated), the measured ones
+// alone and every cell holding a value (filled ones included), and random MERL lookups; into `summary`
+// (its own object: this runs beside the .bsdf export) and `result`'s score.
+void Score(const MerlTable& table, const std::vector<uint8_t>& domain, const BrdfModel& truth,
+           const ReconstructOptions& options, nlohmann::json* summary, ReconstructResult* result) {
   std::vector<uint8_t> measured_only(domain.size());
   for (size_t i = 0; i < domain.size(); ++i) measured_only[i] = domain[i] == uint8_t(DomainClass::kMeasured);
-  const ReconstructionError error = CompareTableWithTruth(table, *truth, 80.0, &domain);
-  summary["error_against_truth"] = ToJson(error);
-  summary["error_against_truth"]["truth"] = options.truth_file;
-  summary["error_against_truth"]["domain"] = "theta_i, theta_e <= 80 deg; cells measured or interpolated (domain.npy)";
+  MerlLookupCheck lookups;
+  std::vector<ReconstructionError> errors;
+  tbb::task_group group;
+  group.run([&] { lookups = CheckMerlLookups(table, truth); });
+  errors = CompareTableWithTruth(table, truth, 80.0, {&domain, &measured_only, nullptr});
+  group.wait();
+  const ReconstructionError& error = errors[0];
+  (*summary)["error_against_truth"] = ToJson(error);
+  (*summary)["error_against_truth"]["truth"] = options.truth_file;
+  (*summary)["error_against_truth"]["domain"] =
+      "theta_i, theta_e <= 80 deg; cells measured or interpolated (domain.npy)";
   Log(1, "against the truth (theta <= 80, measured and interpolated cells): " + error.Brief());
-  summary["error_against_truth_measured"] = ToJson(CompareTableWithTruth(table, *truth, 80.0, &measured_only));
-  const ReconstructionError all = CompareTableWithTruth(table, *truth, 80.0);
-  summary["error_against_truth_all_tabulated"] = ToJson(all);
-  Log(1, "against the truth (theta <= 80, every cell holding a value): " + all.Brief());
-  const MerlLookupCheck lookups = CheckMerlLookups(table, *truth);
-  summary["merl_lookups_against_truth"] = ToJson(lookups);
+  (*summary)["error_against_truth_measured"] = ToJson(errors[1]);
+  (*summary)["error_against_truth_all_tabulated"] = ToJson(errors[2]);
+  Log(1, "against the truth (theta <= 80, every cell holding a value): " + errors[2].Brief());
+  (*summary)["merl_lookups_against_truth"] = ToJson(lookups);
   Log(1, lookups.Brief());
   result->scored = true;
   result->error_against_truth = error;
@@ -246,19 +268,24 @@ std::string MaterialName(const ReconstructOptions& options, const std::string& s
 }
 
 // The Lafortune and GGX fits, their material files and renderer snippets; returns the chosen model
-// (lowest relative RMS against the samples).
+// (lowest relative RMS against the samples). `colour_space` (the samples' own, from their sidecar) is
+// stated in every material file and snippet.
 std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, const ModelFitOptions& options,
-                                     const std::string& name, const std::string& tmp, ReconstructResult* result,
-                                     nlohmann::json* timings) {
+                                     const std::string& name, const std::string& colour_space,
+                                     const std::string& tmp, ReconstructResult* result, nlohmann::json* timings) {
   Timer timer;
-  const nlohmann::json& space = result->summary["colour_space"];
-  const std::string colour_space = space.is_string() ? space.get<std::string>() : space.is_null() ? "" : space.dump();
-  ModelFitResult lafortune = FitLafortune(samples, options);
-  Log(1, lafortune.BriefReport());
-  WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, name + "-lafortune", colour_space));
-  ModelFitResult ggx = FitGgx(samples, options);
+  // The two fits side by side (each runs its starts in parallel too).
+  ModelFitResult lafortune, ggx;
+  tbb::task_group group;
+  group.run([&] {
+    lafortune = FitLafortune(samples, options);
+    Log(1, lafortune.BriefReport());
+    WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, name + "-lafortune", colour_space));
+  });
+  ggx = FitGgx(samples, options);
   Log(1, ggx.BriefReport());
   WriteJsonFile(tmp + "/ggx.json", FitMaterialJson(ggx, name + "-ggx", colour_space));
+  group.wait();
   const RendererSnippets snippets = RendererMaterials(ggx, name, colour_space);
   WriteText(tmp + "/" + snippets.pbrt_file, snippets.pbrt);
   WriteText(tmp + "/" + snippets.mitsuba_file, snippets.mitsuba);
@@ -299,8 +326,22 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
       theta_d[i] = angles.theta_d;
       uvw[i] = RegressionCoordinates(angles);
     }
-    ReliabilityCounts counts;
-    const std::vector<Estimate> estimates = regression.EvaluateMany(uvw, &counts);
+    // A node beyond the samples' theta_d range is unmeasured whatever its estimate; with a fit to fill
+    // it the estimate is not needed, so it is not computed (as in the tabulation): such nodes (near
+    // retro-reflection, at grazing angles) are the regression's most expensive, its support grown.
+    const double margin = options.tabulate.domain.theta_d_margin_deg * M_PI / 180.0;
+    std::vector<size_t> evaluated;
+    std::vector<Eigen::Vector3d> evaluated_uvw;
+    for (size_t i = 0; i < n; ++i) {
+      const bool beyond =
+          theta_d[i] < regression.theta_d_min() - margin || theta_d[i] > regression.theta_d_max() + margin;
+      if (beyond && chosen) continue;
+      evaluated.push_back(i);
+      evaluated_uvw.push_back(uvw[i]);
+    }
+    const std::vector<Estimate> some = regression.EvaluateMany(evaluated_uvw, nullptr);
+    std::vector<Estimate> estimates(n);  // default: unsupported, so unmeasured
+    for (size_t k = 0; k < evaluated.size(); ++k) estimates[evaluated[k]] = some[k];
     f->assign(n, Eigen::Vector3d::Zero());
     for (size_t i = 0; i < n; ++i) {
       const Estimate& e = estimates[i];
@@ -357,28 +398,42 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
     if (domain[flat] == uint8_t(DomainClass::kMeasured)) cells.push_back(flat);
   }
   const size_t stride = std::max<size_t>(1, cells.size() / 200000);
+  // Each checked cell's band (-1: beyond 80 degrees) and relative errors (-1: no positive table value),
+  // TBB-parallel; gathered in cell order after.
+  const size_t checked = (cells.size() + stride - 1) / stride;
+  std::vector<int8_t> cell_band(checked, -1);
+  std::vector<Eigen::Vector3d> cell_errors(checked);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, checked, 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t m = range.begin(); m != range.end(); ++m) {
+      const size_t flat = cells[m * stride];
+      const int i_h = int(flat / (size_t(kMerlThetaD) * kMerlPhiD)), i_d = int(flat / kMerlPhiD % kMerlThetaD),
+                i_p = int(flat % kMerlPhiD);
+      Eigen::Vector3d wi, wo;
+      FromHalfDiff(MerlCellCentre(i_h, i_d, i_p), &wi, &wo);
+      const double theta_max = std::acos(std::min(wi.z(), wo.z())) * 180 / M_PI;
+      if (theta_max > 80.0) continue;
+      const Eigen::Vector3d t = table.Cell(flat), g = written.Eval(wi, wo);
+      cell_band[m] = static_cast<int8_t>(theta_max < 25.0 ? 0 : theta_max < 50.0 ? 1 : 2);
+      for (int c = 0; c < 3; ++c) cell_errors[m][c] = t[c] > 0.0 ? std::abs(g[c] - t[c]) / t[c] : -1.0;
+    }
+  });
   std::vector<double> errors;
   std::vector<std::vector<double>> band_errors(3);  // theta_max 0-25, 25-50, 50-80 degrees
-  for (size_t n = 0; n < cells.size(); n += stride) {
-    const size_t flat = cells[n];
-    const int i_h = int(flat / (size_t(kMerlThetaD) * kMerlPhiD)), i_d = int(flat / kMerlPhiD % kMerlThetaD),
-              i_p = int(flat % kMerlPhiD);
-    Eigen::Vector3d wi, wo;
-    FromHalfDiff(MerlCellCentre(i_h, i_d, i_p), &wi, &wo);
-    const double theta_max = std::acos(std::min(wi.z(), wo.z())) * 180 / M_PI;
-    if (theta_max > 80.0) continue;
-    const Eigen::Vector3d t = table.Cell(flat), g = written.Eval(wi, wo);
-    const int band = theta_max < 25.0 ? 0 : theta_max < 50.0 ? 1 : 2;
+  for (size_t m = 0; m < checked; ++m) {
+    if (cell_band[m] < 0) continue;
     for (int c = 0; c < 3; ++c) {
-      if (!(t[c] > 0.0)) continue;
-      errors.push_back(std::abs(g[c] - t[c]) / t[c]);
-      band_errors[band].push_back(errors.back());
+      if (cell_errors[m][c] < 0.0) continue;
+      errors.push_back(cell_errors[m][c]);
+      band_errors[cell_band[m]].push_back(errors.back());
     }
   }
-  auto quantile = [](std::vector<double> v, double q) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    return v[std::min(v.size() - 1, size_t(q * double(v.size())))];
+  // Each list sorted once (the bands beside the whole), then read at its quantiles.
+  tbb::parallel_for(0, 4, [&](int list) {
+    std::sort(list < 3 ? band_errors[list].begin() : errors.begin(), list < 3 ? band_errors[list].end() : errors.end());
+  });
+  auto quantile = [](const std::vector<double>& sorted, double q) {
+    if (sorted.empty()) return 0.0;
+    return sorted[std::min(sorted.size() - 1, size_t(q * double(sorted.size())))];
   };
   nlohmann::json bands = nlohmann::json::object();
   const char* band_names[] = {"0-25", "25-50", "50-80"};
@@ -479,23 +534,76 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
   timings["build_s"] = timer.ElapsedSeconds();
   result.samples_used = regression.size();
   result.points = regression.points();
+  // The fits run beside the evaluation and tabulation (both TBB-parallel: the two share the cores),
+  // unless --fill model needs the chosen fit first. They write into their own result and timings,
+  // merged after.
   std::unique_ptr<BrdfModel> chosen;
-  if (options.fits && !options.eval_only) {
-    chosen = FitModels(samples, options.fit, MaterialName(options, samples_file), tmp, &result, &timings);
+  ReconstructResult fitted;
+  nlohmann::json fit_timings;
+  const bool fits = options.fits && !options.eval_only;
+  const bool fill_with_model = options.tabulate.fill == FillMode::kModel;
+  const std::string name = MaterialName(options, samples_file);
+  // Read before the fits start: they run beside the tabulation, which writes into result.summary.
+  const nlohmann::json space = result.summary.value("colour_space", nlohmann::json());
+  const std::string colour_space = space.is_string() ? space.get<std::string>() : space.is_null() ? "" : space.dump();
+  auto fit = [&] { chosen = FitModels(samples, options.fit, name, colour_space, tmp, &fitted, &fit_timings); };
+  tbb::task_group fitting;
+  if (fits && fill_with_model) fit();
+  if (fits && !fill_with_model) fitting.run(fit);
+  MerlTable table;
+  std::vector<uint8_t> domain;
+  TableFiles table_files;
+  try {
+    const BrdfModel* fill_model = fill_with_model ? chosen.get() : nullptr;
+    if (!inputs.eval_wi.empty()) {
+      EvaluatePoints(regression, inputs, options, fill_model, tmp, &result.summary, &timings);
+      result.eval_points = inputs.eval_wi.size();
+    }
+    result.summary["regression"] = RegressionJson(options, result.regression, regression);
+    if (!options.eval_only) {
+      Tabulate(regression, options, fill_model, &result, &timings, &table, &domain, &table_files);
+    }
+  } catch (...) {
+    fitting.wait();  // rethrows a fit's error, if any; otherwise the tabulation's below
+    throw;
   }
-  const BrdfModel* fill_model = options.tabulate.fill == FillMode::kModel ? chosen.get() : nullptr;
-  if (!inputs.eval_wi.empty()) {
-    EvaluatePoints(regression, inputs, options, fill_model, tmp, &result.summary, &timings);
-    result.eval_points = inputs.eval_wi.size();
+  fitting.wait();
+  if (fitted.fitted) {
+    result.summary["fits"] = fitted.summary["fits"];
+    result.fitted = true;
+    result.lafortune_rel_rms = fitted.lafortune_rel_rms;
+    result.ggx_rel_rms = fitted.ggx_rel_rms;
+    result.chosen_model = fitted.chosen_model;
+    timings["fits_s"] = fit_timings["fits_s"];
   }
-  result.summary["regression"] = RegressionJson(options, result.regression, regression);
   if (!options.eval_only) {
-    MerlTable table;
-    std::vector<uint8_t> domain;
-    TabulateAndScore(regression, options, inputs.truth.get(), fill_model, tmp, &result, &timings, &table, &domain);
-    if (options.bsdf) {
-      ExportBsdf(regression, options, chosen.get(), table, domain, MaterialName(options, samples_file), samples_file,
-                 tmp, &result, &timings);
+    // The table's files and the score against the truth beside the .bsdf export (the score into its own
+    // summary object, merged after).
+    nlohmann::json score;
+    tbb::task_group scoring;
+    double write_s = 0.0;
+    scoring.run([&] { write_s = WriteTable(table, domain, table_files, tmp); });
+    if (inputs.truth) {
+      scoring.run([&] {
+        const Timer score_timer;
+        Score(table, domain, *inputs.truth, options, &score, &result);
+        score["score_s"] = score_timer.ElapsedSeconds();
+      });
+    }
+    try {
+      if (options.bsdf) {
+        ExportBsdf(regression, options, chosen.get(), table, domain, name, samples_file, tmp, &result, &timings);
+      }
+    } catch (...) {
+      scoring.wait();
+      throw;
+    }
+    scoring.wait();
+    timings["write_s"] = write_s;
+    if (inputs.truth) {
+      timings["score_s"] = score["score_s"];
+      score.erase("score_s");
+      for (auto& [key, value] : score.items()) result.summary[key] = value;
     }
   }
   result.total_s = total.ElapsedSeconds();

@@ -8,8 +8,10 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -143,6 +145,54 @@ TEST_F(ReconstructionStage, EvaluatesAtThePointsNearTheTruth) {
     if (values[i] < 0.0) continue;  // unsupported
     EXPECT_NEAR(values[i], truth[i], 0.2 * truth[i]) << i;
   }
+}
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// The stage runs the fits beside the tabulation, and the score and the table's files beside the .bsdf
+// export (docs/decisions.md, "Reconstruct speed"): on one thread and on two every file is the same,
+// byte for byte, and the summary's figures too (timings and the merged mean of effective samples,
+// whose float sum depends on the order the parallel chunks finish in, left out).
+TEST_F(ReconstructionStage, OneAndTwoThreadsWriteTheSameFiles) {
+  ReconstructOptions options;
+  options.truth_file = truth_;
+  options.tabulate.max_theta_deg = 40.0;  // a part of the table, to keep the test short
+  options.fit.max_samples = 1500;
+  options.fit.max_iterations = 50;
+  options.bsdf_export.theta_i_count = 4;
+  options.bsdf_export.ndf_size = 32;
+  options.bsdf_export.vndf_size = 16;
+  options.bsdf_export.rgb_size = 16;
+  options.name = "bluepaint";
+  std::vector<ReconstructResult> results;
+  for (int threads : {1, 2}) {
+    tbb::global_control control(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    results.push_back(Reconstruct(*samples_, options, out_dir_ / ("rec" + std::to_string(threads))));
+    ASSERT_TRUE(results.back().success);
+  }
+  const std::string one = out_dir_ / "rec1", two = out_dir_ / "rec2";
+  for (const char* file : {"brdf.binary", "brdf.npy", "domain.npy", "effective_samples.npy", "brdf.json",
+                           "lafortune.json", "ggx.json", "bluepaint.bsdf", "bluepaint.pbrt", "bluepaint.xml"}) {
+    SCOPED_TRACE(file);
+    ASSERT_TRUE(fs::exists(one + "/" + file));
+    EXPECT_EQ(FileBytes(one + "/" + file), FileBytes(two + "/" + file));
+  }
+  nlohmann::json a = results[0].summary, b = results[1].summary;
+  for (nlohmann::json* summary : {&a, &b}) {
+    summary->erase("timings_s");
+    summary->at("regression").at("reliability").erase("mean_effective_samples");
+    summary->at("bsdf").erase("build_s");
+    summary->at("fits").at("lafortune").erase("seconds");
+    summary->at("fits").at("ggx").erase("seconds");
+  }
+  EXPECT_EQ(a, b) << nlohmann::json::diff(a, b).dump(1);
+  EXPECT_TRUE(a.contains("fits") && a.contains("error_against_truth") && a.contains("merl_lookups_against_truth"));
+  EXPECT_GT(a.at("error_against_truth").at("cells_scored").get<double>(), 1000.0);
+  EXPECT_GT(results[0].summary.at("timings_s").at("score_s").get<double>(), 0.0);
+  EXPECT_EQ(results[0].chosen_model, results[1].chosen_model);
 }
 
 TEST_F(ReconstructionStage, NoSamplesIsAnErrorAndWritesNothing) {
