@@ -305,8 +305,8 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels&
     MeshPhotoStats& local = block_stats[b];
     const size_t nx = xs.size(), nc = corner_xs.size();
     std::vector<Eigen::Vector3d> directions(nx), corner_directions(nc);
-    std::vector<SurfaceHit> hits(nx), corner_hits(nc);
-    std::unique_ptr<bool[]> found(new bool[nx]), corner_found(new bool[nc]);
+    std::vector<SurfaceHit> hits(nx);
+    std::unique_ptr<bool[]> found(new bool[nx]);
     // Corner distances (NaN: the corner ray misses) of the rows above and below the pixel row.
     std::vector<double> top(nc), bottom(nc);
     int bottom_row = -1;
@@ -315,12 +315,10 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels&
         const Eigen::Vector2f& xy = path.corner_rays[size_t(row) * (width + 1) + corner_xs[k]];
         corner_directions[k] = (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
       }
-      mesh.IntersectBatch(camera_center, corner_directions.data(), nc, corner_hits.data(), corner_found.get());
-      for (size_t k = 0; k < nc; ++k) {
-        (*depths)[k] = corner_found[k] ? corner_hits[k].t : std::numeric_limits<double>::quiet_NaN();
-      }
+      mesh.DepthBatch(camera_center, corner_directions.data(), nc, depths->data());
     };
     const size_t row_end = std::min(ys.size(), (b + 1) * kRowsPerBlock);
+    out.reserve(nx * (row_end - b * kRowsPerBlock));  // no regrowth: each copy costs more than the pixel's work
     for (size_t r = b * kRowsPerBlock; r < row_end; ++r) {
       const int y = ys[r];
       for (size_t i = 0; i < nx; ++i) {
