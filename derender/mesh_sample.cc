@@ -245,8 +245,8 @@ bool MeshSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d&
 }
 
 template <class OnHit, class OnMiss>
-void MeshSample::CastBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count,
-                           OnHit on_hit, OnMiss on_miss) const {
+void MeshSample::CastBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count, OnHit on_hit,
+                           OnMiss on_miss) const {
   const Eigen::Vector3f o = (origin - origin_).cast<float>();
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);

@@ -49,8 +49,7 @@ class MeshSample : public SampleSurface {
                       bool* found) const;
   // The distance of each ray's hit alone, as IntersectBatch would report it in SurfaceHit::t (NaN where
   // the ray misses): for rays whose depth is all that is needed (the mixed-pixel test's pixel corners).
-  void DepthBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count,
-                  double* depths) const;
+  void DepthBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count, double* depths) const;
   // Inside when rays along all six axis directions leave through back faces (exact for a closed
   // mesh; an open scan has no inside and gives false almost everywhere).
   bool Contains(const Eigen::Vector3d& point) const override;

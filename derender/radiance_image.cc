@@ -7,6 +7,7 @@
 #include <mutex>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "core/error.h"
@@ -371,14 +372,11 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
   st.area = area;
   // Every element is written before it is read, so the scratch memory is only grown, never cleared.
   std::vector<float>& scratch = *scratch_buffer;
-  if (scratch.size() < 3 * area * (2 * m + 2)) {
-    ReserveWithHugePages(&scratch, 3 * area * (2 * m + 2));
-    scratch.resize(3 * area * (2 * m + 2));
+  if (scratch.size() < 3 * area * m) {
+    ReserveWithHugePages(&scratch, 3 * area * m);
+    scratch.resize(3 * area * m);
   }
-  float* const linear = scratch.data();
-  float* const expected = linear + 3 * area * m;
-  float* const outer = expected + 3 * area * m;
-  float* const inner = outer + 3 * area;
+  float* const expected = scratch.data();
   st.expected = expected;
   if (area == 0) return;
   constexpr int kOuter = kFloorRingOuter, kInner = kFloorRingInner;
@@ -392,17 +390,33 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
     span_inner_x[i] = span(i, kInner, width);
   }
   const int interior_begin = std::min(kOuter, width), interior_end = std::max(width - kOuter, interior_begin);
+  const size_t row_values = 3 * size_t(width);
+  // Per thread: the linear signal and the horizontal sums of a block of rows and its kOuter rows above
+  // and below, small enough to stay in cache (the blocks' halo rows are computed twice).
+  struct RowBuffers {
+    std::vector<float> linear, outer, inner;
+  };
+  tbb::enumerable_thread_specific<RowBuffers> buffers;
+  constexpr int kBlockRows = 32;
   for (size_t e = 0; e < m; ++e) {
     const Image& image = images[e];
-    float* lin = &linear[3 * area * e];
-    // Linear signal and horizontal sums, row by row.
-    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
-      for (int j = rows.begin(); j < rows.end(); ++j) {
-        float* row = &lin[3 * size_t(j) * width];
+    float* exp = &expected[3 * area * e];
+    tbb::parallel_for(tbb::blocked_range<int>(0, height, kBlockRows), [&](const tbb::blocked_range<int>& rows) {
+      const int first = std::max(rows.begin() - kOuter, 0), last = std::min(rows.end() + kOuter, height);
+      RowBuffers& local = buffers.local();
+      const size_t needed = row_values * size_t(last - first);
+      if (local.linear.size() < needed) {
+        local.linear.resize(needed);
+        local.outer.resize(needed);
+        local.inner.resize(needed);
+      }
+      // The linear signal and the horizontal sums of rows first .. last - 1.
+      for (int j = first; j < last; ++j) {
+        float* row = &local.linear[row_values * (j - first)];
         const float* values = &image.pixels[(size_t(j + window.y0) * impl.width + window.x0) * image.channels];
         if (image.channels == 3 && impl.linear) {
           const double black = radiometry.black_level;
-          for (int k = 0; k < 3 * width; ++k) {
+          for (size_t k = 0; k < row_values; ++k) {
             const double v = values[k];
             row[k] = static_cast<float>(std::isfinite(v) ? v - black : 0.0);
           }
@@ -415,8 +429,8 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
             }
           }
         }
-        float* row_outer = &outer[3 * size_t(j) * width];
-        float* row_inner = &inner[3 * size_t(j) * width];
+        float* row_outer = &local.outer[row_values * (j - first)];
+        float* row_inner = &local.inner[row_values * (j - first)];
         const auto edge = [&](int i) {
           for (int c = 0; c < 3; ++c) {
             double sum_outer = 0.0, sum_inner = 0.0;
@@ -448,32 +462,30 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
         }
         for (int i = interior_end; i < width; ++i) edge(i);
       }
-    });
-    float* exp = &expected[3 * area * e];
-    // Vertical sums and the mean.
-    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+      // Vertical sums and the mean, rows of the block.
+      const auto outer_at = [&](int j) { return &local.outer[row_values * (j - first)]; };
+      const auto inner_at = [&](int j) { return &local.inner[row_values * (j - first)]; };
       for (int j = rows.begin(); j < rows.end(); ++j) {
         const int span_outer_y = span(j, kOuter, height), span_inner_y = span(j, kInner, height);
-        float* row_exp = &exp[3 * size_t(j) * width];
-        const float* row_lin = &lin[3 * size_t(j) * width];
+        float* row_exp = &exp[row_values * j];
+        const float* row_lin = &local.linear[row_values * (j - first)];
         if (j >= kOuter && j + kOuter < height) {
-          const float* o[5];
-          const float* n[3];
-          for (int d = -kOuter; d <= kOuter; ++d) o[d + kOuter] = &outer[3 * size_t(j + d) * width];
-          for (int d = -kInner; d <= kInner; ++d) n[d + kInner] = &inner[3 * size_t(j + d) * width];
+          const float *o0 = outer_at(j - 2), *o1 = outer_at(j - 1), *o2 = outer_at(j), *o3 = outer_at(j + 1),
+                      *o4 = outer_at(j + 2);
+          const float *n0 = inner_at(j - 1), *n1 = inner_at(j), *n2 = inner_at(j + 1);
           for (int i = 0; i < width; ++i) {
             const int count = span_outer_x[i] * span_outer_y - span_inner_x[i] * span_inner_y;
             for (int c = 0; c < 3; ++c) {
               const size_t k = 3 * size_t(i) + c;
               double ring = 0.0;
-              ring += o[0][k];
-              ring += o[1][k];
-              ring -= n[0][k];
-              ring += o[2][k];
-              ring -= n[1][k];
-              ring += o[3][k];
-              ring -= n[2][k];
-              ring += o[4][k];
+              ring += o0[k];
+              ring += o1[k];
+              ring -= n0[k];
+              ring += o2[k];
+              ring -= n1[k];
+              ring += o3[k];
+              ring -= n2[k];
+              ring += o4[k];
               // A window too small for any ring pixel: the pixel's own value.
               row_exp[k] = count > 0 ? static_cast<float>(ring / count) : row_lin[k];
             }
@@ -486,8 +498,8 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
             double ring = 0.0;
             for (int d = -kOuter; d <= kOuter; ++d) {
               if (j + d < 0 || j + d >= height) continue;
-              ring += outer[3 * (size_t(j + d) * width + i) + c];
-              if (std::abs(d) <= kInner) ring -= inner[3 * (size_t(j + d) * width + i) + c];
+              ring += outer_at(j + d)[3 * i + c];
+              if (std::abs(d) <= kInner) ring -= inner_at(j + d)[3 * i + c];
             }
             // A window too small for any ring pixel (a 1x1 window): the pixel's own value.
             row_exp[3 * i + c] = count > 0 ? static_cast<float>(ring / count) : row_lin[3 * i + c];
