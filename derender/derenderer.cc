@@ -427,10 +427,11 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels&
   }
 }
 
-// DerenderPhoto (derenderer.h) on either kind of radiometry (ImagePixels, WindowPixels).
-template <class Pixels>
+// DerenderPhoto (derenderer.h) on either kind of radiometry (ImagePixels, WindowPixels), for a
+// surface of type Surface (a concrete analytic shape: its Intersect is inlined into the pixel loop).
+template <class Pixels, class Surface>
 void DerenderAnalyticPhoto(const Session& session, size_t photo_index, const Pixels& image,
-                           const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
+                           const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
                            const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
                            ExposureTally* exposure) {
   const PhotoSpec& photo = session.photos[photo_index];
@@ -709,8 +710,18 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
                                             options, &w->samples, &w->mesh_stats);
                           AddCounts(w->mesh_stats.counts, &w->rejected);
                         } else {
-                          DerenderAnalyticPhoto(session, groups[g].front(), WindowPixels(w->image), rays, sample,
-                                                options, &w->samples, &w->rejected, &w->exposure);
+                          const WindowPixels pixels(w->image);
+                          const auto derender = [&](const auto& surface) {
+                            DerenderAnalyticPhoto(session, groups[g].front(), pixels, rays, surface, options,
+                                                  &w->samples, &w->rejected, &w->exposure);
+                          };
+                          if (const auto* sphere = dynamic_cast<const SphereSample*>(&sample)) {
+                            derender(*sphere);
+                          } else if (const auto* cylinder = dynamic_cast<const CylinderSample*>(&sample)) {
+                            derender(*cylinder);
+                          } else {
+                            derender(sample);
+                          }
                         }
                         // Counted here, while the photo's samples are in cache, not over the whole result afterwards.
                         w->channels_not_measured = {};
