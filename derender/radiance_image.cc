@@ -391,6 +391,13 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
   }
   const int interior_begin = std::min(kOuter, width), interior_end = std::max(width - kOuter, interior_begin);
   const size_t row_values = 3 * size_t(width);
+  // Ring pixel counts of each value of a row at least kOuter rows from the window's top and bottom.
+  std::vector<int> interior_row_count(row_values);
+  for (int i = 0; i < width; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      interior_row_count[3 * i + c] = span_outer_x[i] * (2 * kOuter + 1) - span_inner_x[i] * (2 * kInner + 1);
+    }
+  }
   // Per thread: the linear signal and the horizontal sums of a block of rows and its kOuter rows above
   // and below, small enough to stay in cache (the blocks' halo rows are computed twice).
   struct RowBuffers {
@@ -473,22 +480,19 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
           const float *o0 = outer_at(j - 2), *o1 = outer_at(j - 1), *o2 = outer_at(j), *o3 = outer_at(j + 1),
                       *o4 = outer_at(j + 2);
           const float *n0 = inner_at(j - 1), *n1 = inner_at(j), *n2 = inner_at(j + 1);
-          for (int i = 0; i < width; ++i) {
-            const int count = span_outer_x[i] * span_outer_y - span_inner_x[i] * span_inner_y;
-            for (int c = 0; c < 3; ++c) {
-              const size_t k = 3 * size_t(i) + c;
-              double ring = 0.0;
-              ring += o0[k];
-              ring += o1[k];
-              ring -= n0[k];
-              ring += o2[k];
-              ring -= n1[k];
-              ring += o3[k];
-              ring -= n2[k];
-              ring += o4[k];
-              // A window too small for any ring pixel: the pixel's own value.
-              row_exp[k] = count > 0 ? static_cast<float>(ring / count) : row_lin[k];
-            }
+          for (size_t k = 0; k < row_values; ++k) {
+            double ring = 0.0;
+            ring += o0[k];
+            ring += o1[k];
+            ring -= n0[k];
+            ring += o2[k];
+            ring -= n1[k];
+            ring += o3[k];
+            ring -= n2[k];
+            ring += o4[k];
+            // A window too small for any ring pixel: the pixel's own value.
+            const int count = interior_row_count[k];
+            row_exp[k] = count > 0 ? static_cast<float>(ring / count) : row_lin[k];
           }
           continue;
         }
