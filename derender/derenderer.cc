@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <mutex>
 
@@ -641,6 +642,24 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   }
   const std::vector<Eigen::Vector2f> rays = PixelRaysInBox(session.camera, ray_box);
   const RadianceReader reader(session);
+  // A mask that several groups use (the session's default mask, usually) is decoded once, here;
+  // masks of one group only are read as their group is worked on.
+  std::vector<std::shared_ptr<const std::vector<uint8_t>>> shared_masks(groups.size());
+  {
+    std::map<std::vector<std::string>, std::vector<size_t>> groups_by_masks;
+    for (size_t g = 0; g < groups.size(); ++g) {
+      std::vector<std::string> paths;
+      for (size_t i : groups[g]) paths.push_back(session.PhotoMaskPath(i));
+      groups_by_masks[paths].push_back(g);
+    }
+    for (const auto& [paths, users] : groups_by_masks) {
+      bool any_mask = false;
+      for (const std::string& path : paths) any_mask = any_mask || !path.empty();
+      if (!any_mask || users.size() < 2) continue;
+      const auto mask = std::make_shared<const std::vector<uint8_t>>(ReadGroupMask(session, groups[users.front()]));
+      for (size_t g : users) shared_masks[g] = mask;
+    }
+  }
   // Each photo (exposure group) is linearized only inside the pixel box that can see the sample (the
   // per-pixel loops below trace nothing outside it). A TBB pipeline keeps a few photos in flight, so
   // one is decoded while another's pixels are worked on; each token's buffers (decoded files,
@@ -701,7 +720,11 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
                         w->decode_s = 0.0;
                         reader.PrepareWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1},
                                              &w->image, &w->decode_s);
-                        w->image.mask = ReadGroupMask(session, groups[g]);
+                        if (shared_masks[g]) {
+                          w->image.mask = *shared_masks[g];
+                        } else {
+                          w->image.mask = ReadGroupMask(session, groups[g]);
+                        }
                         // Room for every examined pixel: reserved once per buffer (regrowth copies and page faults
                         // cost more than the per-pixel geometry).
                         ReserveWithHugePages(&w->samples, PixelsPerImage(session.camera, options.pixel_stride));
