@@ -51,10 +51,13 @@ class AnalyticSample : public SampleSurface {
 };
 
 // final, and Intersect inline (below): the derenderer calls it per pixel through the concrete type.
+// Declared inline in the class so that it is not the key function: the vtable stays in
+// analytic_sample.cc (with Contains), not in every file that includes this header.
 class SphereSample final : public AnalyticSample {
  public:
   SphereSample(const Eigen::Vector3d& center, double radius) : center_(center), radius_(radius) {}
-  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const override;
+  inline bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                        SurfaceHit* hit) const override;
   bool Contains(const Eigen::Vector3d& point) const override;
   Eigen::Vector3d BoundingCenter() const override { return center_; }
   double BoundingRadius() const override { return radius_; }
@@ -69,7 +72,8 @@ class CylinderSample final : public AnalyticSample {
  public:
   CylinderSample(const Eigen::Vector3d& center, const Eigen::Vector3d& axis, double radius, double length)
       : center_(center), axis_(axis.normalized()), radius_(radius), half_length_(0.5 * length) {}
-  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const override;
+  inline bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                        SurfaceHit* hit) const override;
   bool Contains(const Eigen::Vector3d& point) const override;
   Eigen::Vector3d BoundingCenter() const override { return center_; }
   double BoundingRadius() const override;
