@@ -2,6 +2,7 @@
 // exact normals, no mesh (a scene models only what it needs).
 #pragma once
 
+#include <cmath>
 #include <memory>
 
 #include <Eigen/Core>
@@ -49,10 +50,14 @@ class AnalyticSample : public SampleSurface {
   static std::unique_ptr<AnalyticSample> Create(const SampleSpec& spec);
 };
 
-class SphereSample : public AnalyticSample {
+// final, and Intersect inline (below): the derenderer calls it per pixel through the concrete type.
+// Declared inline in the class so that it is not the key function: the vtable stays in
+// analytic_sample.cc (with Contains), not in every file that includes this header.
+class SphereSample final : public AnalyticSample {
  public:
   SphereSample(const Eigen::Vector3d& center, double radius) : center_(center), radius_(radius) {}
-  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const override;
+  inline bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                        SurfaceHit* hit) const override;
   bool Contains(const Eigen::Vector3d& point) const override;
   Eigen::Vector3d BoundingCenter() const override { return center_; }
   double BoundingRadius() const override { return radius_; }
@@ -63,11 +68,12 @@ class SphereSample : public AnalyticSample {
 };
 
 // A closed circular cylinder: the curved side is the sample, the end caps are unmeasured (black).
-class CylinderSample : public AnalyticSample {
+class CylinderSample final : public AnalyticSample {
  public:
   CylinderSample(const Eigen::Vector3d& center, const Eigen::Vector3d& axis, double radius, double length)
       : center_(center), axis_(axis.normalized()), radius_(radius), half_length_(0.5 * length) {}
-  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, SurfaceHit* hit) const override;
+  inline bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                        SurfaceHit* hit) const override;
   bool Contains(const Eigen::Vector3d& point) const override;
   Eigen::Vector3d BoundingCenter() const override { return center_; }
   double BoundingRadius() const override;
@@ -78,5 +84,54 @@ class CylinderSample : public AnalyticSample {
   double radius_;
   double half_length_;
 };
+
+// Ray/sphere in the form of Haines et al., "Precision improvements for ray/sphere intersection" (Ray
+// Tracing Gems, ch. 7): the discriminant from the ray's closest approach, and the far root from the
+// near one by Vieta, so a small sphere far from the camera keeps its digits.
+inline bool SphereSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                    SurfaceHit* hit) const {
+  const Eigen::Vector3d f = origin - center_;
+  const double b = f.dot(direction);
+  const double c = f.squaredNorm() - radius_ * radius_;
+  if (c <= 0.0) return false;  // starts inside (or on) the sphere
+  if (b >= 0.0) return false;  // sphere behind the ray
+  const Eigen::Vector3d closest = f - b * direction;
+  const double discriminant = radius_ * radius_ - closest.squaredNorm();
+  if (discriminant < 0.0) return false;
+  const double q = -b + std::sqrt(discriminant);  // > 0
+  hit->t = c / q;                                 // the near root
+  hit->point = origin + hit->t * direction;
+  // The normal from the centre offset along the ray, not from the absolute point: no cancellation
+  // when the scene is far from the origin.
+  hit->normal = ((f + hit->t * direction) / radius_).normalized();
+  return true;
+}
+
+inline bool CylinderSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                      SurfaceHit* hit) const {
+  const Eigen::Vector3d f = origin - center_;
+  const double f_axial = f.dot(axis_);
+  const double d_axial = direction.dot(axis_);
+  const Eigen::Vector3d f_perp = f - f_axial * axis_;
+  const Eigen::Vector3d d_perp = direction - d_axial * axis_;
+  const double a = d_perp.squaredNorm();
+  if (!(a > 1e-24)) return false;  // parallel to the axis: only a cap could be hit
+  const double c = f_perp.squaredNorm() - radius_ * radius_;
+  if (c <= 0.0) return false;  // inside the infinite cylinder: no outer side surface ahead
+  const double b = f_perp.dot(d_perp);
+  if (b >= 0.0) return false;
+  // |f_perp + t d_perp|^2 = a (t - t_mid)^2 + |closest|^2 with t_mid = -b / a.
+  const Eigen::Vector3d closest = f_perp - (b / a) * d_perp;
+  const double discriminant = radius_ * radius_ - closest.squaredNorm();
+  if (discriminant < 0.0) return false;
+  const double q = -b + std::sqrt(a * discriminant);
+  const double t = c / q;  // the near root
+  const double axial = f_axial + t * d_axial;
+  if (std::abs(axial) > half_length_) return false;  // above or below the side: a cap, or a miss
+  hit->t = t;
+  hit->point = origin + t * direction;
+  hit->normal = ((f_perp + t * d_perp) / radius_).normalized();
+  return true;
+}
 
 }  // namespace ibrdf

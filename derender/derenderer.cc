@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <mutex>
 
@@ -155,10 +156,42 @@ inline double HalfAngle(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo, co
   return std::acos(std::clamp(h.dot(normal), -1.0, 1.0));
 }
 
+// A photo's radiometry as the per-pixel loops read it: a radiance image merged beforehand (the public
+// DerenderPhoto), or a window whose pixels are merged on demand (the stage's pipeline), with the same
+// values either way.
+class ImagePixels {
+ public:
+  explicit ImagePixels(const RadianceImage& image) : image_(image) {}
+  // Whether the photos' masks exclude pixel (x, y).
+  bool Masked(int x, int y) const { return !image_.mask.empty() && !image_.mask[image_.Index(x, y)]; }
+  // The merged reading of pixel (x, y).
+  void At(int x, int y, PixelRadiance* v) const {
+    const size_t p = image_.Index(x, y);
+    for (int c = 0; c < 3; ++c) {
+      v->radiance[c] = image_.radiance[3 * p + c];
+      v->sigma[c] = image_.sigma[3 * p + c];
+      v->channel_flags[c] = image_.channel_flags[3 * p + c];
+    }
+    v->exposures = image_.exposures_used.empty() ? 1 : image_.exposures_used[p];
+  }
+
+ private:
+  const RadianceImage& image_;
+};
+
+class WindowPixels {
+ public:
+  explicit WindowPixels(const RadianceWindow& window) : window_(window) {}
+  bool Masked(int x, int y) const { return !window_.mask.empty() && !window_.mask[size_t(y) * window_.width() + x]; }
+  void At(int x, int y, PixelRadiance* v) const { window_.At(x, y, v); }
+
+ private:
+  const RadianceWindow& window_;
+};
+
 // f = L / E per channel, in the local frame of `normal`.
-inline BrdfSample MakeSample(const RadianceImage& image, size_t p, const Eigen::Vector3d& normal,
-                             const Incidence& incidence, const Eigen::Vector3d& wo_world, size_t photo_index, int x,
-                             int y) {
+inline BrdfSample MakeSample(const PixelRadiance& pixel, const Eigen::Vector3d& normal, const Incidence& incidence,
+                             const Eigen::Vector3d& wo_world, size_t photo_index, int x, int y) {
   const LocalFrame frame = LocalFrame::FromNormal(normal);
   const Eigen::Vector3d wi = frame.ToLocal(incidence.wi);
   const Eigen::Vector3d wo = frame.ToLocal(wo_world);
@@ -168,13 +201,13 @@ inline BrdfSample MakeSample(const RadianceImage& image, size_t p, const Eigen::
     s.wi[c] = static_cast<float>(wi[c]);
     s.wo[c] = static_cast<float>(wo[c]);
     const double irradiance = incidence.irradiance[c];
-    const bool valid = image.channel_flags[3 * p + c] == 0;
+    const bool valid = pixel.channel_flags[c] == 0;
     // A channel not measured keeps its (clipped or noisy) value, at least 0, with sigma 0 and valid 0.
-    s.brdf[c] = static_cast<float>(std::max(0.0, image.radiance[3 * p + c] / irradiance));
-    s.sigma[c] = valid ? static_cast<float>(image.sigma[3 * p + c] / irradiance) : 0.0f;
+    s.brdf[c] = static_cast<float>(std::max(0.0, pixel.radiance[c] / irradiance));
+    s.sigma[c] = valid ? static_cast<float>(pixel.sigma[c] / irradiance) : 0.0f;
     s.valid[c] = valid ? 1 : 0;
   }
-  s.exposures = image.exposures_used.empty() ? 1 : image.exposures_used[p];
+  s.exposures = pixel.exposures;
   s.theta_i = static_cast<float>(angles.theta_i);
   s.theta_e = static_cast<float>(angles.theta_e);
   s.delta_phi = static_cast<float>(angles.delta_phi);
@@ -231,7 +264,8 @@ Reason ShadowTest(const MeshSample& mesh, const Light& light, const Incidence& i
 
 // The mesh path's per-pixel work for one photo: rows of pixels in blocks across threads, each row's
 // rays handed to Embree together; samples in row-major order.
-void DerenderMeshPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
+template <class Pixels>
+void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels& image,
                        const std::vector<Eigen::Vector2f>& rays, const MeshPath& path, const DerenderOptions& options,
                        std::vector<BrdfSample>* samples, MeshPhotoStats* stats) {
   const MeshSample& mesh = *path.mesh;
@@ -243,7 +277,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
   const double cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
   const double cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
   const int stride = options.pixel_stride;
-  const int width = image.width;
+  const int width = session.camera.width;
   const bool mask_mixed = options.mask_mixed_pixels && !path.corner_rays.empty();
 
   const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, mesh);
@@ -272,8 +306,8 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
     MeshPhotoStats& local = block_stats[b];
     const size_t nx = xs.size(), nc = corner_xs.size();
     std::vector<Eigen::Vector3d> directions(nx), corner_directions(nc);
-    std::vector<SurfaceHit> hits(nx), corner_hits(nc);
-    std::unique_ptr<bool[]> found(new bool[nx]), corner_found(new bool[nc]);
+    std::vector<SurfaceHit> hits(nx);
+    std::unique_ptr<bool[]> found(new bool[nx]);
     // Corner distances (NaN: the corner ray misses) of the rows above and below the pixel row.
     std::vector<double> top(nc), bottom(nc);
     int bottom_row = -1;
@@ -282,12 +316,10 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
         const Eigen::Vector2f& xy = path.corner_rays[size_t(row) * (width + 1) + corner_xs[k]];
         corner_directions[k] = (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
       }
-      mesh.IntersectBatch(camera_center, corner_directions.data(), nc, corner_hits.data(), corner_found.get());
-      for (size_t k = 0; k < nc; ++k) {
-        (*depths)[k] = corner_found[k] ? corner_hits[k].t : std::numeric_limits<double>::quiet_NaN();
-      }
+      mesh.DepthBatch(camera_center, corner_directions.data(), nc, depths->data());
     };
     const size_t row_end = std::min(ys.size(), (b + 1) * kRowsPerBlock);
+    out.reserve(nx * (row_end - b * kRowsPerBlock));  // no regrowth: each copy costs more than the pixel's work
     for (size_t r = b * kRowsPerBlock; r < row_end; ++r) {
       const int y = ys[r];
       for (size_t i = 0; i < nx; ++i) {
@@ -316,7 +348,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
           ++local.counts[kOff];
           continue;
         }
-        if (!image.mask.empty() && !image.mask[image.Index(x, y)]) {
+        if (image.Masked(x, y)) {
           ++local.counts[kMasked];
           continue;
         }
@@ -372,14 +404,15 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
         } else {
           ++local.shadow_tests_skipped;
         }
-        const size_t p = image.Index(x, y);
-        local.exposure.Add(HalfAngle(incidence.wi, wo_world, hit.normal), &image.channel_flags[3 * p]);
-        const Reason radiometric = RadiometricReason(&image.channel_flags[3 * p]);
+        PixelRadiance pixel;
+        image.At(x, y, &pixel);
+        local.exposure.Add(HalfAngle(incidence.wi, wo_world, hit.normal), pixel.channel_flags);
+        const Reason radiometric = RadiometricReason(pixel.channel_flags);
         if (radiometric != kNumReasons) {
           ++local.counts[radiometric];
           continue;
         }
-        out.push_back(MakeSample(image, p, hit.normal, incidence, wo_world, photo_index, x, y));
+        out.push_back(MakeSample(pixel, hit.normal, incidence, wo_world, photo_index, x, y));
       }
     }
   });
@@ -393,6 +426,72 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Radianc
     stats->shadow_tests_skipped += block_stats[b].shadow_tests_skipped;
     stats->exposure.Merge(block_stats[b].exposure);
   }
+}
+
+// DerenderPhoto (derenderer.h) on either kind of radiometry (ImagePixels, WindowPixels), for a
+// surface of type Surface (a concrete analytic shape: its Intersect is inlined into the pixel loop).
+template <class Pixels, class Surface>
+void DerenderAnalyticPhoto(const Session& session, size_t photo_index, const Pixels& image,
+                           const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
+                           const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
+                           ExposureTally* exposure) {
+  const PhotoSpec& photo = session.photos[photo_index];
+  const Light& light = session.PhotoLight(photo_index);
+  const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
+  const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
+  const Eigen::Vector3d camera_center = world_from_camera.translation;
+  const double cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
+  const double cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
+  const int stride = options.pixel_stride;
+  ReasonCounts counts{};
+
+  // Only the pixels that can see the sample are traced; the others are off the sample by construction.
+  const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, sample);
+  const int x_start = (box.x0 + stride - 1) / stride * stride, y_start = (box.y0 + stride - 1) / stride * stride;
+  uint64_t traced = 0;
+  SurfaceHit hit;  // reused: Intersect sets every field it reports
+  for (int y = y_start; y < box.y1; y += stride) {
+    for (int x = x_start; x < box.x1; x += stride) {
+      ++traced;
+      const Eigen::Vector2f& xy = rays[size_t(y) * session.camera.width + x];
+      const Eigen::Vector3d direction =
+          (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+      if (!sample.Intersect(camera_center, direction, &hit)) {
+        ++counts[kOff];
+        continue;
+      }
+      if (image.Masked(x, y)) {
+        ++counts[kMasked];
+        continue;
+      }
+      const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
+      if (!incidence.lit) {
+        ++counts[kUnlit];
+        continue;
+      }
+      const Eigen::Vector3d wo_world = -direction;
+      const double cos_e = wo_world.dot(hit.normal);
+      if (!(cos_e >= cos_max_e)) {
+        ++counts[kGrazingE];
+        continue;
+      }
+      if (!(incidence.cos_theta >= cos_max_i)) {
+        ++counts[kGrazingI];
+        continue;
+      }
+      PixelRadiance pixel;
+      image.At(x, y, &pixel);
+      if (exposure) exposure->Add(HalfAngle(incidence.wi, wo_world, hit.normal), pixel.channel_flags);
+      const Reason radiometric = RadiometricReason(pixel.channel_flags);
+      if (radiometric != kNumReasons) {
+        ++counts[radiometric];
+        continue;
+      }
+      samples->push_back(MakeSample(pixel, hit.normal, incidence, wo_world, photo_index, x, y));
+    }
+  }
+  counts[kOff] += PixelsPerImage(session.camera, stride) - traced;
+  AddCounts(counts, rejected);
 }
 
 // Whether the scan's convexity report asks for shadow rays: from the scan stage's sidecar
@@ -543,6 +642,24 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   }
   const std::vector<Eigen::Vector2f> rays = PixelRaysInBox(session.camera, ray_box);
   const RadianceReader reader(session);
+  // A mask that several groups use (the session's default mask, usually) is decoded once, here;
+  // masks of one group only are read as their group is worked on.
+  std::vector<std::shared_ptr<const std::vector<uint8_t>>> shared_masks(groups.size());
+  {
+    std::map<std::vector<std::string>, std::vector<size_t>> groups_by_masks;
+    for (size_t g = 0; g < groups.size(); ++g) {
+      std::vector<std::string> paths;
+      for (size_t i : groups[g]) paths.push_back(session.PhotoMaskPath(i));
+      groups_by_masks[paths].push_back(g);
+    }
+    for (const auto& [paths, users] : groups_by_masks) {
+      bool any_mask = false;
+      for (const std::string& path : paths) any_mask = any_mask || !path.empty();
+      if (!any_mask || users.size() < 2) continue;
+      const auto mask = std::make_shared<const std::vector<uint8_t>>(ReadGroupMask(session, groups[users.front()]));
+      for (size_t g : users) shared_masks[g] = mask;
+    }
+  }
   // Each photo (exposure group) is linearized only inside the pixel box that can see the sample (the
   // per-pixel loops below trace nothing outside it). A TBB pipeline keeps a few photos in flight, so
   // one is decoded while another's pixels are worked on; each token's buffers (decoded files,
@@ -550,13 +667,13 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   // order, byte-identical to a photo-by-photo loop.
   struct PhotoWork {
     size_t group = 0;
-    std::vector<Image> decoded;
-    RadianceImage image;
+    RadianceWindow image;  // the decoded exposures, merged pixel by pixel on demand
     std::vector<BrdfSample> samples;
     RejectionCounts rejected;
     MeshPhotoStats mesh_stats;
     ExposureTally exposure;  // analytic path
     double decode_s = 0.0;
+    std::array<uint64_t, 3> channels_not_measured{};
   };
   // One photo in flight per thread and one more waiting its turn in the in-order merge: each token
   // holds full-frame buffers (tens of MB whose first touch costs page faults), so no more than that.
@@ -578,61 +695,81 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   ProgressBar progress("photos", groups.size());
   size_t next_group = 0;
   tbb::parallel_pipeline(
-      tokens,
-      tbb::make_filter<void,
-                       PhotoWork*>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& control) -> PhotoWork* {
-        if (next_group == groups.size()) {
-          control.stop();
-          return nullptr;
-        }
-        PhotoWork* w = nullptr;
-        IBRDF_CHECK(idle.try_pop(w)) << "no idle photo buffers";
-        w->group = next_group++;
-        return w;
-      }) & tbb::make_filter<PhotoWork*, PhotoWork*>(tbb::filter_mode::parallel, [&](PhotoWork* w) {
-        const size_t g = w->group;
-        const PixelBox& box = boxes[g];
-        std::vector<PhotoSpec> exposures;
-        for (size_t i : groups[g]) exposures.push_back(session.photos[i]);
-        w->samples.clear();
-        w->rejected.clear();
-        w->mesh_stats = MeshPhotoStats();
-        w->exposure = ExposureTally();
-        w->decode_s = 0.0;
-        reader.ReadWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1}, &w->decoded,
-                          &w->image, &w->decode_s);
-        w->image.mask = ReadGroupMask(session, groups[g]);
-        // Room for every examined pixel: reserved once per buffer (regrowth copies and page faults
-        // cost more than the per-pixel geometry).
-        ReserveWithHugePages(&w->samples, PixelsPerImage(session.camera, options.pixel_stride));
-        if (mesh_path) {
-          DerenderMeshPhoto(session, groups[g].front(), w->image, rays, *mesh_path, options, &w->samples,
-                            &w->mesh_stats);
-          AddCounts(w->mesh_stats.counts, &w->rejected);
-        } else {
-          DerenderPhoto(session, groups[g].front(), w->image, rays, sample, options, &w->samples, &w->rejected,
-                        &w->exposure);
-        }
-        return w;
-      }) & tbb::make_filter<PhotoWork*, void>(tbb::filter_mode::serial_in_order, [&](PhotoWork* w) {
-        result.samples.insert(result.samples.end(), w->samples.begin(), w->samples.end());
-        for (const auto& [reason, count] : w->rejected) result.summary.rejected[reason] += count;
-        result.summary.decode_s += w->decode_s;
-        result.summary.shadow_rays += w->mesh_stats.shadow_rays;
-        result.summary.shadow_tests_skipped += w->mesh_stats.shadow_tests_skipped;
-        result.summary.exposure.Merge(w->exposure);
-        result.summary.exposure.Merge(w->mesh_stats.exposure);
-        idle.push(w);
-        progress.Add(1);
-      }));
+      tokens, tbb::make_filter<void, PhotoWork*>(tbb::filter_mode::serial_in_order,
+                                                 [&](tbb::flow_control& control) -> PhotoWork* {
+                                                   if (next_group == groups.size()) {
+                                                     control.stop();
+                                                     return nullptr;
+                                                   }
+                                                   PhotoWork* w = nullptr;
+                                                   IBRDF_CHECK(idle.try_pop(w)) << "no idle photo buffers";
+                                                   w->group = next_group++;
+                                                   return w;
+                                                 }) &
+                  tbb::make_filter<PhotoWork*, PhotoWork*>(
+                      tbb::filter_mode::parallel,
+                      [&](PhotoWork* w) {
+                        const size_t g = w->group;
+                        const PixelBox& box = boxes[g];
+                        std::vector<PhotoSpec> exposures;
+                        for (size_t i : groups[g]) exposures.push_back(session.photos[i]);
+                        w->samples.clear();
+                        w->rejected.clear();
+                        w->mesh_stats = MeshPhotoStats();
+                        w->exposure = ExposureTally();
+                        w->decode_s = 0.0;
+                        reader.PrepareWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1},
+                                             &w->image, &w->decode_s);
+                        if (shared_masks[g]) {
+                          w->image.mask = *shared_masks[g];
+                        } else {
+                          w->image.mask = ReadGroupMask(session, groups[g]);
+                        }
+                        // Room for every examined pixel: reserved once per buffer (regrowth copies and page faults
+                        // cost more than the per-pixel geometry).
+                        ReserveWithHugePages(&w->samples, PixelsPerImage(session.camera, options.pixel_stride));
+                        if (mesh_path) {
+                          DerenderMeshPhoto(session, groups[g].front(), WindowPixels(w->image), rays, *mesh_path,
+                                            options, &w->samples, &w->mesh_stats);
+                          AddCounts(w->mesh_stats.counts, &w->rejected);
+                        } else {
+                          const WindowPixels pixels(w->image);
+                          const auto derender = [&](const auto& surface) {
+                            DerenderAnalyticPhoto(session, groups[g].front(), pixels, rays, surface, options,
+                                                  &w->samples, &w->rejected, &w->exposure);
+                          };
+                          if (const auto* sphere = dynamic_cast<const SphereSample*>(&sample)) {
+                            derender(*sphere);
+                          } else if (const auto* cylinder = dynamic_cast<const CylinderSample*>(&sample)) {
+                            derender(*cylinder);
+                          } else {
+                            derender(sample);
+                          }
+                        }
+                        // Counted here, while the photo's samples are in cache, not over the whole result afterwards.
+                        w->channels_not_measured = {};
+                        for (const BrdfSample& s : w->samples) {
+                          for (int c = 0; c < 3; ++c) w->channels_not_measured[c] += s.valid[c] == 0;
+                        }
+                        return w;
+                      }) &
+                  tbb::make_filter<PhotoWork*, void>(tbb::filter_mode::serial_in_order, [&](PhotoWork* w) {
+                    result.samples.insert(result.samples.end(), w->samples.begin(), w->samples.end());
+                    for (const auto& [reason, count] : w->rejected) result.summary.rejected[reason] += count;
+                    result.summary.decode_s += w->decode_s;
+                    for (int c = 0; c < 3; ++c) result.summary.channels_not_measured[c] += w->channels_not_measured[c];
+                    result.summary.shadow_rays += w->mesh_stats.shadow_rays;
+                    result.summary.shadow_tests_skipped += w->mesh_stats.shadow_tests_skipped;
+                    result.summary.exposure.Merge(w->exposure);
+                    result.summary.exposure.Merge(w->mesh_stats.exposure);
+                    idle.push(w);
+                    progress.Add(1);
+                  }));
   progress.Finish();
   const size_t measured = groups.size();
   result.summary.photos = measured;
   result.summary.pixels_examined = PixelsPerImage(session.camera, options.pixel_stride) * measured;
   result.summary.accepted = result.samples.size();
-  for (const BrdfSample& s : result.samples) {
-    for (int c = 0; c < 3; ++c) result.summary.channels_not_measured[c] += s.valid[c] == 0;
-  }
   bool bracketed = false;
   for (const auto& group : groups) bracketed = bracketed || group.size() > 1;
   result.summary.exposure_warnings = AdviseExposure(result.summary.exposure, options.exposure_advice, bracketed);
@@ -724,62 +861,7 @@ void DerenderPhoto(const Session& session, size_t photo_index, const RadianceIma
                    const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
                    const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
                    ExposureTally* exposure) {
-  const PhotoSpec& photo = session.photos[photo_index];
-  const Light& light = session.PhotoLight(photo_index);
-  const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
-  const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
-  const Eigen::Vector3d camera_center = world_from_camera.translation;
-  const double cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
-  const double cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
-  const int stride = options.pixel_stride;
-  ReasonCounts counts{};
-
-  // Only the pixels that can see the sample are traced; the others are off the sample by construction.
-  const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, sample);
-  const int x_start = (box.x0 + stride - 1) / stride * stride, y_start = (box.y0 + stride - 1) / stride * stride;
-  uint64_t traced = 0;
-  SurfaceHit hit;  // reused: Intersect sets every field it reports
-  for (int y = y_start; y < box.y1; y += stride) {
-    for (int x = x_start; x < box.x1; x += stride) {
-      ++traced;
-      const Eigen::Vector2f& xy = rays[size_t(y) * image.width + x];
-      const Eigen::Vector3d direction =
-          (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
-      if (!sample.Intersect(camera_center, direction, &hit)) {
-        ++counts[kOff];
-        continue;
-      }
-      if (!image.mask.empty() && !image.mask[image.Index(x, y)]) {
-        ++counts[kMasked];
-        continue;
-      }
-      const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
-      if (!incidence.lit) {
-        ++counts[kUnlit];
-        continue;
-      }
-      const Eigen::Vector3d wo_world = -direction;
-      const double cos_e = wo_world.dot(hit.normal);
-      if (!(cos_e >= cos_max_e)) {
-        ++counts[kGrazingE];
-        continue;
-      }
-      if (!(incidence.cos_theta >= cos_max_i)) {
-        ++counts[kGrazingI];
-        continue;
-      }
-      const size_t p = image.Index(x, y);
-      if (exposure) exposure->Add(HalfAngle(incidence.wi, wo_world, hit.normal), &image.channel_flags[3 * p]);
-      const Reason radiometric = RadiometricReason(&image.channel_flags[3 * p]);
-      if (radiometric != kNumReasons) {
-        ++counts[radiometric];
-        continue;
-      }
-      samples->push_back(MakeSample(image, p, hit.normal, incidence, wo_world, photo_index, x, y));
-    }
-  }
-  counts[kOff] += PixelsPerImage(session.camera, stride) - traced;
-  AddCounts(counts, rejected);
+  DerenderAnalyticPhoto(session, photo_index, ImagePixels(image), rays, sample, options, samples, rejected, exposure);
 }
 
 DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& options) {

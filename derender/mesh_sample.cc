@@ -172,8 +172,9 @@ MeshSample::MeshSample(const ScanMesh& mesh, const Sim3d& world_from_mesh, const
 
 MeshSample::~MeshSample() = default;
 
-bool MeshSample::CompleteHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, unsigned face,
-                             float t_float, float u_float, float v_float, SurfaceHit* hit) const {
+bool MeshSample::RefineHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, unsigned face,
+                           float t_float, float u_float, float v_float, double* t_out, double* u_out,
+                           double* v_out) const {
   const Eigen::Vector3i& f = faces_[face];
   const Eigen::Vector3d& p0 = points_[f[0]];
   const Eigen::Vector3d& p1 = points_[f[1]];
@@ -199,7 +200,18 @@ bool MeshSample::CompleteHit(const Eigen::Vector3d& origin, const Eigen::Vector3
       v = v_double;
     }
   }
-  if (!(t > 0.0) || !std::isfinite(t)) return false;
+  *t_out = t;
+  *u_out = u;
+  *v_out = v;
+  return t > 0.0 && std::isfinite(t);
+}
+
+bool MeshSample::CompleteHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, unsigned face,
+                             float t_float, float u_float, float v_float, SurfaceHit* hit) const {
+  double t, u, v;
+  if (!RefineHit(origin, direction, face, t_float, u_float, v_float, &t, &u, &v)) return false;
+  const Eigen::Vector3i& f = faces_[face];
+  const Eigen::Vector3d e1 = points_[f[1]] - points_[f[0]], e2 = points_[f[2]] - points_[f[0]];
   // Embree's robust test may accept a hit a rounding error outside the face: clamp to it.
   u = std::clamp(u, 0.0, 1.0);
   v = std::clamp(v, 0.0, 1.0 - u);
@@ -232,14 +244,24 @@ bool MeshSample::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d&
   return CompleteHit(origin, direction, rayhit.hit.primID, rayhit.ray.tfar, rayhit.hit.u, rayhit.hit.v, hit);
 }
 
-void MeshSample::IntersectBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count,
-                                SurfaceHit* hits, bool* found) const {
+template <class OnHit, class OnMiss>
+void MeshSample::CastBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count, OnHit on_hit,
+                           OnMiss on_miss) const {
   const Eigen::Vector3f o = (origin - origin_).cast<float>();
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   switch (ray_mode_) {
     case RayMode::kSingle:
-      for (size_t i = 0; i < count; ++i) found[i] = Intersect(origin, directions[i], &hits[i]);
+      for (size_t i = 0; i < count; ++i) {
+        RTCRayHit rayhit;
+        InitRayHit(o, directions[i].cast<float>(), &rayhit);
+        rtcIntersect1(embree_->scene.scene, &context, &rayhit);
+        if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+          on_miss(i);
+        } else {
+          on_hit(i, rayhit.hit.primID, rayhit.ray.tfar, rayhit.hit.u, rayhit.hit.v);
+        }
+      }
       return;
     case RayMode::kPacket8: {
       context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -269,10 +291,11 @@ void MeshSample::IntersectBatch(const Eigen::Vector3d& origin, const Eigen::Vect
         }
         rtcIntersect8(valid, embree_->scene.scene, &context, &packet);
         for (size_t k = 0; k < lanes; ++k) {
-          const size_t i = begin + k;
-          found[i] = packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID &&
-                     CompleteHit(origin, directions[i], packet.hit.primID[k], packet.ray.tfar[k], packet.hit.u[k],
-                                 packet.hit.v[k], &hits[i]);
+          if (packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
+            on_miss(begin + k);
+          } else {
+            on_hit(begin + k, packet.hit.primID[k], packet.ray.tfar[k], packet.hit.u[k], packet.hit.v[k]);
+          }
         }
       }
       return;
@@ -283,13 +306,37 @@ void MeshSample::IntersectBatch(const Eigen::Vector3d& origin, const Eigen::Vect
       for (size_t i = 0; i < count; ++i) InitRayHit(o, directions[i].cast<float>(), &stream[i]);
       rtcIntersect1M(embree_->scene.scene, &context, stream.data(), unsigned(count), sizeof(RTCRayHit));
       for (size_t i = 0; i < count; ++i) {
-        found[i] = stream[i].hit.geomID != RTC_INVALID_GEOMETRY_ID &&
-                   CompleteHit(origin, directions[i], stream[i].hit.primID, stream[i].ray.tfar, stream[i].hit.u,
-                               stream[i].hit.v, &hits[i]);
+        if (stream[i].hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+          on_miss(i);
+        } else {
+          on_hit(i, stream[i].hit.primID, stream[i].ray.tfar, stream[i].hit.u, stream[i].hit.v);
+        }
       }
       return;
     }
   }
+}
+
+void MeshSample::IntersectBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count,
+                                SurfaceHit* hits, bool* found) const {
+  CastBatch(
+      origin, directions, count,
+      [&](size_t i, unsigned face, float t, float u, float v) {
+        found[i] = CompleteHit(origin, directions[i], face, t, u, v, &hits[i]);
+      },
+      [&](size_t i) { found[i] = false; });
+}
+
+void MeshSample::DepthBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count,
+                            double* depths) const {
+  constexpr double kMiss = std::numeric_limits<double>::quiet_NaN();
+  CastBatch(
+      origin, directions, count,
+      [&](size_t i, unsigned face, float t_float, float u_float, float v_float) {
+        double t, u, v;
+        depths[i] = RefineHit(origin, directions[i], face, t_float, u_float, v_float, &t, &u, &v) ? t : kMiss;
+      },
+      [&](size_t i) { depths[i] = kMiss; });
 }
 
 bool MeshSample::Contains(const Eigen::Vector3d& point) const {

@@ -47,6 +47,9 @@ class MeshSample : public SampleSurface {
   // directions[i] hit, hits[i] what it hit. Same results as Intersect, faster in kPacket8/kStream.
   void IntersectBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count, SurfaceHit* hits,
                       bool* found) const;
+  // The distance of each ray's hit alone, as IntersectBatch would report it in SurfaceHit::t (NaN where
+  // the ray misses): for rays whose depth is all that is needed (the mixed-pixel test's pixel corners).
+  void DepthBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count, double* depths) const;
   // Inside when rays along all six axis directions leave through back faces (exact for a closed
   // mesh; an open scan has no inside and gives false almost everywhere).
   bool Contains(const Eigen::Vector3d& point) const override;
@@ -74,6 +77,15 @@ class MeshSample : public SampleSurface {
   // recomputation finds nothing usable.
   bool CompleteHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, unsigned face, float t, float u,
                    float v, SurfaceHit* hit) const;
+  // CompleteHit's first half: t, u and v recomputed in double (not yet clamped to the face); false
+  // where no positive finite t remains.
+  bool RefineHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, unsigned face, float t_float,
+                 float u_float, float v_float, double* t, double* u, double* v) const;
+  // Casts the rays (IntersectBatch's modes) and calls on_hit(i, face, t, u, v) for each ray Embree hits
+  // (in order of i within each packet), on_miss(i) for the others.
+  template <class OnHit, class OnMiss>
+  void CastBatch(const Eigen::Vector3d& origin, const Eigen::Vector3d* directions, size_t count, OnHit on_hit,
+                 OnMiss on_miss) const;
 
   Eigen::Vector3d origin_;               // world; the local frame's origin
   std::vector<Eigen::Vector3d> points_;  // world - origin_, double

@@ -7,6 +7,7 @@
 #include <mutex>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "core/error.h"
@@ -121,10 +122,10 @@ struct RadianceReader::Impl {
   RadiometrySpec radiometry;
   std::string directory;
   int width = 0, height = 0;
-  bool linear = false;            // a linear response: file values are the signal (no call per value)
-  bool table = false;             // use the lookup table (non-linear responses)
+  bool linear = false;             // a linear response: file values are the signal (no call per value)
+  bool table = false;              // use the lookup table (non-linear responses)
   double quantization_step = 0.0;  // one file step, 1 / (2^bits - 1), with a noise model of bits > 0
-  std::vector<double> to_linear;  // response^-1 at kTableIntervals + 1 nodes over [0, 1]
+  std::vector<double> to_linear;   // response^-1 at kTableIntervals + 1 nodes over [0, 1]
   std::shared_ptr<const FlatField> flat;
 
   double ToLinear(double encoded) const {
@@ -184,8 +185,147 @@ RadianceImage RadianceReader::Read(const std::vector<PhotoSpec>& exposures, doub
   return out;
 }
 
-void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
-                                std::vector<Image>* decoded, RadianceImage* radiance_image, double* decode_s) const {
+// The exposures of one pose prepared inside a window: what the per-pixel merge reads besides the
+// decoded files (RadianceReader::Prepare), and the merge itself.
+struct RadianceReader::Exposures {
+  const Impl* impl = nullptr;
+  const Image* images = nullptr;  // m decoded files
+  size_t m = 0;
+  PixelWindow window;
+  int window_width = 0, window_height = 0;
+  size_t area = 0;
+  double min_signal = 0.0;
+  bool noise = false;
+  const float* inverse_flat = nullptr;
+  std::vector<double> saturation;   // per exposure: float files have none unless the session states one
+  std::vector<double> scale;        // per exposure: exposure_s * gain
+  const float* expected = nullptr;  // 3 * area per exposure: the mean linear signal over the floor's ring
+
+  // The merged reading of pixel (x, y) inside the window and, with kPixelFlags, its per-pixel flags
+  // (every channel, own values).
+  template <bool kPixelFlags>
+  void Merge(int x, int y, PixelRadiance* out, uint8_t* pixel_flags) const;
+};
+
+template <bool kPixelFlags>
+void RadianceReader::Exposures::Merge(int x, int y, PixelRadiance* out, uint8_t* pixel_flags) const {
+  const RadiometrySpec& radiometry = impl->radiometry;
+  const size_t p = size_t(y) * impl->width + x;
+  const size_t q = size_t(y - window.y0) * window_width + (x - window.x0);
+  // Per exposure of the pixel (a bracket holds at most 255).
+  double encoded[3 * 255], radiance[3 * 255];
+  uint8_t flags[255], channel[3 * 255];
+  double inverse[3] = {1.0, 1.0, 1.0};
+  if (inverse_flat) {
+    for (int c = 0; c < 3; ++c) inverse[c] = inverse_flat[3 * p + c];
+  }
+  // Each exposure on its own: the pixel's flags (every channel, own values), each channel's flags
+  // (the floor on the expected signal) and the radiance.
+  uint8_t all_flags = 0xff;
+  bool any_clean = false;
+  for (size_t e = 0; e < m; ++e) {
+    const Image& image = images[e];
+    const float* values = &image.pixels[p * image.channels];
+    bool finite = true, saturated = false;
+    double darkest = 1e300;
+    for (int c = 0; c < 3; ++c) {
+      const double v = values[image.channels == 1 ? 0 : c];
+      encoded[3 * e + c] = v;
+      const bool finite_c = std::isfinite(v);
+      const bool saturated_c = v >= saturation[e];
+      const double linear_c = impl->ToLinear(v) - radiometry.black_level;
+      if (kPixelFlags) {
+        finite = finite && finite_c;
+        saturated = saturated || saturated_c;
+        darkest = std::min(darkest, linear_c);
+      }
+      radiance[3 * e + c] = linear_c / scale[e] * inverse[c];
+      uint8_t fc = 0;
+      if (!finite_c) fc |= kPixelNonFinite;
+      if (saturated_c) fc |= kPixelSaturated;
+      if (!(expected[3 * (area * e + q) + c] >= min_signal)) fc |= kPixelBelowSignal;
+      channel[3 * e + c] = fc;
+    }
+    if (kPixelFlags) {
+      uint8_t f = 0;
+      if (!finite) f |= kPixelNonFinite;
+      if (saturated) f |= kPixelSaturated;
+      if (!(darkest >= min_signal)) f |= kPixelBelowSignal;
+      flags[e] = f;
+      all_flags &= f;
+      any_clean = any_clean || f == 0;
+    }
+  }
+  if (kPixelFlags) {
+    if (any_clean) {
+      *pixel_flags = 0;
+    } else {
+      // No exposure with every channel usable: the reasons every exposure shares, or for mixed
+      // reasons the one a longer exposure would not fix (clipping) before the one it would (the floor).
+      uint8_t f = all_flags;
+      if (f == 0) {
+        bool any_saturated = false;
+        for (size_t e = 0; e < m; ++e) any_saturated = any_saturated || (flags[e] & kPixelSaturated);
+        f = any_saturated ? kPixelSaturated : kPixelBelowSignal;
+      }
+      *pixel_flags = f;
+    }
+  }
+  int used = 0;
+  for (int c = 0; c < 3; ++c) {
+    // `best` is the exposure usable in this channel with the most signal (the longest), the
+    // reference for the noise model's weights.
+    int best = -1, longest = 0;
+    uint8_t shared = 0xff;
+    bool any_saturated = false;
+    for (size_t e = 0; e < m; ++e) {
+      const uint8_t fc = channel[3 * e + c];
+      shared &= fc;
+      any_saturated = any_saturated || (fc & kPixelSaturated);
+      if (scale[e] > scale[longest]) longest = int(e);
+      if (fc == 0 && (best < 0 || scale[e] > scale[best])) best = int(e);
+    }
+    if (best < 0) {
+      const uint8_t mixed = any_saturated ? kPixelSaturated : kPixelBelowSignal;
+      out->channel_flags[c] = shared != 0 ? shared : mixed;
+      out->radiance[c] = static_cast<float>(radiance[3 * longest + c]);
+      out->sigma[c] = 0.0f;
+      continue;
+    }
+    // Inverse-variance weights, the variance predicted from the reference radiance (not from
+    // each exposure's own noisy value, which would favour exposures that happened to read low).
+    const double reference = radiance[3 * best + c];
+    double weight_sum = 0.0, weighted = 0.0;
+    int used_c = 0;
+    for (size_t e = 0; e < m; ++e) {
+      if (channel[3 * e + c] != 0) continue;
+      double weight;
+      if (noise) {
+        const double to_radiance = inverse[c] / scale[e];
+        const double signal = reference / to_radiance;
+        weight = 1.0 / (impl->SignalVariance(encoded[3 * e + c], signal) * to_radiance * to_radiance);
+      } else {
+        weight = scale[e] * scale[e];  // equal signal noise: radiance variance ~ 1 / scale^2
+      }
+      weight_sum += weight;
+      weighted += weight * radiance[3 * e + c];
+      ++used_c;
+    }
+    const double merged = weighted / weight_sum;
+    out->radiance[c] = static_cast<float>(merged);
+    out->sigma[c] = noise ? static_cast<float>(1.0 / std::sqrt(weight_sum)) : 0.0f;
+    // A negative radiance (noise around a tiny signal after the black level) is no measurement of
+    // a non-negative BRDF: flagged as below the floor (rare where the expected signal passes it).
+    out->channel_flags[c] = merged >= 0.0 ? uint8_t(0) : uint8_t(kPixelBelowSignal);
+    if (merged >= 0.0) used = std::max(used, used_c);
+  }
+  // As RadianceImage::exposures_used for a bracket; a single photo is one exposure.
+  out->exposures = m > 1 ? static_cast<uint8_t>(used) : uint8_t(1);
+}
+
+void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
+                             std::vector<Image>* decoded, std::vector<float>* scratch_buffer, Exposures* state,
+                             double* decode_s) const {
   IBRDF_CHECK(!exposures.empty());
   IBRDF_CHECK(exposures.size() < 256) << exposures.size() << " exposures";
   const Impl& impl = *impl_;
@@ -194,8 +334,16 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
   const size_t m = exposures.size();
   std::vector<Image>& images = *decoded;
   if (images.size() < m) images.resize(m);
-  std::vector<double> saturation(m);  // per exposure: float files have none unless the session states one
-  std::vector<double> scale(m);  // exposure_s * gain
+  Exposures& st = *state;
+  st.impl = &impl;
+  st.images = images.data();
+  st.m = m;
+  st.window = window;
+  st.min_signal = min_signal;
+  st.noise = radiometry.noise.has_value();
+  st.inverse_flat = impl.flat ? impl.flat->inverse.data() : nullptr;
+  st.saturation.assign(m, 0.0);
+  st.scale.assign(m, 0.0);
   for (size_t e = 0; e < m; ++e) {
     const std::string path = ResolvePath(impl.directory, exposures[e].file);
     Timer timer;
@@ -209,9 +357,169 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
     if (images[e].channels != 1 && images[e].channels < 3) {
       ThrowError(path, "expected 1 (grey) or 3+ (RGB) channels, got " + std::to_string(images[e].channels));
     }
-    scale[e] = exposures[e].exposure_s * exposures[e].gain;
-    saturation[e] = SaturationLevel(radiometry, images[e]);
+    st.scale[e] = exposures[e].exposure_s * exposures[e].gain;
+    st.saturation[e] = SaturationLevel(radiometry, images[e]);
   }
+
+  // The expected signal of every channel in every exposure: the mean linear signal over the ring of
+  // neighbours (kFloorRing*), by separable box sums over the window (5x5 minus 3x3). The sums run in
+  // the same order at the window's edges and inside it (the inside's loops only drop the bounds
+  // tests, so the compiler can vectorize them), so the values do not depend on the window.
+  const int width = window.x1 - window.x0, height = window.y1 - window.y0;
+  st.window_width = std::max(width, 0);
+  st.window_height = std::max(height, 0);
+  const size_t area = size_t(st.window_width) * st.window_height;
+  st.area = area;
+  // Every element is written before it is read, so the scratch memory is only grown, never cleared.
+  std::vector<float>& scratch = *scratch_buffer;
+  if (scratch.size() < 3 * area * m) {
+    ReserveWithHugePages(&scratch, 3 * area * m);
+    scratch.resize(3 * area * m);
+  }
+  float* const expected = scratch.data();
+  st.expected = expected;
+  if (area == 0) return;
+  constexpr int kOuter = kFloorRingOuter, kInner = kFloorRingInner;
+  // Neighbours on one side: the loops below spell the ring's sums out for these half-widths.
+  static_assert(kOuter == 2 && kInner == 1, "the ring's sums are written for a 5x5 square without its 3x3");
+  const auto span = [](int k, int half, int size) { return std::min(k + half, size - 1) - std::max(k - half, 0) + 1; };
+  // Ring pixel counts by column (outer and inner span); rows are done per row.
+  std::vector<int> span_outer_x(width), span_inner_x(width);
+  for (int i = 0; i < width; ++i) {
+    span_outer_x[i] = span(i, kOuter, width);
+    span_inner_x[i] = span(i, kInner, width);
+  }
+  const int interior_begin = std::min(kOuter, width), interior_end = std::max(width - kOuter, interior_begin);
+  const size_t row_values = 3 * size_t(width);
+  // Ring pixel counts of each value of a row at least kOuter rows from the window's top and bottom.
+  std::vector<int> interior_row_count(row_values);
+  for (int i = 0; i < width; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      interior_row_count[3 * i + c] = span_outer_x[i] * (2 * kOuter + 1) - span_inner_x[i] * (2 * kInner + 1);
+    }
+  }
+  // Per thread: the linear signal and the horizontal sums of a block of rows and its kOuter rows above
+  // and below, small enough to stay in cache (the blocks' halo rows are computed twice).
+  struct RowBuffers {
+    std::vector<float> linear, outer, inner;
+  };
+  tbb::enumerable_thread_specific<RowBuffers> buffers;
+  constexpr int kBlockRows = 32;
+  for (size_t e = 0; e < m; ++e) {
+    const Image& image = images[e];
+    float* exp = &expected[3 * area * e];
+    tbb::parallel_for(tbb::blocked_range<int>(0, height, kBlockRows), [&](const tbb::blocked_range<int>& rows) {
+      const int first = std::max(rows.begin() - kOuter, 0), last = std::min(rows.end() + kOuter, height);
+      RowBuffers& local = buffers.local();
+      const size_t needed = row_values * size_t(last - first);
+      if (local.linear.size() < needed) {
+        local.linear.resize(needed);
+        local.outer.resize(needed);
+        local.inner.resize(needed);
+      }
+      // The linear signal and the horizontal sums of rows first .. last - 1.
+      for (int j = first; j < last; ++j) {
+        float* row = &local.linear[row_values * (j - first)];
+        const float* values = &image.pixels[(size_t(j + window.y0) * impl.width + window.x0) * image.channels];
+        if (image.channels == 3 && impl.linear) {
+          const double black = radiometry.black_level;
+          for (size_t k = 0; k < row_values; ++k) {
+            const double v = values[k];
+            row[k] = static_cast<float>(std::isfinite(v) ? v - black : 0.0);
+          }
+        } else {
+          for (int i = 0; i < width; ++i) {
+            for (int c = 0; c < 3; ++c) {
+              const double v = values[i * image.channels + (image.channels == 1 ? 0 : c)];
+              const double l = std::isfinite(v) ? impl.ToLinear(v) - radiometry.black_level : 0.0;
+              row[3 * i + c] = static_cast<float>(l);
+            }
+          }
+        }
+        float* row_outer = &local.outer[row_values * (j - first)];
+        float* row_inner = &local.inner[row_values * (j - first)];
+        const auto edge = [&](int i) {
+          for (int c = 0; c < 3; ++c) {
+            double sum_outer = 0.0, sum_inner = 0.0;
+            for (int d = -kOuter; d <= kOuter; ++d) {
+              if (i + d < 0 || i + d >= width) continue;
+              const double l = row[3 * (i + d) + c];
+              sum_outer += l;
+              if (std::abs(d) <= kInner) sum_inner += l;
+            }
+            row_outer[3 * i + c] = static_cast<float>(sum_outer);
+            row_inner[3 * i + c] = static_cast<float>(sum_inner);
+          }
+        };
+        for (int i = 0; i < interior_begin; ++i) edge(i);
+        for (int k = 3 * interior_begin; k < 3 * interior_end; ++k) {
+          const double l2 = row[k - 6], l1 = row[k - 3], l0 = row[k], r1 = row[k + 3], r2 = row[k + 6];
+          double sum_outer = 0.0;
+          sum_outer += l2;
+          sum_outer += l1;
+          sum_outer += l0;
+          sum_outer += r1;
+          sum_outer += r2;
+          double sum_inner = 0.0;
+          sum_inner += l1;
+          sum_inner += l0;
+          sum_inner += r1;
+          row_outer[k] = static_cast<float>(sum_outer);
+          row_inner[k] = static_cast<float>(sum_inner);
+        }
+        for (int i = interior_end; i < width; ++i) edge(i);
+      }
+      // Vertical sums and the mean, rows of the block.
+      const auto outer_at = [&](int j) { return &local.outer[row_values * (j - first)]; };
+      const auto inner_at = [&](int j) { return &local.inner[row_values * (j - first)]; };
+      for (int j = rows.begin(); j < rows.end(); ++j) {
+        const int span_outer_y = span(j, kOuter, height), span_inner_y = span(j, kInner, height);
+        float* row_exp = &exp[row_values * j];
+        const float* row_lin = &local.linear[row_values * (j - first)];
+        if (j >= kOuter && j + kOuter < height) {
+          const float *o0 = outer_at(j - 2), *o1 = outer_at(j - 1), *o2 = outer_at(j), *o3 = outer_at(j + 1),
+                      *o4 = outer_at(j + 2);
+          const float *n0 = inner_at(j - 1), *n1 = inner_at(j), *n2 = inner_at(j + 1);
+          for (size_t k = 0; k < row_values; ++k) {
+            double ring = 0.0;
+            ring += o0[k];
+            ring += o1[k];
+            ring -= n0[k];
+            ring += o2[k];
+            ring -= n1[k];
+            ring += o3[k];
+            ring -= n2[k];
+            ring += o4[k];
+            // A window too small for any ring pixel: the pixel's own value.
+            const int count = interior_row_count[k];
+            row_exp[k] = count > 0 ? static_cast<float>(ring / count) : row_lin[k];
+          }
+          continue;
+        }
+        for (int i = 0; i < width; ++i) {
+          const int count = span_outer_x[i] * span_outer_y - span_inner_x[i] * span_inner_y;
+          for (int c = 0; c < 3; ++c) {
+            double ring = 0.0;
+            for (int d = -kOuter; d <= kOuter; ++d) {
+              if (j + d < 0 || j + d >= height) continue;
+              ring += outer_at(j + d)[3 * i + c];
+              if (std::abs(d) <= kInner) ring -= inner_at(j + d)[3 * i + c];
+            }
+            // A window too small for any ring pixel (a 1x1 window): the pixel's own value.
+            row_exp[3 * i + c] = count > 0 ? static_cast<float>(ring / count) : row_lin[3 * i + c];
+          }
+        }
+      }
+    });
+  }
+}
+
+void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
+                                std::vector<Image>* decoded, RadianceImage* radiance_image, double* decode_s) const {
+  Exposures st;
+  Prepare(exposures, min_signal, window, decoded, &radiance_image->scratch, &st, decode_s);
+  const Impl& impl = *impl_;
+  const size_t m = exposures.size();
   RadianceImage& out = *radiance_image;
   out.width = impl.width;
   out.height = impl.height;
@@ -229,189 +537,37 @@ void RadianceReader::ReadWindow(const std::vector<PhotoSpec>& exposures, double 
     out.exposures_used.clear();
   }
   out.channel_flags.resize(3 * n);
-  const bool noise = radiometry.noise.has_value();
-  const float* inverse_flat = impl.flat ? impl.flat->inverse.data() : nullptr;
-
-  // The expected signal of every channel in every exposure: the mean linear signal over the ring of
-  // neighbours (kFloorRing*), by separable box sums over the window (5x5 minus 3x3).
-  const int width = window.x1 - window.x0, height = window.y1 - window.y0;
-  const size_t area = size_t(std::max(width, 0)) * std::max(height, 0);
-  // Every element is written before it is read, so the scratch memory is only grown, never cleared.
-  std::vector<float>& scratch = out.scratch;
-  if (scratch.size() < 3 * area * (2 * m + 2)) scratch.resize(3 * area * (2 * m + 2));
-  float* const linear = scratch.data();
-  float* const expected = linear + 3 * area * m;
-  float* const outer = expected + 3 * area * m;
-  float* const inner = outer + 3 * area;
-  for (size_t e = 0; e < m; ++e) {
-    const Image& image = images[e];
-    float* lin = &linear[3 * area * e];
-    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
-      for (int j = rows.begin(); j < rows.end(); ++j) {
-        for (int i = 0; i < width; ++i) {
-          const size_t p = size_t(j + window.y0) * impl.width + (i + window.x0);
-          const float* values = &image.pixels[p * image.channels];
-          for (int c = 0; c < 3; ++c) {
-            const double v = values[image.channels == 1 ? 0 : c];
-            const double l = std::isfinite(v) ? impl.ToLinear(v) - radiometry.black_level : 0.0;
-            lin[3 * (size_t(j) * width + i) + c] = static_cast<float>(l);
-          }
-        }
-      }
-    });
-    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
-      for (int j = rows.begin(); j < rows.end(); ++j) {
-        for (int i = 0; i < width; ++i) {
-          for (int c = 0; c < 3; ++c) {
-            double sum_outer = 0.0, sum_inner = 0.0;
-            for (int d = -kFloorRingOuter; d <= kFloorRingOuter; ++d) {
-              if (i + d < 0 || i + d >= width) continue;
-              const double l = lin[3 * (size_t(j) * width + i + d) + c];
-              sum_outer += l;
-              if (std::abs(d) <= kFloorRingInner) sum_inner += l;
-            }
-            outer[3 * (size_t(j) * width + i) + c] = static_cast<float>(sum_outer);
-            inner[3 * (size_t(j) * width + i) + c] = static_cast<float>(sum_inner);
-          }
-        }
-      }
-    });
-    float* exp = &expected[3 * area * e];
-    const auto span = [](int k, int half, int size) {
-      return std::min(k + half, size - 1) - std::max(k - half, 0) + 1;
-    };
-    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
-      for (int j = rows.begin(); j < rows.end(); ++j) {
-        for (int i = 0; i < width; ++i) {
-          const int count = span(i, kFloorRingOuter, width) * span(j, kFloorRingOuter, height) -
-                            span(i, kFloorRingInner, width) * span(j, kFloorRingInner, height);
-          for (int c = 0; c < 3; ++c) {
-            double ring = 0.0;
-            for (int d = -kFloorRingOuter; d <= kFloorRingOuter; ++d) {
-              if (j + d < 0 || j + d >= height) continue;
-              ring += outer[3 * (size_t(j + d) * width + i) + c];
-              if (std::abs(d) <= kFloorRingInner) ring -= inner[3 * (size_t(j + d) * width + i) + c];
-            }
-            // A window too small for any ring pixel (a 1x1 window): the pixel's own value.
-            exp[3 * (size_t(j) * width + i) + c] =
-                count > 0 ? static_cast<float>(ring / count) : lin[3 * (size_t(j) * width + i) + c];
-          }
-        }
-      }
-    });
-  }
-
   tbb::parallel_for(tbb::blocked_range<int>(window.y0, window.y1), [&](const tbb::blocked_range<int>& rows) {
-    // Per exposure of the pixel being worked on.
-    std::vector<double> encoded(3 * m), radiance(3 * m);
-    std::vector<uint8_t> flags(m), channel(3 * m);
+    PixelRadiance pixel;
     for (int y = rows.begin(); y < rows.end(); ++y) {
       for (int x = window.x0; x < window.x1; ++x) {
         const size_t p = size_t(y) * impl.width + x;
-        const size_t q = size_t(y - window.y0) * width + (x - window.x0);
-        double inverse[3] = {1.0, 1.0, 1.0};
-        if (inverse_flat) {
-          for (int c = 0; c < 3; ++c) inverse[c] = inverse_flat[3 * p + c];
-        }
-        // Each exposure on its own: the pixel's flags (every channel, own values), each channel's flags
-        // (the floor on the expected signal) and the radiance.
-        uint8_t all_flags = 0xff;
-        bool any_clean = false;
-        for (size_t e = 0; e < m; ++e) {
-          const Image& image = images[e];
-          const float* values = &image.pixels[p * image.channels];
-          bool finite = true, saturated = false;
-          double darkest = 1e300;
-          for (int c = 0; c < 3; ++c) {
-            const double v = values[image.channels == 1 ? 0 : c];
-            encoded[3 * e + c] = v;
-            const bool finite_c = std::isfinite(v);
-            const bool saturated_c = v >= saturation[e];
-            finite = finite && finite_c;
-            saturated = saturated || saturated_c;
-            const double linear_c = impl.ToLinear(v) - radiometry.black_level;
-            darkest = std::min(darkest, linear_c);
-            radiance[3 * e + c] = linear_c / scale[e] * inverse[c];
-            uint8_t fc = 0;
-            if (!finite_c) fc |= kPixelNonFinite;
-            if (saturated_c) fc |= kPixelSaturated;
-            if (!(expected[3 * (area * e + q) + c] >= min_signal)) fc |= kPixelBelowSignal;
-            channel[3 * e + c] = fc;
-          }
-          uint8_t f = 0;
-          if (!finite) f |= kPixelNonFinite;
-          if (saturated) f |= kPixelSaturated;
-          if (!(darkest >= min_signal)) f |= kPixelBelowSignal;
-          flags[e] = f;
-          all_flags &= f;
-          any_clean = any_clean || f == 0;
-        }
-        if (any_clean) {
-          out.flags[p] = 0;
-        } else {
-          // No exposure with every channel usable: the reasons every exposure shares, or for mixed
-          // reasons the one a longer exposure would not fix (clipping) before the one it would (the floor).
-          uint8_t f = all_flags;
-          if (f == 0) {
-            bool any_saturated = false;
-            for (size_t e = 0; e < m; ++e) any_saturated = any_saturated || (flags[e] & kPixelSaturated);
-            f = any_saturated ? kPixelSaturated : kPixelBelowSignal;
-          }
-          out.flags[p] = f;
-        }
-        int used = 0;
+        st.Merge<true>(x, y, &pixel, &out.flags[p]);
         for (int c = 0; c < 3; ++c) {
-          // `best` is the exposure usable in this channel with the most signal (the longest), the
-          // reference for the noise model's weights.
-          int best = -1, longest = 0;
-          uint8_t shared = 0xff;
-          bool any_saturated = false;
-          for (size_t e = 0; e < m; ++e) {
-            const uint8_t fc = channel[3 * e + c];
-            shared &= fc;
-            any_saturated = any_saturated || (fc & kPixelSaturated);
-            if (scale[e] > scale[longest]) longest = int(e);
-            if (fc == 0 && (best < 0 || scale[e] > scale[best])) best = int(e);
-          }
-          if (best < 0) {
-            const uint8_t mixed = any_saturated ? kPixelSaturated : kPixelBelowSignal;
-            out.channel_flags[3 * p + c] = shared != 0 ? shared : mixed;
-            out.radiance[3 * p + c] = static_cast<float>(radiance[3 * longest + c]);
-            out.sigma[3 * p + c] = 0.0f;
-            continue;
-          }
-          // Inverse-variance weights, the variance predicted from the reference radiance (not from
-          // each exposure's own noisy value, which would favour exposures that happened to read low).
-          const double reference = radiance[3 * best + c];
-          double weight_sum = 0.0, weighted = 0.0;
-          int used_c = 0;
-          for (size_t e = 0; e < m; ++e) {
-            if (channel[3 * e + c] != 0) continue;
-            double weight;
-            if (noise) {
-              const double to_radiance = inverse[c] / scale[e];
-              const double signal = reference / to_radiance;
-              weight = 1.0 / (impl.SignalVariance(encoded[3 * e + c], signal) * to_radiance * to_radiance);
-            } else {
-              weight = scale[e] * scale[e];  // equal signal noise: radiance variance ~ 1 / scale^2
-            }
-            weight_sum += weight;
-            weighted += weight * radiance[3 * e + c];
-            ++used_c;
-          }
-          const double merged = weighted / weight_sum;
-          out.radiance[3 * p + c] = static_cast<float>(merged);
-          out.sigma[3 * p + c] = noise ? static_cast<float>(1.0 / std::sqrt(weight_sum)) : 0.0f;
-          // A negative radiance (noise around a tiny signal after the black level) is no measurement of
-          // a non-negative BRDF: flagged as below the floor (rare where the expected signal passes it).
-          out.channel_flags[3 * p + c] = merged >= 0.0 ? uint8_t(0) : uint8_t(kPixelBelowSignal);
-          if (merged >= 0.0) used = std::max(used, used_c);
+          out.radiance[3 * p + c] = pixel.radiance[c];
+          out.sigma[3 * p + c] = pixel.sigma[c];
+          out.channel_flags[3 * p + c] = pixel.channel_flags[c];
         }
-        if (m > 1) out.exposures_used[p] = static_cast<uint8_t>(used);
+        if (m > 1) out.exposures_used[p] = pixel.exposures;
       }
     }
   });
 }
+
+void RadianceReader::PrepareWindow(const std::vector<PhotoSpec>& exposures, double min_signal,
+                                   const PixelWindow& window, RadianceWindow* out, double* decode_s) const {
+  if (!out->state_) out->state_ = std::make_unique<Exposures>();
+  Prepare(exposures, min_signal, window, &out->decoded_, &out->scratch_, out->state_.get(), decode_s);
+}
+
+RadianceWindow::RadianceWindow() = default;
+RadianceWindow::~RadianceWindow() = default;
+
+void RadianceWindow::At(int x, int y, PixelRadiance* out) const { state_->Merge<false>(x, y, out, nullptr); }
+
+int RadianceWindow::width() const { return state_->impl->width; }
+int RadianceWindow::height() const { return state_->impl->height; }
+const PixelWindow& RadianceWindow::window() const { return state_->window; }
 
 RadianceImage ReadRadianceImage(const Session& session, const std::vector<size_t>& group, double min_signal,
                                 double* decode_s) {

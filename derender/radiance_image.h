@@ -78,6 +78,17 @@ struct PixelWindow {
 // for a bracket whose poses or lights disagree, a repeated exposure, or more than 255 exposures.
 std::vector<std::vector<size_t>> ExposureGroups(const Session& session);
 
+// One pixel's reading as a RadianceImage holds it: radiance, sigma and PixelFlag bits per channel, and
+// the exposures merged (1 for a single photo).
+struct PixelRadiance {
+  float radiance[3];
+  float sigma[3];
+  uint8_t channel_flags[3];
+  uint8_t exposures;
+};
+
+class RadianceWindow;
+
 // The session's radiometric chain, prepared once (response lookup table, flat field) and applied to
 // any number of photos, from any number of threads.
 class RadianceReader {
@@ -100,13 +111,55 @@ class RadianceReader {
   void ReadWindow(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
                   std::vector<Image>* decoded, RadianceImage* out, double* decode_s = nullptr) const;
 
+  // As ReadWindow, but each pixel is merged only when asked for (RadianceWindow::At): decodes the
+  // exposures and computes, inside `window`, what the merge reads of the neighbours (the expected
+  // signal of the floor). `out`'s buffers are reused from photo to photo; `out` keeps a pointer to
+  // this reader, which must outlive its use.
+  void PrepareWindow(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
+                     RadianceWindow* out, double* decode_s = nullptr) const;
+
   // The linear signal of a file value (response inverted, black level subtracted), through a lookup
   // table for values in [1/64, 1] (exact for linear responses; within 3e-5 relative otherwise).
   double Linear(double encoded) const;
 
  private:
+  friend class RadianceWindow;
   struct Impl;
+  struct Exposures;
+  // Decodes and checks the exposures and fills `state` (the expected signal inside `window`).
+  void Prepare(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
+               std::vector<Image>* decoded, std::vector<float>* scratch, Exposures* state, double* decode_s) const;
   std::unique_ptr<Impl> impl_;
+};
+
+// The exposures of one pose, decoded and prepared inside a pixel window by RadianceReader::PrepareWindow,
+// merged pixel by pixel on demand: the derenderer merges only the pixels whose ray hits the sample
+// (lit, not grazing), instead of every pixel of the window into full-frame radiance and sigma images.
+class RadianceWindow {
+ public:
+  RadianceWindow();
+  ~RadianceWindow();
+  RadianceWindow(const RadianceWindow&) = delete;
+  RadianceWindow& operator=(const RadianceWindow&) = delete;
+
+  // The reading of pixel (x, y), which must lie inside the window: the values RadianceReader::ReadWindow
+  // stores for it (RadianceImage's radiance, sigma, channel_flags and exposures_used), bit for bit.
+  void At(int x, int y, PixelRadiance* out) const;
+
+  // The photo's size and the window prepared.
+  int width() const;
+  int height() const;
+  const PixelWindow& window() const;
+
+  // Per pixel of the photo, 0 where the photos' masks exclude it (photo_mask.h); empty: no mask. Set by
+  // the caller, as RadianceImage::mask.
+  std::vector<uint8_t> mask;
+
+ private:
+  friend class RadianceReader;
+  std::vector<Image> decoded_;
+  std::vector<float> scratch_;
+  std::unique_ptr<RadianceReader::Exposures> state_;
 };
 
 // Decodes the photos of one group (session.photos indices) and turns them into one radiance image,

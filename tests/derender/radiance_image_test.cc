@@ -3,7 +3,10 @@
 #include "derender/radiance_image.h"
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -367,6 +370,138 @@ TEST(RadianceImage, BracketMergesWhereUsable) {
   for (int c = 0; c < 3; ++c) EXPECT_EQ(merged.channel_flags[3 * dark + c], 0) << "channel " << c;
   EXPECT_EQ(merged.exposures_used[dark], 2);
   EXPECT_NEAR(merged.radiance[3 * dark], 1e-4, 1e-7);
+}
+
+// A 3-exposure sRGB bracket of W x H noisy pixels (some clipped, some dark, one NaN) for the window tests.
+std::vector<PhotoSpec> NoisyBracket(const ScratchDir& dir, int width, int height) {
+  std::vector<PhotoSpec> bracket;
+  uint64_t state = 12345;
+  auto uniform = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return double(state >> 11) * (1.0 / 9007199254740992.0);
+  };
+  const double exposures[3] = {1.0, 0.25, 0.0625};
+  for (int e = 0; e < 3; ++e) {
+    Image image(width, height, 3);
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        // A radiance field from 1e-4 (under the floor) to 3 (clipped in the long exposures).
+        const double base = 3.0 * std::pow(double(x + 1) / width, 4.0) * (0.5 + double(y) / height);
+        for (int c = 0; c < 3; ++c) {
+          const double linear = std::min(1.0, base * (0.8 + 0.4 * uniform()) * exposures[e] * (1.0 + 0.3 * c));
+          image.at(x, y, c) = static_cast<float>(LinearToSrgb(linear));
+        }
+      }
+    }
+    if (e == 0) image.at(3, 4, 1) = std::numeric_limits<float>::quiet_NaN();
+    const std::string name = "bracket" + std::to_string(e) + ".exr";
+    WriteImage(dir / name, image, PixelFormat::kFloat);
+    PhotoSpec photo;
+    photo.file = name;
+    photo.exposure_s = exposures[e];
+    bracket.push_back(photo);
+  }
+  return bracket;
+}
+
+// Issue 15: the derenderer merges only the pixels it needs (RadianceReader::PrepareWindow and
+// RadianceWindow::At); each must read exactly what ReadWindow stores for it, for single photos and
+// brackets, in windows at the photo's edges, inside it, and too small for a ring.
+TEST(RadianceImage, WindowMergedOnDemandIsReadWindowBitForBit) {
+  ScratchDir dir;
+  constexpr int kW = 61, kH = 83;  // several of the floor pass's row blocks
+  Session session = SmallSession(dir);
+  session.camera = Camera::Create(CameraModelId::kPinhole, kW, kH, {50.0, 50.0, 30.0, 40.0});
+  session.radiometry.response.kind = Response::Kind::kSrgb;
+  session.radiometry.black_level = 0.001;
+  session.radiometry.saturation_stated = true;
+  session.radiometry.saturation_level = 0.98;
+  session.radiometry.noise = CameraNoise{20000.0, 4.0, 12};
+  const std::vector<PhotoSpec> bracket = NoisyBracket(dir, kW, kH);
+  const RadianceReader reader(session);
+  const std::vector<PixelWindow> windows = {{0, 0, kW, kH},   {7, 5, 50, 77},   {0, 60, 9, kH},
+                                            {20, 20, 22, 22}, {30, 31, 31, 32}, {10, 10, 13, 40}};
+  for (const std::vector<PhotoSpec>& exposures :
+       {bracket, std::vector<PhotoSpec>{bracket[0]}, std::vector<PhotoSpec>{bracket[2], bracket[1]}}) {
+    RadianceWindow lazy;  // reused across windows, as the derenderer reuses it across photos
+    for (const PixelWindow& w : windows) {
+      SCOPED_TRACE(std::to_string(exposures.size()) + " exposures, window " + std::to_string(w.x0) + "," +
+                   std::to_string(w.y0) + " to " + std::to_string(w.x1) + "," + std::to_string(w.y1));
+      std::vector<Image> decoded;
+      RadianceImage image;
+      reader.ReadWindow(exposures, 0.002, w, &decoded, &image);
+      reader.PrepareWindow(exposures, 0.002, w, &lazy);
+      int mismatches = 0, flagged = 0;
+      for (int y = w.y0; y < w.y1; ++y) {
+        for (int x = w.x0; x < w.x1; ++x) {
+          PixelRadiance pixel;
+          lazy.At(x, y, &pixel);
+          const size_t p = image.Index(x, y);
+          for (int c = 0; c < 3; ++c) {
+            mismatches += std::memcmp(&pixel.radiance[c], &image.radiance[3 * p + c], sizeof(float)) != 0;
+            mismatches += std::memcmp(&pixel.sigma[c], &image.sigma[3 * p + c], sizeof(float)) != 0;
+            mismatches += pixel.channel_flags[c] != image.channel_flags[3 * p + c];
+            flagged += pixel.channel_flags[c] != 0;
+          }
+          mismatches += pixel.exposures != (image.exposures_used.empty() ? 1 : image.exposures_used[p]);
+        }
+      }
+      EXPECT_EQ(mismatches, 0);
+      if (w.x1 - w.x0 == kW) {
+        EXPECT_GT(flagged, 0);  // the test reaches the flags
+      }
+    }
+  }
+}
+
+// The floor's expected signal against its definition, computed the slow way: the mean linear signal
+// of the ring of 16 pixels around each pixel (those inside the window), in a window larger than the
+// pass's row blocks, so block edges and window edges are both crossed.
+TEST(RadianceImage, FloorRingMatchesItsDefinitionAcrossRowBlocks) {
+  ScratchDir dir;
+  constexpr int kW = 37, kH = 101;
+  Session session = SmallSession(dir);
+  session.camera = Camera::Create(CameraModelId::kPinhole, kW, kH, {50.0, 50.0, 18.0, 50.0});
+  session.radiometry.response.kind = Response::Kind::kSrgb;
+  session.radiometry.saturation_stated = true;
+  session.radiometry.saturation_level = 2.0;  // nothing clips: the floor alone decides
+  const PhotoSpec photo = NoisyBracket(dir, kW, kH)[1];
+  const Image file = ReadImage(dir / photo.file);
+  const RadianceReader reader(session);
+  const PixelWindow w{2, 3, kW - 1, kH - 2};
+  const double min_signal = 0.01;
+  RadianceWindow lazy;
+  reader.PrepareWindow({photo}, min_signal, w, &lazy);
+  int compared = 0, below = 0;
+  for (int y = w.y0; y < w.y1; ++y) {
+    for (int x = w.x0; x < w.x1; ++x) {
+      PixelRadiance pixel;
+      lazy.At(x, y, &pixel);
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0.0;
+        int count = 0;
+        for (int dy = -2; dy <= 2; ++dy) {
+          for (int dx = -2; dx <= 2; ++dx) {
+            const int u = x + dx, v = y + dy;
+            if (std::max(std::abs(dx), std::abs(dy)) != 2 || u < w.x0 || u >= w.x1 || v < w.y0 || v >= w.y1) continue;
+            const double value = file.at(u, v, c);
+            sum += std::isfinite(value) ? reader.Linear(value) : 0.0;
+            ++count;
+          }
+        }
+        const double mean = sum / count;
+        if (std::abs(mean - min_signal) < 1e-4 * min_signal) continue;  // rounding could go either way
+        ++compared;
+        const bool expected_below = mean < min_signal;
+        below += expected_below;
+        EXPECT_EQ((pixel.channel_flags[c] & kPixelBelowSignal) != 0, expected_below)
+            << "pixel " << x << "," << y << " channel " << c << ": ring mean " << mean;
+      }
+    }
+  }
+  EXPECT_GT(compared, 3 * (w.x1 - w.x0) * (w.y1 - w.y0) * 9 / 10);
+  EXPECT_GT(below, 100);
+  EXPECT_LT(below, compared - 100);
 }
 
 }  // namespace
