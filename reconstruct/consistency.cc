@@ -264,11 +264,8 @@ std::string RegressionSummary(const PredictionReport& r) {
     }
     return std::string(buffer);
   };
-  char held[160];
-  std::snprintf(held, sizeof(held), "%zu held-out photos, RMS prediction error R G B %.2f %.2f %.2f %%",
-                r.held_out.size(), 100.0 * r.held_out_rms[0], 100.0 * r.held_out_rms[1], 100.0 * r.held_out_rms[2]);
   return "regression check: " + figure("reciprocity near the incidence plane", r.reciprocity) + "; " +
-         figure("bilateral symmetry", r.bilateral) + "; " + (r.held_out.empty() ? "no held-out photos" : held);
+         figure("bilateral symmetry", r.bilateral) + "; " + HeldOutHeadline(r);
 }
 
 bool ConsistencyOptions::Check(std::string* why) const {
