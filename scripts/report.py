@@ -186,7 +186,7 @@ def incidence_plane_figure(data, models, out):
     fig.suptitle(f"Incidence plane (band: |theta - theta_0| <= {b['band_theta_deg']:g} deg, within "
                  f"{b['band_phi_deg']:g} deg of the plane). Curves: each model at the samples' own directions "
                  "(median per degree); dotted: the same model in the exact plane", fontsize=10)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.05, right=0.99, bottom=0.06, top=0.9, wspace=0.22, hspace=0.18)  # fixed grid
     return save(fig, out, "incidence-plane.png")
 
 
@@ -229,7 +229,7 @@ def reciprocity_curves_figure(data, out):
             axes[0][col].legend(fontsize=7)
     fig.suptitle("Reciprocity as in the paper: the fixed-incidence curve against the fixed-exitance curve "
                  "(sample medians per 2 deg, no model)", fontsize=10)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.06, right=0.99, bottom=0.09, top=0.88, wspace=0.25, hspace=0.35)  # fixed grid
     return save(fig, out, "reciprocity-curves.png")
 
 
@@ -291,7 +291,7 @@ def consistency_figure(c, key, title, out):
     axes[2].set_ylim(0, 90)
     axes[2].set_title("where: the worst bins located", fontsize=10)
     fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.06, right=0.97, bottom=0.12, top=0.86, wspace=0.28)  # fixed grid
     return save(fig, out, f"{key}.png")
 
 
