@@ -118,12 +118,12 @@ def binned_median(x, y, width=1.0):
     if x.size == 0:
         return np.array([]), np.array([])
     keys = np.floor(x / width).astype(int)
-    centres, values = [], []
-    for key in np.unique(keys):
-        sel = keys == key
-        centres.append((key + 0.5) * width)
-        values.append(np.median(y[sel]))
-    return np.array(centres), np.array(values)
+    # One sort and a split instead of a mask per bin (the same medians: a median ignores order).
+    order = np.argsort(keys, kind="stable")
+    keys, y = keys[order], y[order]
+    unique, starts = np.unique(keys, return_index=True)
+    values = np.array([np.median(part) for part in np.split(y, starts[1:])])
+    return (unique + 0.5) * width, values
 
 
 def load_plane(out, plane):
