@@ -31,10 +31,10 @@ StageLauncher ChildLauncher() {
   if (Verbosity() == 1) prefix.push_back("-q");
   prefix.push_back("--threads");
   prefix.push_back(std::to_string(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
-  return [prefix](const std::string& name, const std::vector<std::string>& arguments) {
+  return [prefix](const std::string& name, const std::vector<std::string>& arguments, const std::string& log_path) {
     std::vector<std::string> argv = prefix;
     argv.insert(argv.end(), arguments.begin(), arguments.end());
-    return RunSubprocess(argv, {"", {}, name});
+    return RunSubprocess(argv, {log_path, {}, name});
   };
 }
 
@@ -109,6 +109,10 @@ void AddRunCommand(CLI::App& app) {
   command->add_flag_callback(
       "--no-report", [args] { args->options.report = false; }, "Skip the HTML report");
   command->add_flag("--force", o.force, "Re-run every stage, up to date or not");
+  command->add_flag_callback(
+      "--sequential", [args] { args->options.concurrent_sample_stages = false; },
+      "Run check and compare after reconstruct, not beside it (by default they run at the same time,\n"
+      "their output shown when they end; the outputs are the same)");
   // Named pass-through options: each goes to its stage unchanged.
   struct Named {
     const char* flag;

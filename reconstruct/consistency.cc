@@ -6,7 +6,10 @@
 #include <cstdio>
 #include <unordered_map>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -26,17 +29,52 @@ Eigen::Vector3d Embed(double theta_i, double theta_e, double delta_phi) {
   return {theta_i, theta_e * std::cos(delta_phi), theta_e * std::sin(delta_phi)};
 }
 
-// The samples in a hash grid of cells `cell` radians wide, for nearest-partner queries.
+// The samples in a grid of cells `cell` radians wide, for nearest-partner queries: the usable samples
+// sorted by cell (x, y, z) and index, so a column of cells (x, y) is one run of the arrays, found by a
+// dense (x, y) table, and its cells z - 1 .. z + 1 one stretch of it.
 class PartnerGrid {
  public:
-  PartnerGrid(const std::vector<BrdfSample>& samples, const std::vector<uint32_t>& usable, double cell)
-      : samples_(samples), cell_(cell) {
-    points_.resize(samples.size());
-    for (const uint32_t index : usable) {
-      const BrdfSample& s = samples[index];
-      points_[index] = Embed(s.theta_i, s.theta_e, s.delta_phi);
-      cells_[Key(Cell(points_[index]))].push_back(index);
+  PartnerGrid(const std::vector<BrdfSample>& samples, const std::vector<uint32_t>& usable, double cell) : cell_(cell) {
+    const size_t n = usable.size();
+    std::vector<Eigen::Vector3i> cells(n);
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+      const BrdfSample& s = samples[usable[i]];
+      cells[i] = Cell(Embed(s.theta_i, s.theta_e, s.delta_phi));
+    });
+    if (n == 0) return;
+    lo_ = hi_ = cells[0].head<2>();
+    for (const Eigen::Vector3i& c : cells) {
+      lo_ = lo_.cwiseMin(c.head<2>());
+      hi_ = hi_.cwiseMax(c.head<2>());
     }
+    size_x_ = hi_.x() - lo_.x() + 1;
+    size_y_ = hi_.y() - lo_.y() + 1;
+    // Sorted by (x, y, z), then by sample index: within a cell the samples keep their file order, so a
+    // partner's sum adds them in the order of the hash grid before (the same bits).
+    std::vector<uint32_t> order(n);
+    for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
+    tbb::parallel_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+      const Eigen::Vector3i &ca = cells[a], &cb = cells[b];
+      if (ca.x() != cb.x()) return ca.x() < cb.x();
+      if (ca.y() != cb.y()) return ca.y() < cb.y();
+      if (ca.z() != cb.z()) return ca.z() < cb.z();
+      return a < b;
+    });
+    index_.resize(n);
+    z_.resize(n);
+    points_.resize(n);
+    values_.resize(n);
+    tbb::parallel_for(size_t(0), n, [&](size_t k) {
+      const uint32_t index = usable[order[k]];
+      const BrdfSample& s = samples[index];
+      index_[k] = index;
+      z_[k] = cells[order[k]].z();
+      points_[k] = Embed(s.theta_i, s.theta_e, s.delta_phi);
+      values_[k] = Eigen::Vector3f(s.brdf[0], s.brdf[1], s.brdf[2]);
+    });
+    columns_.assign(size_t(size_x_) * size_y_ + 1, 0);
+    for (size_t k = 0; k < n; ++k) ++columns_[Column(cells[order[k]]) + 1];
+    for (size_t c = 1; c < columns_.size(); ++c) columns_[c] += columns_[c - 1];
   }
 
   // The partner of `target`: the samples within `radius` (<= the cell size) whose centroid lies within
@@ -48,18 +86,18 @@ class PartnerGrid {
     const Eigen::Vector3i c = Cell(target);
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), sum = Eigen::Vector3d::Zero();
     int n = 0;
-    for (int dx = -1; dx <= 1; ++dx) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = cells_.find(Key(c + Eigen::Vector3i(dx, dy, dz)));
-          if (it == cells_.end()) continue;
-          for (const uint32_t index : it->second) {
-            if (index == exclude || (points_[index] - target).squaredNorm() > radius * radius) continue;
-            centroid += points_[index];
-            const BrdfSample& s = samples_[index];
-            sum += Eigen::Vector3d(s.brdf[0], s.brdf[1], s.brdf[2]);
-            ++n;
-          }
+    for (int x = c.x() - 1; x <= c.x() + 1; ++x) {
+      if (x < lo_.x() || x > hi_.x()) continue;
+      for (int y = c.y() - 1; y <= c.y() + 1; ++y) {
+        if (y < lo_.y() || y > hi_.y()) continue;
+        const size_t column = Column(Eigen::Vector3i(x, y, 0));
+        const auto begin = z_.begin() + columns_[column], end = z_.begin() + columns_[column + 1];
+        for (auto it = std::lower_bound(begin, end, c.z() - 1); it != end && *it <= c.z() + 1; ++it) {
+          const size_t k = size_t(it - z_.begin());
+          if (index_[k] == exclude || (points_[k] - target).squaredNorm() > radius * radius) continue;
+          centroid += points_[k];
+          sum += values_[k].cast<double>();
+          ++n;
         }
       }
     }
@@ -73,14 +111,16 @@ class PartnerGrid {
     // The embedding is bounded by pi/2 in every coordinate, so the cells fit an int.
     return {int(std::floor(p[0] / cell_)), int(std::floor(p[1] / cell_)), int(std::floor(p[2] / cell_))};
   }
-  static int64_t Key(const Eigen::Vector3i& c) {
-    return ((int64_t(c[0]) + 4096) << 26) | ((int64_t(c[1]) + 4096) << 13) | (int64_t(c[2]) + 4096);
-  }
+  size_t Column(const Eigen::Vector3i& c) const { return size_t(c.x() - lo_.x()) * size_y_ + (c.y() - lo_.y()); }
 
-  const std::vector<BrdfSample>& samples_;
   double cell_;
-  std::vector<Eigen::Vector3d> points_;
-  std::unordered_map<int64_t, std::vector<uint32_t>> cells_;
+  Eigen::Vector2i lo_ = Eigen::Vector2i::Zero(), hi_ = Eigen::Vector2i::Constant(-1);  // (x, y) cells held
+  int size_x_ = 0, size_y_ = 0;
+  std::vector<size_t> columns_;          // column (x, y) holds entries [columns_[c], columns_[c + 1])
+  std::vector<uint32_t> index_;          // sample index of each entry
+  std::vector<int> z_;                   // z cell of each entry (increasing within a column)
+  std::vector<Eigen::Vector3d> points_;  // embedded point of each entry
+  std::vector<Eigen::Vector3f> values_;  // brdf of each entry
 };
 
 // The pairs of one bin: signed relative differences and both values, per channel.
@@ -111,17 +151,36 @@ ConsistencyFigure PairedFigure(const std::vector<BrdfSample>& samples, const std
                                Take take, PartnerPoint partner_point) {
   std::unordered_map<int, BinPairs> by_bin;
   const double radius = options.match_deg * kDegree;
-  for (const uint32_t index : usable) {
-    const BrdfSample& a = samples[index];
-    if (!take(a)) continue;
+  // The partner searches in parallel, a block at a time into a reused buffer; the pairs are then added
+  // to their bins serially in sample order (the same bins, in the same order, as the one-thread loop).
+  constexpr size_t kBlock = 1 << 16;
+  struct Found {
+    bool paired = false;
     Eigen::Vector3d b;
-    if (!grid.Partner(partner_point(a), radius, index, &b)) continue;
-    BinPairs& pairs = by_bin[bins.Index(a)];
-    for (int c = 0; c < 3; ++c) {
-      const double mean = 0.5 * (double(a.brdf[c]) + b[c]);
-      pairs.signed_diff[c].push_back(mean > 0.0 ? (double(a.brdf[c]) - b[c]) / mean : 0.0);
-      pairs.a[c].push_back(a.brdf[c]);
-      pairs.b[c].push_back(b[c]);
+  };
+  std::vector<Found> block(std::min(kBlock, usable.size()));
+  for (size_t begin = 0; begin < usable.size(); begin += kBlock) {
+    const size_t end = std::min(usable.size(), begin + kBlock);
+    tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 512), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i < range.end(); ++i) {
+        const uint32_t index = usable[i];
+        const BrdfSample& a = samples[index];
+        Found& found = block[i - begin];
+        found.paired = take(a) && grid.Partner(partner_point(a), radius, index, &found.b);
+      }
+    });
+    for (size_t i = begin; i < end; ++i) {
+      const Found& found = block[i - begin];
+      if (!found.paired) continue;
+      const BrdfSample& a = samples[usable[i]];
+      const Eigen::Vector3d& b = found.b;
+      BinPairs& pairs = by_bin[bins.Index(a)];
+      for (int c = 0; c < 3; ++c) {
+        const double mean = 0.5 * (double(a.brdf[c]) + b[c]);
+        pairs.signed_diff[c].push_back(mean > 0.0 ? (double(a.brdf[c]) - b[c]) / mean : 0.0);
+        pairs.a[c].push_back(a.brdf[c]);
+        pairs.b[c].push_back(b[c]);
+      }
     }
   }
   std::vector<int> order;
@@ -205,11 +264,8 @@ std::string RegressionSummary(const PredictionReport& r) {
     }
     return std::string(buffer);
   };
-  char held[160];
-  std::snprintf(held, sizeof(held), "%zu held-out photos, RMS prediction error R G B %.2f %.2f %.2f %%",
-                r.held_out.size(), 100.0 * r.held_out_rms[0], 100.0 * r.held_out_rms[1], 100.0 * r.held_out_rms[2]);
   return "regression check: " + figure("reciprocity near the incidence plane", r.reciprocity) + "; " +
-         figure("bilateral symmetry", r.bilateral) + "; " + (r.held_out.empty() ? "no held-out photos" : held);
+         figure("bilateral symmetry", r.bilateral) + "; " + HeldOutHeadline(r);
 }
 
 bool ConsistencyOptions::Check(std::string* why) const {

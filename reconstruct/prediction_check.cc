@@ -57,10 +57,15 @@ PairFigure ComparePairs(const LocalRegression& regression, const std::vector<Eig
 
 nlohmann::json Rgb(const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); }
 
+// An invalid figure (no pairs) has null values, not 0.
 nlohmann::json FigureJson(const PairFigure& figure) {
-  return {{"valid", figure.valid()},           {"pairs", figure.pairs},
-          {"mean_rel_error", figure.mean},     {"per_channel_rel_error", Rgb(figure.mean_rel_error)},
-          {"median_rel_error", figure.median}, {"p95_rel_error", figure.p95}};
+  const auto value = [&](const nlohmann::json& v) { return figure.valid() ? v : nlohmann::json(); };
+  return {{"valid", figure.valid()},
+          {"pairs", figure.pairs},
+          {"mean_rel_error", value(figure.mean)},
+          {"per_channel_rel_error", value(Rgb(figure.mean_rel_error))},
+          {"median_rel_error", value(figure.median)},
+          {"p95_rel_error", value(figure.p95)}};
 }
 
 }  // namespace
@@ -134,14 +139,24 @@ PredictionReport CheckWithRegression(const std::vector<BrdfSample>& samples, con
 
   // Held-out photos, evenly spaced over the images present.
   double sum_squares[3] = {0, 0, 0};
-  size_t total = 0;
   for (const uint32_t image : HeldOutImages(samples, options.held_out_photos)) {
     std::vector<BrdfSample> fit, predict;
     for (const BrdfSample& s : samples) (s.image == image ? predict : fit).push_back(s);
     const double max_theta = options.max_theta_deg * kDegree;
+    const size_t in_photo = predict.size();
     predict.erase(std::remove_if(predict.begin(), predict.end(),
                                  [&](const BrdfSample& s) { return s.theta_i > max_theta || s.theta_e > max_theta; }),
                   predict.end());
+    HeldOutPhoto photo;
+    photo.image = image;
+    if (predict.empty()) {
+      char note[160];
+      std::snprintf(note, sizeof(note), "none of its %zu samples has theta_i and theta_e below %g deg", in_photo,
+                    options.max_theta_deg);
+      photo.note = note;
+      report.held_out.push_back(photo);
+      continue;
+    }
     if (predict.size() > options.max_predicted_samples) {
       std::mt19937_64 rng(image + 1);
       std::shuffle(predict.begin(), predict.end(), rng);
@@ -153,18 +168,18 @@ PredictionReport CheckWithRegression(const std::vector<BrdfSample>& samples, con
       points.push_back(RegressionCoordinates(Eigen::Vector3d(s.wi[0], s.wi[1], s.wi[2]).normalized(),
                                              Eigen::Vector3d(s.wo[0], s.wo[1], s.wo[2]).normalized()));
     }
-    HeldOutPhoto photo;
-    photo.image = image;
     const std::vector<Estimate> estimates = regression.EvaluateMany(points, &photo.reliability);
     std::vector<double> abs_rel[3];
     size_t within = 0, with_sigma = 0;
     for (size_t i = 0; i < predict.size(); ++i) {
       for (int c = 0; c < 3; ++c) {
+        if (!predict[i].Valid(c)) continue;  // a channel the photo did not measure (clipped, under the floor)
         const double f = predict[i].brdf[c];
         const double rel = (estimates[i].value[c] - f) / std::max(std::abs(f), 1e-6);
         photo.rms_rel_error[c] += rel * rel;
         sum_squares[c] += rel * rel;
         abs_rel[c].push_back(std::abs(rel));
+        ++photo.measured[c];
         if (predict[i].sigma[c] > 0.0f) {
           ++with_sigma;
           within += std::abs(estimates[i].value[c] - f) <= 2.0 * predict[i].sigma[c];
@@ -172,39 +187,75 @@ PredictionReport CheckWithRegression(const std::vector<BrdfSample>& samples, con
       }
     }
     photo.predicted = predict.size();
-    total += predict.size();
     for (int c = 0; c < 3; ++c) {
-      photo.rms_rel_error[c] = predict.empty() ? 0.0 : std::sqrt(photo.rms_rel_error[c] / predict.size());
+      if (photo.measured[c] == 0) continue;
+      photo.rms_rel_error[c] = std::sqrt(photo.rms_rel_error[c] / photo.measured[c]);
       photo.median_rel_error[c] = Percentile(abs_rel[c], 0.5);
+      report.held_out_measured[c] += photo.measured[c];
     }
+    if (!photo.valid()) photo.note = "no channel of its predicted samples was measured";
     if (with_sigma > 0) photo.within_2_sigma = double(within) / with_sigma;
     report.held_out.push_back(photo);
   }
-  for (int c = 0; c < 3; ++c) report.held_out_rms[c] = total ? std::sqrt(sum_squares[c] / total) : 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const size_t n = report.held_out_measured[c];
+    report.held_out_rms[c] = n ? std::sqrt(sum_squares[c] / n) : 0.0;
+  }
   report.seconds = timer.ElapsedSeconds();
   report.success = true;
   return report;
 }
 
+std::string HeldOutHeadline(const PredictionReport& report) {
+  if (report.held_out.empty()) return "no held-out photos";
+  std::string line = std::to_string(report.held_out.size()) + " held-out photos";
+  if (!report.held_out_valid()) {
+    return line + ", nothing predicted (none of their samples lies below max_theta_deg with a measured channel)";
+  }
+  line += ", RMS prediction error R G B";
+  for (int c = 0; c < 3; ++c) {
+    char value[32];
+    std::snprintf(value, sizeof(value), " %.2f", 100.0 * report.held_out_rms[c]);
+    line += report.held_out_measured[c] ? value : " n/a";
+  }
+  line += " %";
+  for (const HeldOutPhoto& photo : report.held_out) {
+    if (!photo.valid()) line += "; photo " + std::to_string(photo.image) + " not predicted: " + photo.note;
+  }
+  return line;
+}
+
 std::string PredictionReport::BriefReport() const {
-  char buffer[320];
-  std::snprintf(buffer, sizeof(buffer),
-                "regression check: reciprocity near the incidence plane %.2f %% over %zu pairs; bilateral %.2f %% "
-                "over %zu pairs; %zu held-out photos, RMS prediction error R G B %.2f %.2f %.2f %%",
-                100.0 * reciprocity.mean, reciprocity.pairs, 100.0 * bilateral.mean, bilateral.pairs, held_out.size(),
-                100.0 * held_out_rms[0], 100.0 * held_out_rms[1], 100.0 * held_out_rms[2]);
-  return buffer;
+  auto figure = [](const PairFigure& f) {
+    char buffer[96];
+    if (!f.valid()) return std::string("invalid (no pair had two estimates)");
+    std::snprintf(buffer, sizeof(buffer), "%.2f %% over %zu pairs", 100.0 * f.mean, f.pairs);
+    return std::string(buffer);
+  };
+  return "regression check: reciprocity near the incidence plane " + figure(reciprocity) + "; bilateral " +
+         figure(bilateral) + "; " + HeldOutHeadline(*this);
 }
 
 nlohmann::json ToJson(const PredictionReport& report, const PredictionCheckOptions& options) {
   nlohmann::json photos = nlohmann::json::array();
+  // A channel without measured predictions has no figure: null, not 0.
+  auto rgb_or_null = [](const Eigen::Vector3d& v, const Eigen::Matrix<size_t, 3, 1>& n) {
+    nlohmann::json out = nlohmann::json::array();
+    for (int c = 0; c < 3; ++c) out.push_back(n[c] ? nlohmann::json(v[c]) : nlohmann::json());
+    return out;
+  };
   for (const HeldOutPhoto& p : report.held_out) {
-    photos.push_back({{"image", p.image},
-                      {"predicted_samples", p.predicted},
-                      {"rms_rel_error", Rgb(p.rms_rel_error)},
-                      {"median_rel_error", Rgb(p.median_rel_error)},
-                      {"within_2_sigma", p.within_2_sigma},
-                      {"reliability", ToJson(p.reliability)}});
+    nlohmann::json photo = {
+        {"image", p.image},
+        {"valid", p.valid()},
+        {"predicted_samples", p.predicted},
+        {"measured_values", {p.measured[0], p.measured[1], p.measured[2]}},
+        {"rms_rel_error", rgb_or_null(p.rms_rel_error, p.measured)},
+        {"median_rel_error", rgb_or_null(p.median_rel_error, p.measured)},
+        {"within_2_sigma", p.within_2_sigma >= 0.0 ? nlohmann::json(p.within_2_sigma) : nlohmann::json()},
+        {"reliability", ToJson(p.reliability)}};
+    if (!p.note.empty()) photo["note"] = p.note;
+    photos.push_back(photo);
   }
   const LocalRegressionOptions& r = options.regression;
   return {{"method",
@@ -222,7 +273,8 @@ nlohmann::json ToJson(const PredictionReport& report, const PredictionCheckOptio
           {"reciprocity_near_incidence_plane", FigureJson(report.reciprocity)},
           {"bilateral_symmetry", FigureJson(report.bilateral)},
           {"held_out_photos", photos},
-          {"held_out_rms_rel_error", Rgb(report.held_out_rms)},
+          {"held_out_valid", report.held_out_valid()},
+          {"held_out_rms_rel_error", rgb_or_null(report.held_out_rms, report.held_out_measured)},
           {"seconds", report.seconds}};
 }
 

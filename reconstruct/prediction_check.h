@@ -39,11 +39,18 @@ struct PairFigure {
 
 struct HeldOutPhoto {
   uint32_t image = 0;
-  size_t predicted = 0;                                        // samples predicted
+  size_t predicted = 0;  // samples predicted
+  // Per channel: the predicted samples that measured it (valid[c]); the channel's figures are over
+  // these only, and absent (not 0) where there are none.
+  Eigen::Matrix<size_t, 3, 1> measured = Eigen::Matrix<size_t, 3, 1>::Zero();
   Eigen::Vector3d rms_rel_error = Eigen::Vector3d::Zero();     // of (prediction - sample) / sample
   Eigen::Vector3d median_rel_error = Eigen::Vector3d::Zero();  // of |prediction - sample| / sample
   double within_2_sigma = -1.0;  // fraction of values within 2 sigma of the prediction (-1: no sigma)
   ReliabilityCounts reliability;
+  // Whether anything was predicted: a photo with no samples below max_theta_deg (or none measured) has
+  // no error figures, and says so instead of reporting 0.
+  bool valid() const { return measured.maxCoeff() > 0; }
+  std::string note;  // why it is not valid ("" when it is)
 };
 
 struct PredictionReport {
@@ -51,7 +58,10 @@ struct PredictionReport {
   PairFigure reciprocity;  // near the incidence plane
   PairFigure bilateral;
   std::vector<HeldOutPhoto> held_out;
-  Eigen::Vector3d held_out_rms = Eigen::Vector3d::Zero();  // over all held-out samples
+  Eigen::Vector3d held_out_rms = Eigen::Vector3d::Zero();  // over all held-out samples (their measured channels)
+  Eigen::Matrix<size_t, 3, 1> held_out_measured = Eigen::Matrix<size_t, 3, 1>::Zero();  // values behind it
+  // Whether any held-out value was predicted (held_out_rms means something).
+  bool held_out_valid() const { return held_out_measured.maxCoeff() > 0; }
   double seconds = 0.0;
   std::string BriefReport() const;
 };
@@ -59,6 +69,11 @@ struct PredictionReport {
 // The photos held out by CheckWithRegression with `count` held-out photos: `count` (at most the photos
 // present, none with one photo) evenly spaced over the image indices present in `samples`.
 std::vector<uint32_t> HeldOutImages(const std::vector<BrdfSample>& samples, int count);
+
+// The held-out photos' line of the check's summary: their RMS prediction error per channel ("n/a" for a
+// channel nothing measured), "nothing predicted" when no photo had a sample to predict, and each photo
+// left out with why.
+std::string HeldOutHeadline(const PredictionReport& report);
 
 PredictionReport CheckWithRegression(const std::vector<BrdfSample>& samples, const PredictionCheckOptions& options);
 

@@ -9,11 +9,6 @@
 #include "core/statistics.h"
 
 namespace ibrdf {
-namespace {
-
-double Luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
-
-}  // namespace
 
 int SampleStride(const std::vector<const BrdfSample*>& samples) {
   std::map<uint32_t, std::vector<uint32_t>> rows;
@@ -69,16 +64,24 @@ PhotoRender RenderPhotoPixels(const Image& photo, const PixelBox& box, const std
     const Eigen::Vector3d& f = values[i];
     // The sample's own pixel: E cos(theta_i) per channel, as the derenderer divided by it.
     double rendered[3];
-    bool ok = true;
     for (int c = 0; c < 3; ++c) {
       const double measured = photo.at(px, py, std::min(c, photo.channels - 1));
       const double irradiance = s->brdf[c] > 0.0f ? measured / s->brdf[c] : NAN;
       rendered[c] = f[c] >= 0.0 ? f[c] * irradiance : NAN;
-      ok = ok && std::isfinite(rendered[c]);
     }
-    const double m = Luminance(photo.at(px, py, 0), photo.at(px, py, std::min(1, photo.channels - 1)),
-                               photo.at(px, py, std::min(2, photo.channels - 1)));
-    const double d = ok && m > 0.0 ? Luminance(rendered[0], rendered[1], rendered[2]) / m - 1.0 : NAN;
+    // The difference over the channels the sample measured (its `valid` flags): a clipped channel's
+    // photo value is the clip level, one under the noise floor is noise, so neither is compared; the
+    // luminance weights of the measured channels only. NaN when none is measured or a value is missing.
+    const double weights[3] = {0.2126, 0.7152, 0.0722};
+    double render_sum = 0.0, photo_sum = 0.0;
+    bool ok = false;
+    for (int c = 0; c < 3; ++c) {
+      if (!s->Valid(c)) continue;
+      ok = true;
+      render_sum += weights[c] * rendered[c];
+      photo_sum += weights[c] * photo.at(px, py, std::min(c, photo.channels - 1));
+    }
+    const double d = ok && photo_sum > 0.0 && std::isfinite(render_sum) ? render_sum / photo_sum - 1.0 : NAN;
     if (std::isfinite(d)) differences.push_back(std::abs(d));
     // Its stride x stride block shows it.
     for (int y = std::max(box.y0, py - before); y <= std::min(box.y1, py - before + stride - 1); ++y) {

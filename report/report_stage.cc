@@ -371,12 +371,14 @@ nlohmann::json IncidencePlanes(const std::vector<BrdfSample>& samples, const Run
         const double other = (kind == 0 ? s.theta_e : s.theta_i) / kDeg;
         rows.push_back(float(kind));
         rows.push_back(float(light_side ? other : -other));
-        for (int c = 0; c < 3; ++c) rows.push_back(s.brdf[c]);
+        // A channel the sample did not measure (clipped, under the noise floor: its `valid` flag) is NaN
+        // in the file (not plotted) and left out of the ratios.
+        for (int c = 0; c < 3; ++c) rows.push_back(s.Valid(c) ? s.brdf[c] : NAN);
         for (size_t m = 0; m < models.named.size(); ++m) {
           const Eigen::Vector3d f = models.named[m].eval(Wi(s), Wo(s));
           for (int c = 0; c < 3; ++c) {
             rows.push_back(f[c] >= 0.0 ? float(f[c]) : NAN);
-            if (f[c] > 0.0 && s.brdf[c] > 0.0f) ratios[m * 3 + c].push_back(s.brdf[c] / f[c]);
+            if (s.Valid(c) && f[c] > 0.0 && s.brdf[c] > 0.0f) ratios[m * 3 + c].push_back(s.brdf[c] / f[c]);
           }
         }
         ++n_rows;
@@ -403,7 +405,7 @@ nlohmann::json IncidencePlanes(const std::vector<BrdfSample>& samples, const Run
       BandAgreement a;
       a.theta0_deg = t0;
       a.model = models.named[m].name;
-      a.samples = ratios[m * 3].size();
+      a.samples = std::max({ratios[m * 3].size(), ratios[m * 3 + 1].size(), ratios[m * 3 + 2].size()});
       nlohmann::json rgb = nlohmann::json::array();
       for (int c = 0; c < 3; ++c) {
         a.ratio[c] = ratios[m * 3 + c].empty() ? NAN : Percentile(ratios[m * 3 + c], 0.5);

@@ -9,6 +9,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 #include <nlohmann/json.hpp>
 
 #include "align/markers.h"
@@ -22,6 +23,7 @@
 #include "core/statistics.h"
 #include "derender/analytic_sample.h"
 #include "scan/ply_io.h"
+#include "synth/pixel_rays.h"
 #include "synth/synthetic_colour_chart.h"
 #include "synth/synthetic_exif.h"
 #include "synth/synthetic_radiometry.h"
@@ -382,14 +384,12 @@ class TargetScene {
 // of it (the sample, or the white reference's card).
 void CompositeTargets(const Camera& camera, const Rigid3d& camera_from_world, const TargetScene& scene,
                       const TargetOccluder& in_front, const std::vector<uint8_t>& skip_mask, Image* signal) {
-  const Rigid3d world_from_camera = camera_from_world.Inverse();
-  const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
-  const Eigen::Vector3d center = world_from_camera.translation;
+  const CameraRay camera_ray(camera, camera_from_world);
+  const Eigen::Vector3d& center = camera_ray.eye();
   // The boards' value along a ray through an image point; 0 where it shows nothing (or the sample
   // is in front).
   auto value_at = [&](const Eigen::Vector2d& pixel) {
-    const Eigen::Vector2d xy = camera.CamPlaneFromImage(pixel);
-    const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+    const Eigen::Vector3d direction = camera_ray.Direction(pixel);
     double t;
     const double value = scene.Trace(center, direction, &t);
     if (!(value > 0.0)) return 0.0;
@@ -465,8 +465,8 @@ nlohmann::json RigidJson(const Rigid3d& transform) {
   return {{"rotation", {q.w(), q.x(), q.y(), q.z()}}, {"translation", ToJson(transform.translation)}};
 }
 
-Image RenderRadianceImpl(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
-                         const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask,
+Image RenderRadianceImpl(const Session& session, size_t photo_index, const PixelRays& rays, const AnalyticSample& truth,
+                         bool shadow_rays, const BrdfModel& material, std::vector<uint8_t>* hit_mask,
                          uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance);
 
 }  // namespace
@@ -493,69 +493,53 @@ Rigid3d ScanFromWorld(const SynthScanOptions& scan) {
 Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material, int supersample,
                      std::vector<uint8_t>* hit_mask) {
   const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
-  return RenderRadianceImpl(session, photo_index, *sample, false, material, supersample, hit_mask, nullptr,
-                            Eigen::Vector3d::Zero());
+  return RenderRadianceImpl(session, photo_index, PixelRays(session.camera, supersample), *sample, false, material,
+                            hit_mask, nullptr, Eigen::Vector3d::Zero());
 }
 
 Image RenderRadiance(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
                      const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask) {
-  return RenderRadianceImpl(session, photo_index, truth, shadow_rays, material, supersample, hit_mask, nullptr,
-                            Eigen::Vector3d::Zero());
+  return RenderRadianceImpl(session, photo_index, PixelRays(session.camera, supersample), truth, shadow_rays, material,
+                            hit_mask, nullptr, Eigen::Vector3d::Zero());
 }
 
 namespace {
-Image RenderRadianceImpl(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
-                         const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask,
+Image RenderRadianceImpl(const Session& session, size_t photo_index, const PixelRays& rays, const AnalyticSample& truth,
+                         bool shadow_rays, const BrdfModel& material, std::vector<uint8_t>* hit_mask,
                          uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance) {
   const Camera& camera = session.camera;
   const Light& light = session.PhotoLight(photo_index);
   const AnalyticSample* sample = &truth;
   std::atomic<uint64_t> shadowed{0};
-  const Rigid3d world_from_camera = session.photos[photo_index].camera_from_world->Inverse();
-  const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
-  const Eigen::Vector3d center = world_from_camera.translation;
-  Image image(camera.width, camera.height, 3);
   if (hit_mask) hit_mask->assign(size_t(camera.width) * camera.height, 0);
-  const double weight = 1.0 / (supersample * supersample);
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      for (int x = 0; x < camera.width; ++x) {
-        Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
-        for (int sy = 0; sy < supersample; ++sy) {
-          for (int sx = 0; sx < supersample; ++sx) {
-            const Eigen::Vector2d pixel(x + (sx + 0.5) / supersample, y + (sy + 0.5) / supersample);
-            const Eigen::Vector2d xy = camera.CamPlaneFromImage(pixel);
-            const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
-            SurfaceHit hit;
-            if (!sample->Intersect(center, direction, &hit)) continue;
-            const bool centre_ray = sx == supersample / 2 && sy == supersample / 2;
-            if (hit_mask && centre_ray) (*hit_mask)[size_t(y) * camera.width + x] = 1;
-            const LocalFrame frame = LocalFrame::FromNormal(hit.normal);
-            const Eigen::Vector3d wo = frame.ToLocal(-direction);
-            // The fill light (SynthOptions::fill_light) reaches every point, shadowed or not.
-            if (fill_irradiance.any()) {
-              radiance += weight * material.Eval(Eigen::Vector3d::UnitZ(), wo).cwiseProduct(fill_irradiance);
-            }
-            const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
-            if (!incidence.lit) continue;
-            if (shadow_rays) {
-              // The shadow ray starts 2 micrometres off the surface (outside the solid) and is blocked
-              // by any hit nearer than the light.
-              SurfaceHit blocker;
-              if (sample->Intersect(hit.point + 2e-6 * hit.normal, incidence.wi, &blocker) &&
-                  blocker.t < incidence.distance) {
-                if (centre_ray) ++shadowed;
-                continue;
-              }
-            }
-            const Eigen::Vector3d f = material.Eval(frame.ToLocal(incidence.wi), wo);
-            radiance += weight * f.cwiseProduct(incidence.irradiance);
-          }
-        }
-        for (int c = 0; c < 3; ++c) image.at(x, y, c) = static_cast<float>(radiance[c]);
-      }
-    }
-  });
+  const bool fill = fill_irradiance.any();
+  Image image = RenderRays(rays, *session.photos[photo_index].camera_from_world,
+                           [&](const Eigen::Vector3d& eye, const PixelRay& ray) -> Eigen::Vector3d {
+                             SurfaceHit hit;
+                             if (!sample->Intersect(eye, ray.direction, &hit)) return Eigen::Vector3d::Zero();
+                             if (hit_mask && ray.centre) (*hit_mask)[ray.pixel] = 1;
+                             const LocalFrame frame = LocalFrame::FromNormal(hit.normal);
+                             const Eigen::Vector3d wo = frame.ToLocal(-ray.direction);
+                             Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
+                             // The fill light (SynthOptions::fill_light) reaches every point, shadowed or not.
+                             if (fill) {
+                               radiance += material.Eval(Eigen::Vector3d::UnitZ(), wo).cwiseProduct(fill_irradiance);
+                             }
+                             const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
+                             if (!incidence.lit) return radiance;
+                             if (shadow_rays) {
+                               // The shadow ray starts 2 micrometres off the surface (outside the solid)
+                               // and is blocked by any hit nearer than the light.
+                               SurfaceHit blocker;
+                               if (sample->Intersect(hit.point + 2e-6 * hit.normal, incidence.wi, &blocker) &&
+                                   blocker.t < incidence.distance) {
+                                 if (ray.centre) ++shadowed;
+                                 return radiance;
+                               }
+                             }
+                             const Eigen::Vector3d f = material.Eval(frame.ToLocal(incidence.wi), wo);
+                             return Eigen::Vector3d(radiance + f.cwiseProduct(incidence.irradiance));
+                           });
   if (shadowed_pixels) *shadowed_pixels += shadowed;
   return image;
 }
@@ -714,11 +698,28 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   ProgressBar progress("photos", session.photos.size());
   std::unique_ptr<TargetScene> target_scene;
   if (options.targets.enabled) target_scene = std::make_unique<TargetScene>(options);
-  // Photos one after another; each renders and adds noise in parallel over rows.
+  // The camera's sub-pixel rays, undistorted once for every photo.
+  const PixelRays rays(session.camera, effects.supersample);
+  const PixelFormat format = effects.bits == 0   ? PixelFormat::kFloat
+                             : effects.bits <= 8 ? PixelFormat::kUint8
+                                                 : PixelFormat::kUint16;
+  // Photos one after another; each renders and adds noise in parallel over rows, and is written (the
+  // PNG encoder is serial) while the next one renders: one photo being written at a time.
+  tbb::task_group writing;
+  const auto wait_for_writing = [&writing] { writing.wait(); };
+  struct WaitOnExit {  // an exception here must not leave a write running into the unwound folder
+    tbb::task_group& group;
+    ~WaitOnExit() {
+      try {
+        group.wait();
+      } catch (...) {
+      }
+    }
+  } wait_on_exit{writing};
   for (size_t i = 0; i < session.photos.size(); ++i) {
     std::vector<uint8_t> mask;
     Image image =
-        RenderRadianceImpl(session, i, *truth, shadow_rays, material, effects.supersample, &mask,
+        RenderRadianceImpl(session, i, rays, *truth, shadow_rays, material, &mask,
                            session.photos[i].role == PhotoRole::kMeasurement ? &shadowed : nullptr, fill_irradiance(i));
     ApplyCameraMatrix(options.colour.camera_matrix, &image);  // colour hook: the camera's RGB
     PhotoSpec& photo = session.photos[i];
@@ -742,13 +743,15 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
     ApplyVignetting(session.camera, effects.vignetting, &image);
     // The sensor (synthetic_radiometry.h): one random stream per (seed, photo, row).
     saturated += SimulateSensor(effects, options.seed, i, &image);
-    const PixelFormat format = effects.bits == 0   ? PixelFormat::kFloat
-                               : effects.bits <= 8 ? PixelFormat::kUint8
-                                                   : PixelFormat::kUint16;
     const PhotoMetadata exif = SyntheticPhotoMetadata(session, photo, i);
-    WriteImage((fs::path(directory.temporary_path()) / photo.file).string(), image, format, &exif);
-    progress.Add(1);
+    const std::string path = (fs::path(directory.temporary_path()) / photo.file).string();
+    wait_for_writing();
+    writing.run([&progress, image = std::move(image), exif, path, format] {
+      WriteImage(path, image, format, &exif);
+      progress.Add(1);
+    });
   }
+  wait_for_writing();
   progress.Finish();
 
   // Radiometry hook: flat field, white reference (with the platform behind its card).

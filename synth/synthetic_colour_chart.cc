@@ -13,6 +13,7 @@
 #include "core/json_reader.h"
 #include "core/light.h"
 #include "core/statistics.h"
+#include "synth/pixel_rays.h"
 #include "synth/synthetic_exif.h"
 #include "synth/synthetic_radiometry.h"
 
@@ -38,53 +39,38 @@ struct ChartFrame {
 Image RenderChart(const Session& session, const Light& light, const Rigid3d& camera_from_world, const ChartFrame& frame,
                   const SynthColourOptions& colour, int supersample, std::vector<uint8_t>* on_white) {
   const Camera& camera = session.camera;
-  const Rigid3d world_from_camera = camera_from_world.Inverse();
-  const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
-  const Eigen::Vector3d eye = world_from_camera.translation;
   const std::array<Eigen::Vector3d, kColorCheckerPatches> albedo = ColorCheckerReference(ColourSpace::kLinearSrgb);
   const double pitch = colour.chart_pitch;
   const double half_columns = 0.5 * kColorCheckerColumns, half_rows = 0.5 * kColorCheckerRows;
-  Image image(camera.width, camera.height, 3);
   on_white->assign(size_t(camera.width) * camera.height, 0);
-  const double weight = 1.0 / (supersample * supersample);
-  tbb::parallel_for(0, camera.height, [&](int y) {
-    for (int x = 0; x < camera.width; ++x) {
-      Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
-      for (int sy = 0; sy < supersample; ++sy) {
-        for (int sx = 0; sx < supersample; ++sx) {
-          const Eigen::Vector2d xy =
-              camera.CamPlaneFromImage(Eigen::Vector2d(x + (sx + 0.5) / supersample, y + (sy + 0.5) / supersample));
-          const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
-          const double denominator = direction.dot(frame.normal);
-          if (!(denominator < 0.0)) continue;
-          const double t = (frame.center - eye).dot(frame.normal) / denominator;
-          if (!(t > 0.0)) continue;
-          const Eigen::Vector3d point = eye + t * direction;
-          // Grid coordinates with the card's centre at 0: patch k's centre at (k % 6 - 2.5, k / 6 - 1.5).
-          const double u = (point - frame.center).dot(frame.right) / pitch;
-          const double v = (point - frame.center).dot(frame.down) / pitch;
-          if (std::abs(u) > half_columns + 0.5 || std::abs(v) > half_rows + 0.5) continue;  // off the card
-          Eigen::Vector3d rho = Eigen::Vector3d::Constant(colour.chart_card_albedo);
-          const double column = std::round(u + half_columns - 0.5), row = std::round(v + half_rows - 0.5);
-          const bool in_grid = column >= 0 && column < kColorCheckerColumns && row >= 0 && row < kColorCheckerRows;
-          const double du = u + half_columns - 0.5 - column, dv = v + half_rows - 0.5 - row;
-          const int patch = in_grid ? int(row) * kColorCheckerColumns + int(column) : -1;
-          if (in_grid && std::abs(du) <= 0.5 * colour.chart_patch_fraction &&
-              std::abs(dv) <= 0.5 * colour.chart_patch_fraction) {
-            rho = albedo[patch];
-            if (patch == 18 && sx == supersample / 2 && sy == supersample / 2) {
-              (*on_white)[size_t(y) * camera.width + x] = 1;
-            }
-          }
-          const Incidence incidence = IncidenceAt(light, point, frame.normal);
-          if (!incidence.lit) continue;
-          radiance += weight / M_PI * rho.cwiseProduct(incidence.irradiance);
-        }
-      }
-      for (int c = 0; c < 3; ++c) image.at(x, y, c) = static_cast<float>(radiance[c]);
-    }
-  });
-  return image;
+  return RenderRays(PixelRays(camera, supersample), camera_from_world,
+                    [&](const Eigen::Vector3d& eye, const PixelRay& ray) -> Eigen::Vector3d {
+                      const double denominator = ray.direction.dot(frame.normal);
+                      if (!(denominator < 0.0)) return Eigen::Vector3d::Zero();
+                      const double t = (frame.center - eye).dot(frame.normal) / denominator;
+                      if (!(t > 0.0)) return Eigen::Vector3d::Zero();
+                      const Eigen::Vector3d point = eye + t * ray.direction;
+                      // Grid coordinates with the card's centre at 0: patch k's centre at (k % 6 - 2.5, k / 6 - 1.5).
+                      const double u = (point - frame.center).dot(frame.right) / pitch;
+                      const double v = (point - frame.center).dot(frame.down) / pitch;
+                      if (std::abs(u) > half_columns + 0.5 || std::abs(v) > half_rows + 0.5) {
+                        return Eigen::Vector3d::Zero();  // off the card
+                      }
+                      Eigen::Vector3d rho = Eigen::Vector3d::Constant(colour.chart_card_albedo);
+                      const double column = std::round(u + half_columns - 0.5), row = std::round(v + half_rows - 0.5);
+                      const bool in_grid =
+                          column >= 0 && column < kColorCheckerColumns && row >= 0 && row < kColorCheckerRows;
+                      const double du = u + half_columns - 0.5 - column, dv = v + half_rows - 0.5 - row;
+                      const int patch = in_grid ? int(row) * kColorCheckerColumns + int(column) : -1;
+                      if (in_grid && std::abs(du) <= 0.5 * colour.chart_patch_fraction &&
+                          std::abs(dv) <= 0.5 * colour.chart_patch_fraction) {
+                        rho = albedo[patch];
+                        if (patch == 18 && ray.centre) (*on_white)[ray.pixel] = 1;
+                      }
+                      const Incidence incidence = IncidenceAt(light, point, frame.normal);
+                      if (!incidence.lit) return Eigen::Vector3d::Zero();
+                      return Eigen::Vector3d(rho.cwiseProduct(incidence.irradiance) / M_PI);
+                    });
 }
 
 nlohmann::json MatrixJson(const Eigen::Matrix3d& m) {

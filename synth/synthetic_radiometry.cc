@@ -14,6 +14,8 @@
 #include "core/light.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
+#include "synth/noise_random.h"
+#include "synth/pixel_rays.h"
 #include "synth/synthetic_colour_chart.h"
 #include "synth/synthetic_exif.h"
 #include "synth/synthetic_targets.h"
@@ -46,10 +48,10 @@ void ApplyVignetting(const Camera& camera, double strength, Image* signal) {
 uint64_t SimulateSensor(const CameraEffects& effects, uint64_t seed, uint64_t stream, Image* signal) {
   Image& image = *signal;
   const double levels_max = effects.bits > 0 ? std::ldexp(1.0, effects.bits) - 1.0 : 0.0;
+  const double read_sigma = effects.read_noise_e / effects.full_well_e;
   std::atomic<uint64_t> clipped{0};
   tbb::parallel_for(0, image.height, [&](int y) {
-    std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + (stream << 32) + uint64_t(y));
-    std::normal_distribution<double> normal(0.0, 1.0);
+    NoiseRandom rng(seed, stream, uint64_t(y));
     uint64_t row_clipped = 0;
     for (int x = 0; x < image.width; ++x) {
       bool pixel_clipped = false;
@@ -58,17 +60,18 @@ uint64_t SimulateSensor(const CameraEffects& effects, uint64_t seed, uint64_t st
         if (effects.shot_noise && v > 0.0) {
           const double electrons = v * effects.full_well_e;
           const double noisy = electrons < 1000.0 ? double(std::poisson_distribution<long>(electrons)(rng))
-                                                  : electrons + std::sqrt(electrons) * normal(rng);
+                                                  : electrons + std::sqrt(electrons) * rng.Normal();
           v = noisy / effects.full_well_e;
         }
-        if (effects.read_noise) v += effects.read_noise_e / effects.full_well_e * normal(rng);
+        if (effects.read_noise) v += read_sigma * rng.Normal();
         v = std::max(0.0, v + effects.black_level);
         if (effects.clip && v >= 1.0) {
           v = 1.0;
           pixel_clipped = true;
         }
         if (effects.srgb) v = LinearToSrgb(v);
-        if (effects.bits > 0) v = std::round(std::min(v, 1.0) * levels_max) / levels_max;
+        // Round half up (v >= 0): the truncating conversion is inline where std::round is a libm call.
+        if (effects.bits > 0) v = double(int64_t(std::min(v, 1.0) * levels_max + 0.5)) / levels_max;
         image.at(x, y, c) = static_cast<float>(v);
       }
       row_clipped += pixel_clipped;
@@ -110,37 +113,23 @@ namespace {
 Image RenderWhiteReference(const Session& session, const Light& light, const Rigid3d& camera_from_world,
                            const WhiteReferenceSpec& white, int supersample, std::vector<uint8_t>* mask) {
   const Camera& camera = session.camera;
-  const Rigid3d world_from_camera = camera_from_world.Inverse();
-  const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
-  const Eigen::Vector3d center = world_from_camera.translation;
   const Eigen::Vector3d u = white.normal.unitOrthogonal(), v = white.normal.cross(u);
-  Image image(camera.width, camera.height, 3);
   mask->assign(size_t(camera.width) * camera.height, 0);
-  const double weight = 1.0 / (supersample * supersample);
-  tbb::parallel_for(0, camera.height, [&](int y) {
-    for (int x = 0; x < camera.width; ++x) {
-      Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
-      for (int sy = 0; sy < supersample; ++sy) {
-        for (int sx = 0; sx < supersample; ++sx) {
-          const Eigen::Vector2d xy =
-              camera.CamPlaneFromImage(Eigen::Vector2d(x + (sx + 0.5) / supersample, y + (sy + 0.5) / supersample));
-          const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
-          const double denominator = direction.dot(white.normal);
-          if (!(denominator < 0.0)) continue;
-          const double t = (white.center - center).dot(white.normal) / denominator;
-          if (!(t > 0.0)) continue;
-          const Eigen::Vector3d offset = center + t * direction - white.center;
-          if (std::abs(offset.dot(u)) > 0.5 * white.size || std::abs(offset.dot(v)) > 0.5 * white.size) continue;
-          if (sx == supersample / 2 && sy == supersample / 2) (*mask)[size_t(y) * camera.width + x] = 1;
-          const Incidence incidence = IncidenceAt(light, white.center + offset, white.normal);
-          if (!incidence.lit) continue;
-          radiance += weight / M_PI * white.reflectance.cwiseProduct(incidence.irradiance);
-        }
-      }
-      for (int c = 0; c < 3; ++c) image.at(x, y, c) = static_cast<float>(radiance[c]);
-    }
-  });
-  return image;
+  return RenderRays(PixelRays(camera, supersample), camera_from_world,
+                    [&](const Eigen::Vector3d& eye, const PixelRay& ray) -> Eigen::Vector3d {
+                      const double denominator = ray.direction.dot(white.normal);
+                      if (!(denominator < 0.0)) return Eigen::Vector3d::Zero();
+                      const double t = (white.center - eye).dot(white.normal) / denominator;
+                      if (!(t > 0.0)) return Eigen::Vector3d::Zero();
+                      const Eigen::Vector3d offset = eye + t * ray.direction - white.center;
+                      if (std::abs(offset.dot(u)) > 0.5 * white.size || std::abs(offset.dot(v)) > 0.5 * white.size) {
+                        return Eigen::Vector3d::Zero();
+                      }
+                      if (ray.centre) (*mask)[ray.pixel] = 1;
+                      const Incidence incidence = IncidenceAt(light, white.center + offset, white.normal);
+                      if (!incidence.lit) return Eigen::Vector3d::Zero();
+                      return Eigen::Vector3d(white.reflectance.cwiseProduct(incidence.irradiance) / M_PI);
+                    });
 }
 
 // The white reference's marker card (SynthTargetOptions::white_card): its pose and what it looks like.
@@ -203,14 +192,10 @@ class WhiteCard {
 Image RenderWhiteCard(const Session& session, const Light& light, const Rigid3d& camera_from_world,
                       const WhiteCard& card, int supersample, std::vector<uint8_t>* mask) {
   const Camera& camera = session.camera;
-  const Rigid3d world_from_camera = camera_from_world.Inverse();
-  const Eigen::Matrix3d rotation = world_from_camera.rotation.toRotationMatrix();
-  const Eigen::Vector3d center = world_from_camera.translation;
+  const CameraRay camera_ray(camera, camera_from_world);
+  const Eigen::Vector3d& center = camera_ray.eye();
   const double patch_albedo = session.calibration->white_reference->reflectance[0];
-  auto ray = [&](const Eigen::Vector2d& pixel) {
-    const Eigen::Vector2d xy = camera.CamPlaneFromImage(pixel);
-    return Eigen::Vector3d((rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized());
-  };
+  auto ray = [&](const Eigen::Vector2d& pixel) { return camera_ray.Direction(pixel); };
   // Radiance of one ray: albedo / pi x the irradiance at its hit (the patch's per-channel albedo).
   auto radiance_along = [&](const Eigen::Vector3d& direction, double* albedo) {
     Eigen::Vector3d point;
@@ -271,11 +256,10 @@ void WriteSynthCalibration(const SynthOptions& options, const std::string& direc
     Image flat(camera.width, camera.height, 3);
     const double noise = effects.shot_noise ? 1.0 / std::sqrt(0.5 * effects.full_well_e * 64.0) : 0.0;
     tbb::parallel_for(0, camera.height, [&](int y) {
-      std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ull + 0xF1A7F1E1Dull + uint64_t(y));
-      std::normal_distribution<double> normal(0.0, 1.0);
+      NoiseRandom rng(options.seed, 0xF1A7F1E1Dull, uint64_t(y));
       for (int x = 0; x < camera.width; ++x) {
         const double v = VignettingAt(camera, effects.vignetting, x + 0.5, y + 0.5);
-        for (int c = 0; c < 3; ++c) flat.at(x, y, c) = static_cast<float>(v * (1.0 + noise * normal(rng)));
+        for (int c = 0; c < 3; ++c) flat.at(x, y, c) = static_cast<float>(v * (1.0 + noise * rng.Normal()));
       }
     });
     session->radiometry.flat_field = "flat_field.exr";

@@ -18,7 +18,8 @@ std::vector<BatchEntryPlan> PlanBatch(const BatchConfig& config, const std::stri
       options.dry_run = true;
       WorkflowRun run(options);
       // A dry run never calls the launcher: the first stage that would run stops the plan.
-      const StageLauncher never = [](const std::string& name, const std::vector<std::string>&) -> int {
+      const StageLauncher never = [](const std::string& name, const std::vector<std::string>&,
+                                     const std::string&) -> int {
         IBRDF_CHECK(false) << "dry run launched stage " << name;
         return 1;
       };

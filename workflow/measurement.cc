@@ -36,19 +36,34 @@ class Planner {
   std::string At(const std::string& name) const { return run_->Path(name); }
 
   // Executes `stage`; one without an action runs its arguments through the launcher.
-  void Execute(Stage stage) {
-    if (!stage.action) {
-      stage.action = [launch = launch_, name = stage.name, arguments = stage.arguments] {
-        return launch(name, arguments);
-      };
+  void Execute(Stage stage) { run_->Execute(WithAction(std::move(stage))); }
+
+  // Executes `stages` at the same time (WorkflowRun::ExecuteTogether); all but `live` send their output
+  // to DIR/logs/<name>.log, printed when they end.
+  void ExecuteTogether(std::vector<Stage> stages, const std::string& live) {
+    for (Stage& stage : stages) {
+      if (stage.name == live) continue;
+      fs::create_directories(At("logs"));
+      stage.output_log = At("logs/" + stage.name + ".log");
     }
-    run_->Execute(std::move(stage));
+    for (Stage& stage : stages) stage = WithAction(std::move(stage));
+    run_->ExecuteTogether(std::move(stages));
   }
 
   // The session at `path`; absent only when the stage that writes it was left out by --stop-after.
   std::optional<Session> SessionAt(const std::string& path) const {
     if (run_->stopped() && !fs::exists(path)) return std::nullopt;
     return Session::Load(path);
+  }
+
+  // `stage` with its action: as given, or its arguments through the launcher (into its output_log).
+  Stage WithAction(Stage stage) const {
+    if (!stage.action) {
+      stage.action = [launch = launch_, name = stage.name, arguments = stage.arguments, log = stage.output_log] {
+        return launch(name, arguments, log);
+      };
+    }
+    return stage;
   }
 
   void Synth(const Recipe& recipe);
@@ -98,7 +113,7 @@ void Planner::Scan() {
     merged.sample.mesh_file = At("scan/mesh.ply");
     merged.sample.scan_inputs.clear();
     scan.action = [launch = launch_, arguments = scan.arguments, merged, folder = At("scan")] {
-      const int code = launch("scan", arguments);
+      const int code = launch("scan", arguments, "");
       if (code == 0) merged.SaveRebased(folder, Session::PathStyle::kAbsolute);
       return code;
     };
@@ -166,7 +181,6 @@ void Planner::SampleStages() {
                           samples_in, {At("consistency.json")});
   if (options_.check_regression) check.arguments.push_back("--regression");
   check.arguments.insert(check.arguments.end(), options_.check_args.begin(), options_.check_args.end());
-  Execute(check);
 
   Stage compare = MakeStage("compare", {}, samples_in, {At("truth-comparison.json")});
   if (truth_path.empty()) {
@@ -176,7 +190,6 @@ void Planner::SampleStages() {
                          "--out",   At("truth-comparison.json"), "--overwrite"};
     compare.inputs.push_back(truth_path);
   }
-  Execute(compare);
 
   Stage reconstruct =
       MakeStage("reconstruct", {"reconstruct", At("samples.npy"), "--out", At("reconstruction"), "--overwrite"},
@@ -201,7 +214,16 @@ void Planner::SampleStages() {
     reconstruct.arguments.insert(reconstruct.arguments.end(), {"--name", material_name});
   }
   reconstruct.arguments.insert(reconstruct.arguments.end(), extra.begin(), extra.end());
-  Execute(reconstruct);
+  // The three only read the samples (and the truth): with concurrent_sample_stages, reconstruct (the
+  // longest, its progress shown live) runs beside check and compare, filling the cores its serial parts
+  // leave idle. The stage order, outputs and stamps are those of the sequential run.
+  if (options_.concurrent_sample_stages) {
+    ExecuteTogether({check, compare, reconstruct}, "reconstruct");
+  } else {
+    Execute(check);
+    Execute(compare);
+    Execute(reconstruct);
+  }
 
   Stage report = MakeStage("report", {"report", run_->run_dir(), "--out", At("report"), "--overwrite"}, {},
                            {At("report/index.html")});

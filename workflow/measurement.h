@@ -28,7 +28,10 @@ struct MeasurementOptions {
   bool check_regression = false;  // check --regression (slower: three held-out fits)
   bool report = true;             // the HTML report (--no-report)
   bool force = false;             // re-run every stage (--force)
-  std::string stop_after;         // the last stage to run ("": all of them) (--stop-after)
+  // check and compare run beside reconstruct (they only read the samples; their output is shown when
+  // they end); false: one stage after another (--sequential).
+  bool concurrent_sample_stages = true;
+  std::string stop_after;  // the last stage to run ("": all of them) (--stop-after)
   // Extra arguments appended to a stage's command line as given (--derender-args, --check-args,
   // --reconstruct-args, --report-args, and run's named pass-through options); part of the stage's stamp.
   std::vector<std::string> derender_args, check_args, reconstruct_args, report_args;
@@ -49,8 +52,10 @@ struct MeasurementInput {
 MeasurementInput OpenMeasurementInput(const std::string& input, const std::string& out);
 
 // Runs a stage's `ibrdf` command line (the arguments after the program and its global flags) for the
-// stage `name`; returns its exit status (0: success; 128 + N: killed by signal N).
-using StageLauncher = std::function<int(const std::string& name, const std::vector<std::string>& arguments)>;
+// stage `name`, its output into the file `log_path` ("": this process's output); returns its exit
+// status (0: success; 128 + N: killed by signal N).
+using StageLauncher =
+    std::function<int(const std::string& name, const std::vector<std::string>& arguments, const std::string& log_path)>;
 
 // Plans and executes every stage of the measurement in `run`; returns the truth.json used ("" for a
 // real session). Throws Error when a stage fails or a session written by one is invalid.

@@ -16,6 +16,9 @@ struct Stage {
   // Runs the stage: 0 on success, otherwise an exit status (128 + N: killed by signal N). `ibrdf run`
   // runs a child `ibrdf` process here (apps/run_command.cc); tests use plain functions.
   std::function<int()> action;
+  // Run beside other stages (WorkflowRun::ExecuteTogether): the file the action sends its output to
+  // ("": this process's output, live); printed, in stage order, once the stages have ended.
+  std::string output_log;
 };
 
 // What happened to a stage in one invocation.

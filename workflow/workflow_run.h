@@ -37,6 +37,13 @@ class WorkflowRun {
   // runs again. Throws Error when the action fails ("stage NAME failed (exit N) ...").
   const StageOutcome& Execute(Stage stage);
 
+  // Decides `stages` in order as Execute does, then runs those that are due at the same time (each
+  // action on its own thread; they must not read each other's outputs), and records them in order once
+  // all have ended: the output_log of each is printed, then its time, and its stamp written if it
+  // succeeded. Throws Error for the first that failed, after the others have ended (a stage that
+  // succeeded beside it keeps its stamp). With dry_run, or one stage due, it is Execute one by one.
+  void ExecuteTogether(std::vector<Stage> stages);
+
   // True once the stop_after stage has been executed: the stages after it do not run.
   bool stopped() const { return !stopped_.empty(); }
   // The stages executed so far, in order.
@@ -52,8 +59,13 @@ class WorkflowRun {
   std::string Path(const std::string& name) const;
 
  private:
+  // Logs the heading of a stage that runs and removes its old stamp.
+  void Begin(const Stage& stage, size_t number, const std::string& stale, const std::string& beside);
+  // Records a finished action: throws Error when `code` is a failure, else stamps it and logs its time.
+  void Finish(const Stage& stage, const std::string& stale, int code, double seconds);
+
   WorkflowOptions options_;
-  std::string stopped_;  // why later stages do not run ("--stop-after NAME"), once they do not
+  std::string stopped_;    // why later stages do not run ("--stop-after NAME"), once they do not
   std::string would_run_;  // dry_run: the first stage that would run, and why
   std::vector<Stage> stages_;
   std::map<std::string, StageOutcome> outcomes_;

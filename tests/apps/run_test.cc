@@ -91,6 +91,38 @@ TEST(RunCommand, AllStagesWriteTheSummaryAndASecondRunSkipsEveryStage) {
   EXPECT_EQ(again["timings_s"]["derender"], summary["timings_s"]["derender"]);
 }
 
+// check and compare run beside reconstruct: their output is captured and printed after the three
+// ended (DIR/logs/), the order and outputs are those of --sequential (the same bytes).
+TEST(RunCommand, SampleStagesRunTogetherWithTheSequentialOutputs) {
+  ScratchDir dir;
+  ASSERT_EQ(RunIbrdf(kSynth + dir / "s").exit_code, 0);
+  const RunResult together =
+      RunIbrdf("run " + dir / "s" + " --out " + dir / "together" + " --no-fits --no-report", true);
+  ASSERT_EQ(together.exit_code, 0) << together.output;
+  EXPECT_NE(together.output.find("== run 5: check (no record of a completed run); beside compare, reconstruct"),
+            std::string::npos)
+      << together.output;
+  EXPECT_TRUE(fs::exists(dir / "together/logs/check.log"));
+  // check's own line is printed after reconstruct's, not interleaved with it.
+  EXPECT_LT(together.output.find("-- reconstruct:"), together.output.find("\ncheck: "));
+  EXPECT_NE(together.output.find("\ncheck: "), std::string::npos);
+  const RunResult sequential =
+      RunIbrdf("run " + dir / "s" + " --out " + dir / "sequential" + " --no-fits --no-report --sequential", true);
+  ASSERT_EQ(sequential.exit_code, 0) << sequential.output;
+  EXPECT_EQ(sequential.output.find("beside"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "sequential/logs"));
+  EXPECT_EQ(Slurp(dir / "together/consistency.json"), Slurp(dir / "sequential/consistency.json"));
+  EXPECT_EQ(Slurp(dir / "together/reconstruction/brdf.binary"), Slurp(dir / "sequential/reconstruction/brdf.binary"));
+  const nlohmann::json a = ReadJson(dir / "together/truth-comparison.json");
+  const nlohmann::json b = ReadJson(dir / "sequential/truth-comparison.json");
+  EXPECT_EQ(a["overall"], b["overall"]);
+  EXPECT_EQ(a["bands"], b["bands"]);
+  const nlohmann::json summary = ReadJson(dir / "together/summary.json");
+  for (const char* stage : {"check", "compare", "reconstruct"}) {
+    EXPECT_EQ(summary["stages"][stage]["status"], "ran") << stage;
+  }
+}
+
 TEST(RunCommand, ChangedOptionsOrInputsRerunTheStage) {
   ScratchDir dir;
   ASSERT_EQ(RunIbrdf(kSynth + dir / "s").exit_code, 0);

@@ -53,6 +53,35 @@ TEST(PhotoComparison, OwnBrdfGivesThePhotoAndABrighterModelItsRatio) {
   EXPECT_TRUE(std::isnan(none.linear.at(10, 10, 0)));
 }
 
+// A channel the sample did not measure (its `valid` flag 0: clipped, under the floor) is left out of
+// the difference: a photo clipped in red, whose samples' red is flagged, still compares equal to the
+// samples' own BRDF in green and blue; with no channel measured there is no difference at all.
+TEST(PhotoComparison, UnmeasuredChannelsAreLeftOut) {
+  Scene scene = MakeScene(1);
+  for (BrdfSample& s : scene.samples) {
+    scene.photo.at(int(s.pixel[0]), int(s.pixel[1]), 0) = 0.05f;  // red clipped low: no longer f * E
+    s.valid[0] = 0;
+  }
+  const PixelBox box{0, 0, 39, 29};
+  const PhotoRender same = RenderPhotoPixels(scene.photo, box, scene.pointers, "same",
+                                             [](auto&, auto&) { return Eigen::Vector3d(0.2, 0.3, 0.4); });
+  EXPECT_NEAR(same.median_abs_difference, 0.0, 1e-6);
+  EXPECT_NEAR(same.difference.at(20, 12, 0), 0.0, 1e-6);
+  // A model wrong only in the unmeasured channel makes no difference; one 10 % brighter in green and
+  // blue shows +10 %.
+  const PhotoRender red_off = RenderPhotoPixels(scene.photo, box, scene.pointers, "red",
+                                                [](auto&, auto&) { return Eigen::Vector3d(0.9, 0.3, 0.4); });
+  EXPECT_NEAR(red_off.median_abs_difference, 0.0, 1e-6);
+  const PhotoRender brighter = RenderPhotoPixels(scene.photo, box, scene.pointers, "brighter",
+                                                 [](auto&, auto&) { return Eigen::Vector3d(0.2, 0.33, 0.44); });
+  EXPECT_NEAR(brighter.median_abs_difference, 0.1, 1e-5);
+  for (BrdfSample& s : scene.samples) s.valid[1] = s.valid[2] = 0;
+  const PhotoRender unmeasured = RenderPhotoPixels(scene.photo, box, scene.pointers, "same",
+                                                   [](auto&, auto&) { return Eigen::Vector3d(0.2, 0.3, 0.4); });
+  EXPECT_TRUE(std::isnan(unmeasured.difference.at(20, 12, 0)));
+  EXPECT_TRUE(std::isnan(unmeasured.median_abs_difference));
+}
+
 TEST(PhotoComparison, StrideIsFoundAndFillsBlocks) {
   const Scene scene = MakeScene(3);
   EXPECT_EQ(SampleStride(scene.pointers), 3);

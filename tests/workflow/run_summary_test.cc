@@ -71,8 +71,8 @@ class SummaryTest : public ::testing::Test {
   }
   json Build() {
     WorkflowRun run({dir_ / "run", "build", "ibrdf test", false, ""});
-    run.Execute({"derender", {"derender"}, {}, {}, "", [] { return 0; }});
-    run.Execute({"scan", {}, {}, {}, "no scans", nullptr});
+    run.Execute({"derender", {"derender"}, {}, {}, "", [] { return 0; }, ""});
+    run.Execute({"scan", {}, {}, {}, "no scans", nullptr, ""});
     return BuildRunSummary(run, dir_ / "s", dir_ / "s/truth.json", 1.5);
   }
   ScratchDir dir_;

@@ -5,10 +5,12 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -46,7 +48,7 @@ class FakeStages : public ::testing::Test {
     return options;
   }
   Stage Copy(const std::string& option = "--gain 1") {
-    Stage stage{"copy", {"copy", option}, {Input()}, {Output()}, "", nullptr};
+    Stage stage{"copy", {"copy", option}, {Input()}, {Output()}, "", nullptr, ""};
     stage.action = [this, option] {
       ++runs_;
       std::ifstream in(Input());
@@ -201,6 +203,58 @@ TEST_F(FakeStages, StampRoundTrips) {
   EXPECT_EQ(stamp.outputs, (std::vector<std::string>{Output()}));
   EXPECT_EQ(stamp.seconds, outcome.seconds);
   EXPECT_EQ(Fingerprint(dir_ / "absent").size, -1);
+}
+
+// Stages run together (the sample stages of `ibrdf run`): each waits until the other has started, so
+// they pass only when they really run at the same time; they are recorded in the order given, stamped,
+// and skipped together when up to date; a failed one is reported after the other ended and stamped.
+TEST_F(FakeStages, ExecuteTogetherRunsStagesAtTheSameTime) {
+  std::atomic<int> started{0};
+  auto waiting_stage = [&](const std::string& name, int code) {
+    Stage stage{name, {name}, {Input()}, {dir_ / ("run/" + name + ".txt")}, "", nullptr, ""};
+    stage.action = [&started, code, output = stage.outputs[0]] {
+      ++started;
+      for (int i = 0; i < 10000 && started < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      if (started < 2) return 99;  // ran alone
+      WriteText(output, "done");
+      return code;
+    };
+    return stage;
+  };
+  {
+    WorkflowRun run(Options());
+    run.ExecuteTogether({waiting_stage("a", 0), waiting_stage("b", 0)});
+    ASSERT_EQ(run.stages().size(), 2u);
+    EXPECT_EQ(run.stages()[0].name, "a");
+    EXPECT_EQ(run.outcome("a").status, StageStatus::kRan);
+    EXPECT_EQ(run.outcome("b").status, StageStatus::kRan);
+  }
+  {
+    started = 0;
+    WorkflowRun run(Options());
+    run.ExecuteTogether({waiting_stage("a", 0), waiting_stage("b", 0)});
+    EXPECT_EQ(run.outcome("a").status, StageStatus::kSkipped);
+    EXPECT_EQ(run.outcome("b").status, StageStatus::kSkipped);
+  }
+  {
+    started = 0;
+    WorkflowOptions options = Options();
+    options.force = true;
+    WorkflowRun run(options);
+    EXPECT_THROW(run.ExecuteTogether({waiting_stage("a", 3), waiting_stage("b", 0)}), Error);
+    EXPECT_FALSE(fs::exists(StampPath(RunDir(), "a")));
+    EXPECT_TRUE(fs::exists(StampPath(RunDir(), "b")));  // it succeeded beside the failure
+  }
+  {
+    // --stop-after inside the group: the later stage does not apply.
+    WorkflowOptions options = Options();
+    options.force = true;
+    options.stop_after = "copy";
+    WorkflowRun run(options);
+    run.ExecuteTogether({Copy(), waiting_stage("b", 0)});
+    EXPECT_EQ(run.outcome("copy").status, StageStatus::kRan);
+    EXPECT_EQ(run.outcome("b").status, StageStatus::kNotApplicable);
+  }
 }
 
 TEST(WorkflowOptions, RunDirAndBuildIdAreRequired) {
