@@ -43,7 +43,6 @@ class Planner {
   void ExecuteTogether(std::vector<Stage> stages, const std::string& live) {
     for (Stage& stage : stages) {
       if (stage.name == live) continue;
-      fs::create_directories(At("logs"));
       stage.output_log = At("logs/" + stage.name + ".log");
     }
     for (Stage& stage : stages) stage = WithAction(std::move(stage));
@@ -60,6 +59,8 @@ class Planner {
   Stage WithAction(Stage stage) const {
     if (!stage.action) {
       stage.action = [launch = launch_, name = stage.name, arguments = stage.arguments, log = stage.output_log] {
+        // The log's folder appears only when a stage really runs (never in a dry run).
+        if (!log.empty()) fs::create_directories(fs::path(log).parent_path());
         return launch(name, arguments, log);
       };
     }
