@@ -48,25 +48,30 @@ const StageOutcome& WorkflowRun::outcome(const std::string& stage) const {
   return it->second;
 }
 
-const StageOutcome& WorkflowRun::Execute(Stage stage) {
-  if (stopped()) stage.not_applicable = stopped_;
-  if (stage.name == options_.stop_after) stopped_ = "--stop-after " + options_.stop_after;
-  IBRDF_CHECK(!outcomes_.count(stage.name)) << "stage " << stage.name << " executed twice";
-  stages_.push_back(stage);
-  StageOutcome& outcome = outcomes_[stage.name];
-  const std::string heading = "== run " + std::to_string(stages_.size()) + ": " + stage.name;
-  if (!stage.not_applicable.empty()) {
-    outcome = {StageStatus::kNotApplicable, stage.not_applicable, 0.0};
-    Log(1, heading + ": not applicable (" + stage.not_applicable + ")");
-    return outcome;
+std::string WorkflowRun::Decide(Stage* stage) {
+  if (stopped()) stage->not_applicable = stopped_;
+  if (stage->name == options_.stop_after) stopped_ = "--stop-after " + options_.stop_after;
+  IBRDF_CHECK(!outcomes_.count(stage->name)) << "stage " << stage->name << " executed twice";
+  stages_.push_back(*stage);
+  StageOutcome& outcome = outcomes_[stage->name];
+  const std::string heading = "== run " + std::to_string(stages_.size()) + ": " + stage->name;
+  if (!stage->not_applicable.empty()) {
+    outcome = {StageStatus::kNotApplicable, stage->not_applicable, 0.0};
+    Log(1, heading + ": not applicable (" + stage->not_applicable + ")");
+    return "";
   }
-  const std::string stamp_path = StampPath(options_.run_dir, stage.name);
-  const std::string stale = options_.force ? "--force" : WhyStale(options_.run_dir, stage, options_.build_id);
+  const std::string stale = options_.force ? "--force" : WhyStale(options_.run_dir, *stage, options_.build_id);
   if (stale.empty()) {
-    outcome = {StageStatus::kSkipped, "up to date", Stamp::Read(stamp_path).seconds};
+    outcome = {StageStatus::kSkipped, "up to date", Stamp::Read(StampPath(options_.run_dir, stage->name)).seconds};
     Log(1, heading + ": up to date, skipped (took " + FormatSeconds(outcome.seconds) + " when it ran)");
-    return outcome;
   }
+  return stale;
+}
+
+const StageOutcome& WorkflowRun::Execute(Stage stage) {
+  const std::string stale = Decide(&stage);
+  StageOutcome& outcome = outcomes_[stage.name];
+  if (stale.empty()) return outcome;
   if (options_.dry_run) {
     would_run_ = stage.name + " (" + stale + ")";
     stopped_ = "dry run: " + would_run_ + " would run first";
@@ -112,23 +117,8 @@ void WorkflowRun::ExecuteTogether(std::vector<Stage> stages) {
   };
   std::vector<Due> due;
   for (Stage& stage : stages) {
-    if (stopped()) stage.not_applicable = stopped_;
-    if (stage.name == options_.stop_after) stopped_ = "--stop-after " + options_.stop_after;
-    IBRDF_CHECK(!outcomes_.count(stage.name)) << "stage " << stage.name << " executed twice";
-    stages_.push_back(stage);
-    StageOutcome& outcome = outcomes_[stage.name];
-    const std::string heading = "== run " + std::to_string(stages_.size()) + ": " + stage.name;
-    if (!stage.not_applicable.empty()) {
-      outcome = {StageStatus::kNotApplicable, stage.not_applicable, 0.0};
-      Log(1, heading + ": not applicable (" + stage.not_applicable + ")");
-      continue;
-    }
-    const std::string stale = options_.force ? "--force" : WhyStale(options_.run_dir, stage, options_.build_id);
-    if (stale.empty()) {
-      outcome = {StageStatus::kSkipped, "up to date", Stamp::Read(StampPath(options_.run_dir, stage.name)).seconds};
-      Log(1, heading + ": up to date, skipped (took " + FormatSeconds(outcome.seconds) + " when it ran)");
-      continue;
-    }
+    const std::string stale = Decide(&stage);
+    if (stale.empty()) continue;
     IBRDF_CHECK(stage.action) << "stage " << stage.name << " has no action";
     due.push_back({stages_.size() - 1, stale});
   }

@@ -59,6 +59,9 @@ class WorkflowRun {
   std::string Path(const std::string& name) const;
 
  private:
+  // Records `stage` (not applicable once the run stopped) and decides it: returns why it must run, or
+  // "" when it is not applicable or up to date (its outcome then recorded and logged).
+  std::string Decide(Stage* stage);
   // Logs the heading of a stage that runs and removes its old stamp.
   void Begin(const Stage& stage, size_t number, const std::string& stale, const std::string& beside);
   // Records a finished action: throws Error when `code` is a failure, else stamps it and logs its time.
