@@ -60,6 +60,26 @@ std::vector<FitSample> PickSamples(const std::vector<BrdfSample>& samples, const
   return picked;
 }
 
+// The indices 0 .. count - 1.
+std::vector<size_t> AllIndices(size_t count) {
+  std::vector<size_t> all(count);
+  for (size_t i = 0; i < count; ++i) all[i] = i;
+  return all;
+}
+
+// The samples the starts are ranked on (ModelFitOptions::start_samples): a random subset of
+// `start_samples` of the indices 0 .. count - 1 (shuffled with `seed`), or all of them in order where
+// start_samples is 0 or not below count (every start solved on all samples).
+std::vector<size_t> StartSubset(size_t count, size_t start_samples, uint64_t seed) {
+  std::vector<size_t> subset = AllIndices(count);
+  if (start_samples > 0 && start_samples < count) {
+    std::mt19937_64 rng(seed);
+    std::shuffle(subset.begin(), subset.end(), rng);
+    subset.resize(start_samples);
+  }
+  return subset;
+}
+
 ceres::Solver::Options SolverOptions(const ModelFitOptions& options) {
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
@@ -107,7 +127,9 @@ std::vector<double> BandRelativeRms(const BrdfModel& model, const std::vector<Fi
 }
 
 // Penalty keeping a lobe's maximum anywhere, max(|Cxy|, |Cz|)^n, below `cap`: the excess of n log(max)
-// over log(cap), weighted heavily (the data residuals are in sigmas).
+// over log(cap), weighted heavily (the data residuals are in sigmas). (The base's exact maximum is
+// max(|Cxy|, Cz): a negative Cz only lowers it; counting |Cz| is conservative, and relaxing it moved
+// the primer's fit to a worse minimum: docs/decisions.md, issue 14.)
 template <int kLobes>
 struct LobeCapPenalty {
   explicit LobeCapPenalty(double log_cap_in) : log_cap(log_cap_in) {}
@@ -162,7 +184,7 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
       if (!std::isfinite(s.sigma[c])) continue;  // not measured
       problem.AddResidualBlock(new LafortuneAnalyticResidual<kLobes>(s.wi, s.wo, s.value[c], s.sigma[c]), &huber, p);
     }
-    const double cap = std::max(options.max_lobe_ratio * maximum[c], 1e-3);
+    const double cap = std::max(options.max_lobe_ratio * maximum[c], options.min_lobe_cap);
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LobeCapPenalty<kLobes>, kLobes, kParameters>(
                                  new LobeCapPenalty<kLobes>(std::log(cap))),
                              nullptr, p);
@@ -185,15 +207,9 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
   // subset ranks the starts, and each channel's best is then refined on all samples (on the demo's and
   // the squash's samples this gives the same fit as every start on all samples at a third of the CPU:
   // docs/benchmarks.md, issue 14).
-  std::vector<size_t> all(samples.size());
-  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
-  std::vector<size_t> subset = all;
-  const bool two_phase = options.start_samples > 0 && options.start_samples < samples.size();
-  if (two_phase) {
-    std::mt19937_64 rng(options.seed + 1);
-    std::shuffle(subset.begin(), subset.end(), rng);
-    subset.resize(options.start_samples);
-  }
+  const std::vector<size_t> all = AllIndices(samples.size());
+  const std::vector<size_t> subset = StartSubset(samples.size(), options.start_samples, options.seed + 1);
+  const bool two_phase = subset.size() < all.size();
   std::array<std::array<double, kParameters>, 3 * kStarts> solutions;
   std::array<double, 3 * kStarts> costs;
   tbb::parallel_for(0, 3 * kStarts, [&](int job) {
@@ -257,6 +273,7 @@ bool ModelFitOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GT(max_theta_deg, 0.0);
   IBRDF_CHECK_OPTION_LE(max_theta_deg, 90.0);
   IBRDF_CHECK_OPTION_GE(max_lobe_ratio, 1.0);
+  IBRDF_CHECK_OPTION_GT(min_lobe_cap, 0.0);
   return true;
 }
 
@@ -420,16 +437,10 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
     ceres::Solve(solver, &problem, &summary);
     return summary.final_cost;
   };
-  std::vector<size_t> all(picked.size());
-  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
-  std::vector<size_t> subset = all;
-  const bool two_phase = options.start_samples > 0 && options.start_samples < picked.size();
-  if (two_phase) {
-    std::mt19937_64 rng(options.seed + 2);
-    std::shuffle(subset.begin(), subset.end(), rng);
-    subset.resize(options.start_samples);
-    result.start_samples = subset.size();
-  }
+  const std::vector<size_t> all = AllIndices(picked.size());
+  const std::vector<size_t> subset = StartSubset(picked.size(), options.start_samples, options.seed + 2);
+  const bool two_phase = subset.size() < all.size();
+  if (two_phase) result.start_samples = subset.size();
   tbb::parallel_for(0, kStarts * kVariants, [&](int job) {
     const int start = job % kStarts;
     const bool dielectric = job / kStarts == 0;
