@@ -34,6 +34,10 @@ TEST(ModelFit, DefaultOptionsAreValid) {
   few_starts.start_samples = 5;
   EXPECT_FALSE(few_starts.Check(&why));
   EXPECT_NE(why.find("start_samples"), std::string::npos) << why;
+  ModelFitOptions no_cap;
+  no_cap.min_lobe_cap = 0.0;
+  EXPECT_FALSE(no_cap.Check(&why));
+  EXPECT_NE(why.find("min_lobe_cap"), std::string::npos) << why;
 }
 
 TEST(ModelFit, LafortuneCostGradientIsCorrect) {
@@ -273,10 +277,10 @@ TEST(ModelFitPlausibility, OneLobeFitRecoversTheExponent) {
 
 // Every bundled material and a Lafortune truth with broad lobes: each fitted model's directional
 // albedo stays at most 1 over the whole hemisphere, no fit exceeds 3x the truth at retro-reflection
-// up to grazing (never sampled: the cameras start 8 degrees from the light), and the chosen model
-// (the lower error against the samples) is within 3x of the truth there up to 80 degrees, the
-// derenderer's grazing limit. Beyond it the felt's grazing retro-reflection is under-estimated (5x
-// at 85 degrees): reported in docs/benchmarks.md, not tested.
+// up to grazing (never sampled: the cameras start 8 degrees from the light, the samples stop at 80
+// degrees), and the chosen model (the lower error against the samples) is within 3x of the truth
+// there up to 89 degrees: the felt's narrow grazing retro-reflection (1.5 /sr at 89 degrees, 15 times
+// its largest sample) is kept by a lobe at the 1 /sr floor of the lobe cap.
 TEST(ModelFitPlausibility, FitsArePlausibleWhereNoCameraLooked) {
   std::vector<std::pair<std::string, std::unique_ptr<BrdfModel>>> truths;
   for (const char* name : {"bluepaint", "clay", "felt", "glossy-ggx", "lambertian50", "primer"}) {
@@ -306,7 +310,7 @@ TEST(ModelFitPlausibility, FitsArePlausibleWhereNoCameraLooked) {
         for (int c = 0; c < 3; ++c) {
           EXPECT_LE(f[c], 3.0 * t[c]) << name << " " << fit->model << " retro at " << theta_deg << " deg, channel " << c
                                       << ": " << fit->brdf->ToJson().dump();
-          if (fit != &chosen || theta_deg > 80.0) continue;
+          if (fit != &chosen) continue;
           EXPECT_GE(f[c], t[c] / 3.0) << name << " " << fit->model << " retro at " << theta_deg << " deg, channel " << c
                                       << ": " << fit->brdf->ToJson().dump();
         }
