@@ -184,7 +184,8 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
       if (!std::isfinite(s.sigma[c])) continue;  // not measured
       problem.AddResidualBlock(new LafortuneAnalyticResidual<kLobes>(s.wi, s.wo, s.value[c], s.sigma[c]), &huber, p);
     }
-    const double cap = std::max(options.max_lobe_ratio * maximum[c], options.min_lobe_cap);
+    const double cap = std::max(options.max_lobe_ratio * maximum[c],
+                                std::min(options.min_lobe_cap, options.max_lobe_floor_ratio * maximum[c]));
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LobeCapPenalty<kLobes>, kLobes, kParameters>(
                                  new LobeCapPenalty<kLobes>(std::log(cap))),
                              nullptr, p);
@@ -274,6 +275,7 @@ bool ModelFitOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_LE(max_theta_deg, 90.0);
   IBRDF_CHECK_OPTION_GE(max_lobe_ratio, 1.0);
   IBRDF_CHECK_OPTION_GT(min_lobe_cap, 0.0);
+  IBRDF_CHECK_OPTION_GE(max_lobe_floor_ratio, max_lobe_ratio);
   return true;
 }
 

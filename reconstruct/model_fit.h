@@ -32,13 +32,16 @@ struct ModelFitOptions {
   size_t start_samples = 4000;
   double start_tolerance = 1e-6;  // Ceres function and parameter tolerance of those solves (ranking only)
   double max_theta_deg = 80.0;    // samples beyond this theta_i or theta_e are left out
-  // A Lafortune lobe's largest value anywhere, max(|Cxy|, |Cz|)^n, is held below the larger of
-  // max_lobe_ratio times the largest sample value and min_lobe_cap (a penalty): no lobe grows without
-  // bound towards unsampled directions. A lobe whose base never exceeds 1 (|Cxy|, |Cz| <= 1) is
-  // bounded by 1 /sr whatever its exponent, so the floor of 1 /sr lets a dull material keep a narrow
-  // grazing lobe its samples show (felt's retro-reflection: docs/reconstruct.md).
+  // A Lafortune lobe's largest value anywhere, max(|Cxy|, |Cz|)^n, is held below a cap (a penalty), so
+  // no lobe grows without bound towards unsampled directions: max_lobe_ratio times the largest sample
+  // value, or min_lobe_cap where that is higher (a lobe whose base never exceeds 1, |Cxy|, |Cz| <= 1,
+  // is bounded by 1 /sr whatever its exponent: a dull material keeps the narrow grazing lobe its
+  // samples show, felt's retro-reflection), but that floor at most max_lobe_floor_ratio times the
+  // largest sample (samples in arbitrary units, relative light intensities, must not loosen the cap
+  // without bound). docs/reconstruct.md, "Plausible where no camera looked".
   double max_lobe_ratio = 3.0;
-  double min_lobe_cap = 1.0;  // 1/sr
+  double min_lobe_cap = 1.0;           // 1/sr
+  double max_lobe_floor_ratio = 30.0;  // times the largest sample
   uint64_t seed = 1;
   bool Check(std::string* why) const;
 };
