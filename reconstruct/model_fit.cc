@@ -151,7 +151,7 @@ struct LobeCapPenalty {
 template <int kLobes>
 std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& samples, const ModelFitOptions& options,
                                                  double* cost, int* starts, size_t* ranked_on,
-                                                 std::vector<std::string>* at_bound) {
+                                                 std::vector<std::string>* at_bound, std::vector<std::string>* at_cap) {
   // Starting lobes: a forward (specular) lobe, a retro-reflective one and a broad one, in several
   // sharpnesses; every channel keeps the best of its starts. Channels and starts run in parallel.
   const double starts_table[][3][3] = {
@@ -172,6 +172,12 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
       maximum[c] = std::max(maximum[c], s.value[c]);
     }
   }
+  // Each channel's lobe cap (ModelFitOptions::max_lobe_ratio, min_lobe_cap, max_lobe_floor_ratio).
+  Eigen::Vector3d caps;
+  for (int c = 0; c < 3; ++c) {
+    caps[c] = std::max(options.max_lobe_ratio * maximum[c],
+                       std::min(options.min_lobe_cap, options.max_lobe_floor_ratio * maximum[c]));
+  }
   // One channel's solve from `p` over `fitted` (indices into `samples`); returns the final cost. A
   // `ranking` solve (a start on the subset) stops at options.start_tolerance.
   const auto solve = [&](int c, const std::vector<size_t>& fitted, double* p, bool ranking) {
@@ -184,10 +190,8 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
       if (!std::isfinite(s.sigma[c])) continue;  // not measured
       problem.AddResidualBlock(new LafortuneAnalyticResidual<kLobes>(s.wi, s.wo, s.value[c], s.sigma[c]), &huber, p);
     }
-    const double cap = std::max(options.max_lobe_ratio * maximum[c],
-                                std::min(options.min_lobe_cap, options.max_lobe_floor_ratio * maximum[c]));
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LobeCapPenalty<kLobes>, kLobes, kParameters>(
-                                 new LobeCapPenalty<kLobes>(std::log(cap))),
+                                 new LobeCapPenalty<kLobes>(std::log(caps[c]))),
                              nullptr, p);
     problem.SetParameterLowerBound(p, 0, 0.0);
     for (int k = 0; k < kLobes; ++k) {
@@ -255,6 +259,13 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
       if (p[3 + 3 * k] >= 2000.0 - 1e-3) note("n", 2000.0);
       if (std::abs(p[1 + 3 * k]) >= 20.0 - 1e-6) note("Cxy", p[1 + 3 * k]);
       if (std::abs(p[2 + 3 * k]) >= 20.0 - 1e-6) note("Cz", p[2 + 3 * k]);
+      // A lobe whose peak anywhere is within 1 % of the cap: the cap, not the samples, set its size there.
+      const double largest = std::max(std::abs(p[1 + 3 * k]), std::abs(p[2 + 3 * k]));
+      if (largest > 0.0 && p[3 + 3 * k] * std::log(largest) >= std::log(caps[c]) - 0.01) {
+        char line[96];
+        std::snprintf(line, sizeof(line), "lobe %d %c at %.3g /sr", k + 1, channel_names[c], caps[c]);
+        at_cap->push_back(line);
+      }
     }
   }
   return std::make_unique<LafortuneBrdf>(diffuse, lobes);
@@ -308,6 +319,10 @@ std::string ModelFitResult::BriefReport() const {
     text += "; at a bound of the fit:";
     for (const std::string& b : at_bound) text += " " + b + ";";
   }
+  if (!at_lobe_cap.empty()) {
+    text += "; peak held at the lobe cap:";
+    for (const std::string& b : at_lobe_cap) text += " " + b + ";";
+  }
   return text;
 }
 
@@ -317,6 +332,7 @@ nlohmann::json ToJson(const ModelFitResult& fit) {
                          {"at_bound", fit.at_bound},    {"max_directional_albedo", fit.max_albedo},
                          {"seconds", fit.seconds}};
   if (fit.start_samples > 0) json["starts_ranked_on_samples"] = fit.start_samples;
+  if (fit.model == "lafortune") json["lobes_at_cap"] = fit.at_lobe_cap;
   if (fit.band_rel_rms.size() == 3) {
     json["rel_rms_by_theta_max_deg"] = {
         {"0-25", fit.band_rel_rms[0]}, {"25-50", fit.band_rel_rms[1]}, {"50-80", fit.band_rel_rms[2]}};
@@ -369,15 +385,15 @@ ModelFitResult FitLafortune(const std::vector<BrdfSample>& samples, const ModelF
   switch (options.lafortune_lobes) {
     case 1:
       result.brdf = FitLafortuneLobes<1>(picked, options, &result.final_cost, &result.starts, &result.start_samples,
-                                         &result.at_bound);
+                                         &result.at_bound, &result.at_lobe_cap);
       break;
     case 2:
       result.brdf = FitLafortuneLobes<2>(picked, options, &result.final_cost, &result.starts, &result.start_samples,
-                                         &result.at_bound);
+                                         &result.at_bound, &result.at_lobe_cap);
       break;
     default:
       result.brdf = FitLafortuneLobes<3>(picked, options, &result.final_cost, &result.starts, &result.start_samples,
-                                         &result.at_bound);
+                                         &result.at_bound, &result.at_lobe_cap);
       break;
   }
   result.rel_rms = RelativeRms(*result.brdf, picked);
