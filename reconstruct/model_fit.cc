@@ -259,7 +259,7 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
       if (p[3 + 3 * k] >= 2000.0 - 1e-3) note("n", 2000.0);
       if (std::abs(p[1 + 3 * k]) >= 20.0 - 1e-6) note("Cxy", p[1 + 3 * k]);
       if (std::abs(p[2 + 3 * k]) >= 20.0 - 1e-6) note("Cz", p[2 + 3 * k]);
-      // A lobe whose peak anywhere is within 1 % of the cap: the cap, not the samples, set its size there.
+      // A lobe whose max(|Cxy|, |Cz|)^n is within 1 % of the cap: the cap, not the samples, holds it.
       const double largest = std::max(std::abs(p[1 + 3 * k]), std::abs(p[2 + 3 * k]));
       if (largest > 0.0 && p[3 + 3 * k] * std::log(largest) >= std::log(caps[c]) - 0.01) {
         char line[96];
@@ -320,7 +320,7 @@ std::string ModelFitResult::BriefReport() const {
     for (const std::string& b : at_bound) text += " " + b + ";";
   }
   if (!at_lobe_cap.empty()) {
-    text += "; peak held at the lobe cap:";
+    text += "; held by the lobe cap (max(|Cxy|, |Cz|)^n at it):";
     for (const std::string& b : at_lobe_cap) text += " " + b + ";";
   }
   return text;

@@ -57,8 +57,8 @@ struct ModelFitResult {
   size_t start_samples = 0;  // the samples the starts were ranked on (0: all of them)
   // Parameters that ended at a bound of the fit ("n lobe 1 G at 2000"): reported, never silent.
   std::vector<std::string> at_bound;
-  // Lafortune lobes whose peak anywhere is within 1 % of the lobe cap (ModelFitOptions::max_lobe_ratio):
-  // the cap, not the samples, set their height where no camera looked ("lobe 1 G at 1 /sr").
+  // Lafortune lobes whose max(|Cxy|, |Cz|)^n is within 1 % of the lobe cap (ModelFitOptions::
+  // max_lobe_ratio): the cap, not the samples, holds them ("lobe 1 G at 1 /sr").
   std::vector<std::string> at_lobe_cap;
   // The largest directional albedo over a dense grid of incidence directions on the whole hemisphere
   // (0 to 89.5 degrees), per channel's max; a plausible BRDF keeps it at most 1.
