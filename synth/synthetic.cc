@@ -728,8 +728,8 @@ std::string SynthSummary::NoDataReport() const {
              " photos (masks/; derender counts them as `masked`)";
     case SynthNoData::kZero:
       return head +
-             "rendered as 0 (--no-data zero): derender turns them into zero-valued samples, data the table "
-             "does not hold";
+             "rendered as 0 (--no-data zero): derender keeps those that pass its signal floor as near-zero "
+             "samples, data the table does not hold";
     case SynthNoData::kError:
       break;
   }
