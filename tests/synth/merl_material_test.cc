@@ -47,7 +47,7 @@ void Directions(double theta_h_deg, double theta_d_deg, double phi_d_deg, Eigen:
   FromHalfDiff(angles, wi, wo);
 }
 
-TEST(MerlMaterial, LinearLookupInterpolatesBetweenCentresAndNeverBeyondTheData) {
+TEST(SynthMerl, LinearLookupInterpolatesBetweenCentresAndNeverBeyondTheData) {
   MerlTable table = LinearTable();
   const MerlBrdf nearest(table, "t.binary");
   // Cell (40, 20, 50): theta_h centre ((40.5 / 90)^2 x 90) degrees, theta_d 20.5, phi_d 50.5.
@@ -81,7 +81,7 @@ TEST(MerlMaterial, LinearLookupInterpolatesBetweenCentresAndNeverBeyondTheData) 
   EXPECT_FALSE(nearest.ToJson().contains("lookup"));
 }
 
-TEST(MerlMaterial, MaterialFileNamesTheLookup) {
+TEST(SynthMerl, MaterialFileNamesTheLookup) {
   ScratchDir dir;
   WriteMerl(dir / "t.binary", LinearTable());
   WriteJsonFile(dir / "m.json", {{"model", "merl"}, {"file", "t.binary"}, {"lookup", "linear"}});
@@ -122,7 +122,7 @@ std::string HoleyTable(const ScratchDir& dir) {
 // The default, skip: every pixel that looked up a cell without data is left out of the samples by its
 // photo's mask and counted the same in synth's summary, truth.json and derender's `masked`; no sample
 // is zero-valued and none lies beyond the table's data.
-TEST(MerlMaterial, NoDataPixelsAreLeftOutByMasksAndCounted) {
+TEST(SynthMerl, NoDataPixelsAreLeftOutByMasksAndCounted) {
   ScratchDir dir;
   const MerlBrdf material(HoleyTable(dir));
   const SynthSummary summary =
@@ -155,7 +155,7 @@ TEST(MerlMaterial, NoDataPixelsAreLeftOutByMasksAndCounted) {
 // zero renders them black and leaves them in the samples' reach (no mask: derender masks nothing and
 // sees them as dark pixels; in the demo-sized round trip 942 of 211241 passed the signal floor as
 // near-zero samples); error refuses the material and leaves no folder behind.
-TEST(MerlMaterial, NoDataZeroRendersBlackAndErrorRefuses) {
+TEST(SynthMerl, NoDataZeroRendersBlackAndErrorRefuses) {
   ScratchDir dir;
   const MerlBrdf material(HoleyTable(dir));
   SynthOptions noisy = SmallSession(SynthNoData::kZero);

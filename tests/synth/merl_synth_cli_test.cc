@@ -31,7 +31,7 @@ std::string HoleyTable(const ScratchDir& dir) {
 
 const char kSmall[] = " --width 200 --height 150 --photos 4 --effects none";
 
-TEST(MerlSynthCli, LinearLookupAndSkippedPixelsAreSaidAndRecorded) {
+TEST(SynthMerlCli, LinearLookupAndSkippedPixelsAreSaidAndRecorded) {
   ScratchDir dir;
   const std::string table = HoleyTable(dir);
   const auto run = RunIbrdf("synth --out " + (dir / "s") + " --material " + table + " --merl-lookup linear" + kSmall,
@@ -52,7 +52,7 @@ TEST(MerlSynthCli, LinearLookupAndSkippedPixelsAreSaidAndRecorded) {
   for (int c = 0; c < 3; ++c) EXPECT_LT(figures.at("overall").at("median_rel_error")[c].get<double>(), 0.01);
 }
 
-TEST(MerlSynthCli, NoDataErrorAndLookupOnAModelAreRefused) {
+TEST(SynthMerlCli, NoDataErrorAndLookupOnAModelAreRefused) {
   ScratchDir dir;
   const std::string table = HoleyTable(dir);
   const auto refused = RunIbrdf("synth --out " + (dir / "e") + " --material " + table + " --no-data error" + kSmall);
