@@ -1,6 +1,7 @@
 // ibrdf synth: writes a synthetic session with known truth; the flags fill a SynthRequest (synth/synth_request.h).
 #include "apps/commands.h"
 #include "core/brdf_model.h"
+#include "core/error.h"
 #include "core/logging.h"
 #include "core/merl_brdf.h"
 #include "synth/synth_request.h"
@@ -22,6 +23,8 @@ void AddSynthCommand(CLI::App& app) {
     std::vector<double> camera_matrix;  // 9 values, row-major
     bool chart_detect = false;
     std::string colour_space = "linear_srgb";
+    std::string no_data = "skip";
+    std::string merl_lookup = "nearest";
   };
   auto args = std::make_shared<Args>();
   CLI::App& c = *command;
@@ -33,6 +36,17 @@ void AddSynthCommand(CLI::App& app) {
   c.add_option("--material", args->material, "Material JSON (samples/materials/*.json) or a MERL table (.binary)")
       ->required()
       ->check(CLI::ExistingFile);
+  add("--no-data", args->no_data,
+      "A MERL table's cells without data (-1) where a sample pixel looks one up: skip (render it black and\n"
+      "leave it out of the samples through the photo's mask, masks/), zero (render it black and let\n"
+      "derender take it as a zero-valued sample: invented data, warned) or error (refuse)")
+      ->check(CLI::IsMember({"skip", "zero", "error"}));
+  auto* merl_lookup =
+      add("--merl-lookup", args->merl_lookup,
+          "A MERL table's lookups: nearest (the cell holding the direction pair, as the MERL reader\n"
+          "BRDFRead.cpp does; a piecewise-constant BRDF) or linear (trilinear between cell centres in the\n"
+          "table's index coordinates); recorded in truth.json, so compare and reconstruct --truth use it too")
+          ->check(CLI::IsMember({"nearest", "linear"}));
   add("--sample", r.sample, "sphere or cylinder")->check(CLI::IsMember({"sphere", "cylinder"}));
   AddDeprecatedAlias(c, add("--radius-m", o.scene.sample_radius, "Sample radius"), "--radius", o.scene.sample_radius);
   AddDeprecatedAlias(c, add("--length-m", o.scene.cylinder_length, "Cylinder length (axis vertical)"), "--length",
@@ -126,7 +140,7 @@ void AddSynthCommand(CLI::App& app) {
   add("--scan-target-noise-m", o.scan.target_noise_m, "Scanner's error on marker corners, one sigma");
   add("--truth-mesh-spacing-m", o.scan.truth_mesh_spacing_m, "Point spacing of truth-mesh.ply");
   c.add_flag("--overwrite", args->overwrite, "Replace an existing output folder");
-  c.callback([args, elevation, light_photos] {
+  c.callback([args, elevation, light_photos, merl_lookup] {
     SynthRequest& request = args->request;
     request.camera_elevation_given = elevation->count() > 0;
     request.light_photos_given = light_photos->count() > 0;
@@ -136,17 +150,24 @@ void AddSynthCommand(CLI::App& app) {
     }
     request.options.colour.chart_corners = !args->chart_detect;
     ColourSpaceFromName(args->colour_space, &request.options.colour.space);
-    const SynthOptions options = SynthOptionsFromRequest(request);
+    SynthOptions options = SynthOptionsFromRequest(request);
+    options.no_data = SynthNoDataFromName(args->no_data);
     RequireValidOptions(options, "ibrdf synth");
     StageLog stage("synth");
     RequireWritableOutput(args->out, args->overwrite, {args->material});
-    const std::unique_ptr<BrdfModel> material = LoadMaterial(args->material);
+    std::unique_ptr<BrdfModel> material = LoadMaterial(args->material);
+    if (merl_lookup->count() > 0) {
+      const auto* table = dynamic_cast<const MerlBrdf*>(material.get());
+      if (!table) ThrowError(args->material, "--merl-lookup applies to MERL tables (.binary) only");
+      material = std::make_unique<MerlBrdf>(table->table(), table->path(),
+                                            MerlLookupFromName(args->merl_lookup, "synth --merl-lookup"));
+    }
     const SynthSummary summary = WriteSyntheticSession(options, *material, args->material, args->out, args->overwrite);
     Log(1, summary.BriefReport());
-    if (const auto* merl = dynamic_cast<const MerlBrdf*>(material.get()); merl && merl->no_data_lookups() > 0) {
-      Log(0, "warning: " + std::to_string(merl->no_data_lookups()) + " of " + std::to_string(merl->lookups()) +
-                 " BRDF lookups in " + args->material + " hit cells without data (MERL's -1), rendered as 0; " +
-                 std::to_string(merl->cells_without_data()) + " of its cells have no data");
+    if (!summary.NoDataReport().empty()) {
+      Log(summary.no_data == SynthNoData::kZero ? 0 : 1,
+          std::string(summary.no_data == SynthNoData::kZero ? "warning: " : "") + args->material + ": " +
+              summary.NoDataReport() + " (truth.json generator.material_no_data)");
     }
     Log(1, "session written to " + args->out + "/session.json (truth in " + args->out + "/truth.json)");
     if (request.charuco_photos > 0) {

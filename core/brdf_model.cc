@@ -162,7 +162,8 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
   } else if (model == "merl") {
     std::filesystem::path table = object.String("file");
     if (table.is_relative() && !file.empty()) table = std::filesystem::path(file).parent_path() / table;
-    brdf = std::make_unique<MerlBrdf>(table.string());
+    brdf = std::make_unique<MerlBrdf>(table.string(),
+                                      MerlLookupFromName(object.String("lookup", "nearest"), object.Where("lookup")));
   } else if (model == "rgl_bsdf") {
     std::filesystem::path table = object.String("file");
     if (table.is_relative() && !file.empty()) table = std::filesystem::path(file).parent_path() / table;

@@ -17,6 +17,17 @@
 
 namespace ibrdf {
 
+// Where a ray from `origin` along `direction` meets the front of the plane through `center` with unit
+// normal `normal` (the side the normal faces): true with the ray parameter in `t` (> 0); false for a
+// ray parallel to the plane or arriving from behind it, or a plane behind the ray's origin.
+inline bool RayPlaneHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, const Eigen::Vector3d& center,
+                        const Eigen::Vector3d& normal, double* t) {
+  const double denominator = direction.dot(normal);
+  if (!(denominator < 0.0)) return false;
+  *t = (center - origin).dot(normal) / denominator;
+  return *t > 0.0;
+}
+
 // A camera at a pose: the world ray through any image point (pixel centres at +0.5), undistorted with
 // Camera::CamPlaneFromImage (Newton iterations: the slow path, for the rays no table holds).
 class CameraRay {

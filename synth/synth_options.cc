@@ -46,6 +46,25 @@ SynthShape SynthShapeFromName(const std::string& name) {
   ThrowError("synth shape", "unknown shape \"" + name + "\" (expected squash, pot or dent)");
 }
 
+const char* SynthNoDataName(SynthNoData no_data) {
+  switch (no_data) {
+    case SynthNoData::kSkip:
+      return "skip";
+    case SynthNoData::kZero:
+      return "zero";
+    case SynthNoData::kError:
+      return "error";
+  }
+  return "skip";
+}
+
+SynthNoData SynthNoDataFromName(const std::string& name) {
+  for (SynthNoData no_data : {SynthNoData::kSkip, SynthNoData::kZero, SynthNoData::kError}) {
+    if (name == SynthNoDataName(no_data)) return no_data;
+  }
+  ThrowError("synth --no-data", "unknown policy \"" + name + "\" (expected skip, zero or error)");
+}
+
 const char* SynthRigName(SynthRig rig) {
   switch (rig) {
     case SynthRig::kArc:

@@ -224,6 +224,17 @@ struct SynthColourOptions {
   bool Check(std::string* why) const;
 };
 
+// What synth does with a sample pixel whose ray looks up a cell without data in a tabulated material
+// (a MERL table's negative cells, MERL's "no data"): kSkip renders it black and leaves it out of the
+// samples (the photo's mask excludes it: derender counts it as `masked`), kZero renders it black and
+// lets derender turn it into zero-valued samples (an invented value: warned), kError refuses the
+// material. Materials without such cells never meet it.
+enum class SynthNoData { kSkip, kZero, kError };
+
+// "skip", "zero", "error"; and back (throws Error naming the value otherwise).
+const char* SynthNoDataName(SynthNoData no_data);
+SynthNoData SynthNoDataFromName(const std::string& name);
+
 // Everything a synthetic session is made from. Defaults: a 4 cm sphere, 20 photos of 800 x 600 on an
 // arc from 8 to 172 degrees, a 12-bit sensor with noise, no targets.
 struct SynthOptions {
@@ -232,9 +243,10 @@ struct SynthOptions {
   CameraEffects effects;
   SynthRadiometryOptions radiometry;
   SynthTargetOptions targets;
-  SynthScanOptions scan;  // used only for an irregular shape (scene.shape != kNone)
+  SynthScanOptions scan;      // used only for an irregular shape (scene.shape != kNone)
   SynthColourOptions colour;  // camera colour matrix and colour-chart photo
-  uint64_t seed = 1;      // every random stream (noise, scan) derives from it: output is reproducible
+  uint64_t seed = 1;          // every random stream (noise, scan) derives from it: output is reproducible
+  SynthNoData no_data = SynthNoData::kSkip;  // pixels on a tabulated material's cells without data
 
   // Each part's Check (the scan's only for an irregular shape; messages start with the part's name, e.g.
   // "rig: num_photos >= 1 failed: num_photos = 0"), then the constraints between parts.

@@ -19,6 +19,7 @@
 #include "core/json_reader.h"
 #include "core/light.h"
 #include "core/logging.h"
+#include "core/merl_brdf.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
 #include "derender/analytic_sample.h"
@@ -467,7 +468,8 @@ nlohmann::json RigidJson(const Rigid3d& transform) {
 
 Image RenderRadianceImpl(const Session& session, size_t photo_index, const PixelRays& rays, const AnalyticSample& truth,
                          bool shadow_rays, const BrdfModel& material, std::vector<uint8_t>* hit_mask,
-                         uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance);
+                         uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance,
+                         std::vector<uint8_t>* no_data_mask);
 
 }  // namespace
 
@@ -494,25 +496,38 @@ Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel
                      std::vector<uint8_t>* hit_mask) {
   const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
   return RenderRadianceImpl(session, photo_index, PixelRays(session.camera, supersample), *sample, false, material,
-                            hit_mask, nullptr, Eigen::Vector3d::Zero());
+                            hit_mask, nullptr, Eigen::Vector3d::Zero(), nullptr);
 }
 
 Image RenderRadiance(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
                      const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask) {
   return RenderRadianceImpl(session, photo_index, PixelRays(session.camera, supersample), truth, shadow_rays, material,
-                            hit_mask, nullptr, Eigen::Vector3d::Zero());
+                            hit_mask, nullptr, Eigen::Vector3d::Zero(), nullptr);
 }
 
 namespace {
+// `no_data_mask` (optional) gets 1 where a ray of the pixel looked up a cell without data of a tabulated
+// material (a MERL table's negative cell; such a lookup evaluates to 0); all 0 for other materials.
 Image RenderRadianceImpl(const Session& session, size_t photo_index, const PixelRays& rays, const AnalyticSample& truth,
                          bool shadow_rays, const BrdfModel& material, std::vector<uint8_t>* hit_mask,
-                         uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance) {
+                         uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance,
+                         std::vector<uint8_t>* no_data_mask) {
   const Camera& camera = session.camera;
   const Light& light = session.PhotoLight(photo_index);
   const AnalyticSample* sample = &truth;
   std::atomic<uint64_t> shadowed{0};
   if (hit_mask) hit_mask->assign(size_t(camera.width) * camera.height, 0);
+  if (no_data_mask) no_data_mask->assign(size_t(camera.width) * camera.height, 0);
   const bool fill = fill_irradiance.any();
+  const auto* table = no_data_mask ? dynamic_cast<const MerlBrdf*>(&material) : nullptr;
+  // The material at (wi, wo), marking the pixel where the lookup found no data (MerlBrdf::Eval's test).
+  auto eval = [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo, const PixelRay& ray) {
+    if (table && wi.z() > 0.0 && wo.z() > 0.0 &&
+        (table->Lookup(wi.normalized(), wo.normalized()).array() < 0.0).any()) {
+      (*no_data_mask)[ray.pixel] = 1;
+    }
+    return material.Eval(wi, wo);
+  };
   Image image = RenderRays(rays, *session.photos[photo_index].camera_from_world,
                            [&](const Eigen::Vector3d& eye, const PixelRay& ray) -> Eigen::Vector3d {
                              SurfaceHit hit;
@@ -523,7 +538,7 @@ Image RenderRadianceImpl(const Session& session, size_t photo_index, const Pixel
                              Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
                              // The fill light (SynthOptions::fill_light) reaches every point, shadowed or not.
                              if (fill) {
-                               radiance += material.Eval(Eigen::Vector3d::UnitZ(), wo).cwiseProduct(fill_irradiance);
+                               radiance += eval(Eigen::Vector3d::UnitZ(), wo, ray).cwiseProduct(fill_irradiance);
                              }
                              const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
                              if (!incidence.lit) return radiance;
@@ -537,7 +552,7 @@ Image RenderRadianceImpl(const Session& session, size_t photo_index, const Pixel
                                  return radiance;
                                }
                              }
-                             const Eigen::Vector3d f = material.Eval(frame.ToLocal(incidence.wi), wo);
+                             const Eigen::Vector3d f = eval(frame.ToLocal(incidence.wi), wo, ray);
                              return Eigen::Vector3d(radiance + f.cwiseProduct(incidence.irradiance));
                            });
   if (shadowed_pixels) *shadowed_pixels += shadowed;
@@ -615,6 +630,36 @@ double AutoExposureReference(const Image& radiance, const std::vector<uint8_t>& 
   return levels.empty() ? 1.0 : PercentileInPlace(&levels, 0.99);
 }
 
+// A measurement photo's pixels on a tabulated material's cells without data (`no_data`, from
+// RenderRadianceImpl) under options.no_data: counted in `summary`; kSkip writes the photo's mask
+// (masks/<photo's stem>.png under `root`, 0 on those pixels, 255 elsewhere) and names it in `photo`;
+// kError throws naming the material and the photo.
+void ApplyNoDataPolicy(const SynthOptions& options, const std::string& material_name, const Camera& camera,
+                       const std::vector<uint8_t>& no_data, const std::string& root, PhotoSpec* photo,
+                       SynthSummary* summary) {
+  const uint64_t pixels = static_cast<uint64_t>(std::count(no_data.begin(), no_data.end(), uint8_t(1)));
+  if (pixels == 0) return;
+  summary->no_data_pixels += pixels;
+  switch (options.no_data) {
+    case SynthNoData::kError:
+      ThrowError(material_name, photo->file + ": " + std::to_string(pixels) +
+                                    " sample pixels look up cells without data (MERL's -1); --no-data skip leaves "
+                                    "them out of the samples, --no-data zero renders them black");
+    case SynthNoData::kZero:
+      return;
+    case SynthNoData::kSkip: {
+      Image mask(camera.width, camera.height, 1);
+      for (size_t p = 0; p < no_data.size(); ++p) mask.pixels[p] = no_data[p] ? 0.0f : 1.0f;
+      const std::string file = "masks/" + fs::path(photo->file).stem().string() + ".png";
+      fs::create_directories(fs::path(root) / "masks");
+      WriteImage((fs::path(root) / file).string(), mask, PixelFormat::kUint8);
+      photo->mask = file;
+      ++summary->masked_photos;
+      return;
+    }
+  }
+}
+
 // truth.json's "generator": the options that made the session (the keys predate the options' split).
 nlohmann::json GeneratorJson(const SynthOptions& options) {
   const CameraEffects& effects = options.effects;
@@ -672,6 +717,25 @@ std::string SynthSummary::BriefReport() const {
   return buffer;
 }
 
+std::string SynthSummary::NoDataReport() const {
+  if (no_data_pixels == 0) return "";
+  const std::string head = std::to_string(no_data_pixels) +
+                           " sample pixels looked up cells without data in the material's table (MERL's -1; " +
+                           std::to_string(table_cells_without_data) + " such cells): ";
+  switch (no_data) {
+    case SynthNoData::kSkip:
+      return head + "rendered black and left out of the samples by the masks of " + std::to_string(masked_photos) +
+             " photos (masks/; derender counts them as `masked`)";
+    case SynthNoData::kZero:
+      return head +
+             "rendered as 0 (--no-data zero): derender keeps those that pass its signal floor as near-zero "
+             "samples, data the table does not hold";
+    case SynthNoData::kError:
+      break;
+  }
+  return head + "refused (--no-data error)";
+}
+
 SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel& material,
                                    const std::string& material_name, const std::string& out_dir, bool overwrite) {
   Timer timer;
@@ -716,11 +780,21 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
       }
     }
   } wait_on_exit{writing};
+  if (const auto* table = dynamic_cast<const MerlBrdf*>(&material)) {
+    summary.tabulated = true;
+    summary.table_cells_without_data = table->cells_without_data();
+  }
+  summary.no_data = options.no_data;
   for (size_t i = 0; i < session.photos.size(); ++i) {
-    std::vector<uint8_t> mask;
+    std::vector<uint8_t> mask, no_data;
+    const bool measurement = session.photos[i].role == PhotoRole::kMeasurement;
     Image image =
-        RenderRadianceImpl(session, i, rays, *truth, shadow_rays, material, &mask,
-                           session.photos[i].role == PhotoRole::kMeasurement ? &shadowed : nullptr, fill_irradiance(i));
+        RenderRadianceImpl(session, i, rays, *truth, shadow_rays, material, &mask, measurement ? &shadowed : nullptr,
+                           fill_irradiance(i), measurement && summary.tabulated ? &no_data : nullptr);
+    if (!no_data.empty()) {
+      ApplyNoDataPolicy(options, material_name, session.camera, no_data, directory.temporary_path(), &session.photos[i],
+                        &summary);
+    }
     ApplyCameraMatrix(options.colour.camera_matrix, &image);  // colour hook: the camera's RGB
     PhotoSpec& photo = session.photos[i];
     photo.exposure_s *= options.rig.exposure_target /
@@ -778,6 +852,12 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   };
   if (!shape_truth.is_null()) truth_json["generator"]["geometry"] = shape_truth;
   if (!colour_truth.is_null()) truth_json["generator"]["colour"] = colour_truth;
+  if (summary.tabulated) {
+    truth_json["generator"]["material_no_data"] = {{"policy", SynthNoDataName(options.no_data)},
+                                                   {"table_cells_without_data", summary.table_cells_without_data},
+                                                   {"pixels", summary.no_data_pixels},
+                                                   {"photos_masked", summary.masked_photos}};
+  }
   WriteJsonFile((fs::path(directory.temporary_path()) / "truth.json").string(), truth_json);
   directory.Commit();
   summary.photos = options.rig.num_photos;

@@ -45,12 +45,24 @@ struct SynthSummary {
   uint64_t shadowed_pixels = 0;   // sample pixels facing the light but in the shape's own shadow
   int scan_views = 0;             // irregular shapes: range grids written
   uint64_t scan_points = 0;       // their points
+  // A tabulated material (a MERL table) and its cells without data (SynthOptions::no_data): the
+  // table's count of such cells, the measurement photos' pixels with a ray that looked one up, and
+  // (kSkip) the photos whose mask (masks/NAME.png) leaves those pixels out of the samples.
+  bool tabulated = false;
+  uint64_t table_cells_without_data = 0;
+  uint64_t no_data_pixels = 0;
+  int masked_photos = 0;
+  SynthNoData no_data = SynthNoData::kSkip;
   double total_s = 0.0;
   std::string BriefReport() const;  // one line: photos, time, clipped pixels (and shadows and scans)
+  // One line on the pixels that looked up cells without data and what became of them; empty when none.
+  std::string NoDataReport() const;
 };
 
 // Writes a complete session folder: session.json, photos/, and truth.json with the material and the
-// generator options. The folder appears only when complete. Throws Error for invalid options.
+// generator options. The folder appears only when complete. Throws Error for invalid options, and
+// (options.no_data kError) for a tabulated material whose cells without data a sample pixel looks up.
+// With kSkip such pixels are left out through a mask per photo (masks/, session.json's photo "mask").
 SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel& material,
                                    const std::string& material_name, const std::string& out_dir, bool overwrite);
 

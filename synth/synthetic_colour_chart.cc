@@ -45,10 +45,10 @@ Image RenderChart(const Session& session, const Light& light, const Rigid3d& cam
   on_white->assign(size_t(camera.width) * camera.height, 0);
   return RenderRays(PixelRays(camera, supersample), camera_from_world,
                     [&](const Eigen::Vector3d& eye, const PixelRay& ray) -> Eigen::Vector3d {
-                      const double denominator = ray.direction.dot(frame.normal);
-                      if (!(denominator < 0.0)) return Eigen::Vector3d::Zero();
-                      const double t = (frame.center - eye).dot(frame.normal) / denominator;
-                      if (!(t > 0.0)) return Eigen::Vector3d::Zero();
+                      double t;
+                      if (!RayPlaneHit(eye, ray.direction, frame.center, frame.normal, &t)) {
+                        return Eigen::Vector3d::Zero();
+                      }
                       const Eigen::Vector3d point = eye + t * ray.direction;
                       // Grid coordinates with the card's centre at 0: patch k's centre at (k % 6 - 2.5, k / 6 - 1.5).
                       const double u = (point - frame.center).dot(frame.right) / pitch;

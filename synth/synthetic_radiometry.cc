@@ -117,10 +117,10 @@ Image RenderWhiteReference(const Session& session, const Light& light, const Rig
   mask->assign(size_t(camera.width) * camera.height, 0);
   return RenderRays(PixelRays(camera, supersample), camera_from_world,
                     [&](const Eigen::Vector3d& eye, const PixelRay& ray) -> Eigen::Vector3d {
-                      const double denominator = ray.direction.dot(white.normal);
-                      if (!(denominator < 0.0)) return Eigen::Vector3d::Zero();
-                      const double t = (white.center - eye).dot(white.normal) / denominator;
-                      if (!(t > 0.0)) return Eigen::Vector3d::Zero();
+                      double t;
+                      if (!RayPlaneHit(eye, ray.direction, white.center, white.normal, &t)) {
+                        return Eigen::Vector3d::Zero();
+                      }
                       const Eigen::Vector3d offset = eye + t * ray.direction - white.center;
                       if (std::abs(offset.dot(u)) > 0.5 * white.size || std::abs(offset.dot(v)) > 0.5 * white.size) {
                         return Eigen::Vector3d::Zero();
@@ -154,10 +154,7 @@ class WhiteCard {
   // it misses the card. The patch's albedo is channel 0's (a grey reference).
   double Trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Eigen::Vector3d* point,
                double* t) const {
-    const double denominator = direction.dot(white_.normal);
-    if (!(denominator < 0.0)) return -1.0;
-    *t = (white_.center - origin).dot(white_.normal) / denominator;
-    if (!(*t > 0.0)) return -1.0;
+    if (!RayPlaneHit(origin, direction, white_.center, white_.normal, t)) return -1.0;
     *point = origin + *t * direction;
     const Eigen::Vector3d offset = *point - white_.center;
     const double x = offset.dot(x_axis_), y = offset.dot(y_axis_);
