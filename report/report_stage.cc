@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <map>
 #include <memory>
 #include <optional>
@@ -552,6 +553,8 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   // The script starts now (matplotlib's import and the figures of the run folder alone beside the work
   // below) and draws the rest once report-data.json is written; destroyed before `directory`.
   BackgroundReportScript plotting(python, script, run_dir.string(), tmp.string());
+  // OpenImageIO's module (the PNG writer) loads beside the reading below instead of at the first image.
+  const std::future<void> image_module = std::async(std::launch::async, PreloadImageModule);
   const RunModels models = LoadRunModels(run_dir, options.reconstruction);
 
   const std::vector<BrdfSample> samples = ReadSamples(samples_path);

@@ -909,7 +909,7 @@ def main():
     run_dir, out = args
     ready = (lambda: wait_for_data(out)) if data_later else (lambda: True)
     try:
-        s = np.load(os.path.join(run_dir, "samples.npy"))
+        s = np.load(os.path.join(run_dir, "samples.npy"), mmap_mode="r")  # read where the figures use it
         side = load_json(os.path.join(run_dir, "samples.npy.json")) or {}
         c = load_json(os.path.join(run_dir, "consistency.json"))
         t = load_json(os.path.join(run_dir, "truth-comparison.json"))
