@@ -72,6 +72,18 @@ const OiioModule& Oiio(const std::string& path) {
   return module;
 }
 
+}  // namespace
+
+void PreloadImageModule() {
+  try {
+    Oiio("the OpenImageIO module");
+  } catch (...) {
+    // Reported by the first real use.
+  }
+}
+
+namespace {
+
 // Reads a plain PNG (8- or 16-bit grey or RGB, not interlaced, no transparency) with libpng, as
 // OpenImageIO would: file values / (2^bits - 1) as float. Returns false, having read nothing, for any
 // other PNG (those go through OpenImageIO). `image` null: the header only, into `spec`.

@@ -73,6 +73,11 @@ struct PhotoMetadata {
 // Reads the header and metadata without decoding the pixels. Throws Error naming the file.
 PhotoMetadata ReadPhotoMetadata(const std::string& path);
 
+// Loads the OpenImageIO module now: WriteImage and the readers of other formats than plain PNG load it
+// on first use (about half a second of CPU for its ~260 libraries), so a caller can pay that on a thread
+// of its own beside other work (the report). Errors are left for the first real use to report.
+void PreloadImageModule();
+
 // Writes an image atomically; the format follows the extension (.png, .tif, .exr ...). Integer formats
 // take values in [0, 1], clamped and rounded. With `metadata`, its set fields are written as EXIF (PNG:
 // an eXIf chunk; TIFF, JPEG: EXIF tags; EXR: header attributes), so ReadPhotoMetadata reads them back.

@@ -349,10 +349,12 @@ namespace {
 
 // The samples a channel's own regression uses: those that measured channel c, with its value in all
 // three channels (so the regression's three channels are one).
-std::vector<BrdfSample> ChannelSamples(const std::vector<BrdfSample>& samples, int c) {
+std::vector<BrdfSample> ChannelSamples(const std::vector<BrdfSample>& samples, int c,
+                                       const std::vector<uint8_t>* leave_out) {
   std::vector<BrdfSample> out;
-  for (const BrdfSample& s : samples) {
-    if (!s.valid[c]) continue;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const BrdfSample& s = samples[i];
+    if (!s.valid[c] || (leave_out && (*leave_out)[i])) continue;
     BrdfSample t = s;
     for (int k = 0; k < 3; ++k) {
       t.brdf[k] = s.brdf[c];
@@ -366,16 +368,35 @@ std::vector<BrdfSample> ChannelSamples(const std::vector<BrdfSample>& samples, i
 
 }  // namespace
 
-LocalRegression::LocalRegression(const std::vector<BrdfSample>& all_samples, const LocalRegressionOptions& options)
+LocalRegression::LocalRegression(const std::vector<BrdfSample>& samples, const LocalRegressionOptions& options)
     : impl_(std::make_unique<Impl>()), options_(options) {
+  Build(samples, nullptr);
+}
+
+LocalRegression::LocalRegression(const std::vector<BrdfSample>& samples, const std::vector<uint8_t>& leave_out,
+                                 const LocalRegressionOptions& options)
+    : impl_(std::make_unique<Impl>()), options_(options) {
+  IBRDF_CHECK(leave_out.size() == samples.size())
+      << "leave_out has " << leave_out.size() << " flags for " << samples.size() << " samples";
+  Build(samples, &leave_out);
+}
+
+void LocalRegression::Build(const std::vector<BrdfSample>& all_samples, const std::vector<uint8_t>* leave_out) {
+  const LocalRegressionOptions& options = options_;
   std::string why;
   if (!options.Check(&why)) ThrowError("local regression options", why);
+  const auto left_out = [leave_out](size_t i) { return leave_out && (*leave_out)[i] != 0; };
+  size_t included = all_samples.size();
   // Per-channel validity: channels some samples did not measure get their own regression; in the shared
   // one their values are replaced by a fully measured channel's (so an unmeasured value cannot sway the
   // shared fit's degree or range checks), or left as they are when no channel is fully measured.
   uint64_t unmeasured[3] = {0, 0, 0};
-  for (const BrdfSample& s : all_samples) {
-    for (int c = 0; c < 3; ++c) unmeasured[c] += s.valid[c] == 0;
+  for (size_t i = 0; i < all_samples.size(); ++i) {
+    if (left_out(i)) {
+      --included;
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) unmeasured[c] += all_samples[i].valid[c] == 0;
   }
   int full = -1;
   for (int c = 0; c < 3; ++c) {
@@ -385,7 +406,7 @@ LocalRegression::LocalRegression(const std::vector<BrdfSample>& all_samples, con
   if (unmeasured[0] + unmeasured[1] + unmeasured[2] > 0) {
     for (int c = 0; c < 3; ++c) {
       if (unmeasured[c] > 0) {
-        channel_regressions_[c] = std::make_unique<LocalRegression>(ChannelSamples(all_samples, c), options);
+        channel_regressions_[c] = std::make_unique<LocalRegression>(ChannelSamples(all_samples, c, leave_out), options);
       }
     }
     if (full >= 0) {
@@ -413,6 +434,7 @@ LocalRegression::LocalRegression(const std::vector<BrdfSample>& all_samples, con
   std::vector<uint8_t> valid(n, 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
+      if (left_out(i)) continue;
       const BrdfSample& s = samples[i];
       const Eigen::Vector3d wi(s.wi[0], s.wi[1], s.wi[2]), wo(s.wo[0], s.wo[1], s.wo[2]);
       const Eigen::Vector3f f(s.brdf[0], s.brdf[1], s.brdf[2]);
@@ -448,7 +470,7 @@ LocalRegression::LocalRegression(const std::vector<BrdfSample>& all_samples, con
     }
     ++kept;
   }
-  skipped_ = n - kept;
+  skipped_ = included - kept;
   xyz.resize(3 * kept);
   values.resize(3 * kept);
   xyz.shrink_to_fit();

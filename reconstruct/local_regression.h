@@ -161,6 +161,10 @@ class LocalRegression {
   // (a second regression per such channel, built the same way), so an unmeasured value never enters
   // a fit; the channels every sample measured share this one.
   LocalRegression(const std::vector<BrdfSample>& samples, const LocalRegressionOptions& options);
+  // As above without the samples whose `leave_out` flag is non-zero (one flag per sample), the same
+  // regression as of a copy holding only the others: a held-out photo's fit without copying the rest.
+  LocalRegression(const std::vector<BrdfSample>& samples, const std::vector<uint8_t>& leave_out,
+                  const LocalRegressionOptions& options);
   ~LocalRegression();
   LocalRegression(const LocalRegression&) = delete;
   LocalRegression& operator=(const LocalRegression&) = delete;
@@ -194,6 +198,8 @@ class LocalRegression {
   // The fit at `uvw` without sample `exclude` (-1: none); `leverage` (optional) gets the weight of sample
   // `self` in the estimate (0 when it is not in the kernel).
   Estimate Fit(const Eigen::Vector3d& uvw, int64_t exclude, int64_t self, double* leverage) const;
+  // The constructors' work: `leave_out` (null: none) flags the samples left out.
+  void Build(const std::vector<BrdfSample>& samples, const std::vector<uint8_t>* leave_out);
 
   CrossValidationScore CrossValidateShared(size_t count, uint64_t seed) const;
 

@@ -1,7 +1,9 @@
 #include "report/report_script.h"
 
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
+#include <fstream>
 #include <system_error>
 
 #include "core/error.h"
@@ -55,14 +57,48 @@ std::string FindReportScript(const ReportScriptSearch& search) {
 
 std::string ReportPython() { return IBRDF_PYTHON; }
 
-void RunReportScript(const std::string& python, const std::string& script, const std::string& run_dir,
-                     const std::string& out_dir) {
-  const int code = RunSubprocess({python, script, fs::absolute(run_dir).string(), out_dir});
+namespace {
+
+// Throws Error naming the script when it exited with `code` != 0 or wrote no index.html.
+void CheckReportScript(const std::string& script, const std::string& out_dir, int code) {
   if (code != 0) {
     ThrowError(script, "the plotting script failed (exit " + std::to_string(code) +
                            "); its message is above (it needs Debian's python3-numpy and python3-matplotlib)");
   }
   RequireFile((fs::path(out_dir) / "index.html").string(), script + ": wrote no index.html");
+}
+
+}  // namespace
+
+void RunReportScript(const std::string& python, const std::string& script, const std::string& run_dir,
+                     const std::string& out_dir) {
+  CheckReportScript(script, out_dir, RunSubprocess({python, script, fs::absolute(run_dir).string(), out_dir}));
+}
+
+BackgroundReportScript::BackgroundReportScript(const std::string& python, const std::string& script,
+                                               const std::string& run_dir, const std::string& out_dir)
+    : script_(script), out_dir_(out_dir) {
+  std::vector<std::string> argv = {python, script, fs::absolute(run_dir).string(), out_dir, "--data-later"};
+  thread_ = std::thread([this, argv] {
+    try {
+      code_ = RunSubprocess(argv);
+    } catch (const std::exception&) {
+      code_ = 127;  // fork failed
+    }
+  });
+}
+
+BackgroundReportScript::~BackgroundReportScript() {
+  if (!thread_.joinable()) return;
+  if (!finished_) std::ofstream((fs::path(out_dir_) / "report-abort").string()) << "the report failed\n";
+  thread_.join();
+}
+
+void BackgroundReportScript::Finish() {
+  IBRDF_CHECK(!finished_) << "BackgroundReportScript::Finish called twice";
+  finished_ = true;
+  thread_.join();
+  CheckReportScript(script_, out_dir_, code_);
 }
 
 }  // namespace ibrdf

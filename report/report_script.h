@@ -8,6 +8,7 @@
 
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace ibrdf {
@@ -37,5 +38,31 @@ std::string ReportPython();
 // wrote OUT_DIR/index.html. Throws Error naming the script when it fails.
 void RunReportScript(const std::string& python, const std::string& script, const std::string& run_dir,
                      const std::string& out_dir);
+
+// The plotting script started before the report's data is ready, so that it imports matplotlib and
+// draws the figures that need only the run folder (coverage, pair figures, timings, truth bands) while
+// the C++ part computes: `python script RUN_DIR OUT_DIR --data-later` on a thread of its own. The
+// script then waits for OUT_DIR/report-data.json (written atomically) and draws the rest.
+class BackgroundReportScript {
+ public:
+  BackgroundReportScript(const std::string& python, const std::string& script, const std::string& run_dir,
+                         const std::string& out_dir);
+  // Without Finish() (the C++ part failed): writes OUT_DIR/report-abort, on which the script stops
+  // waiting and exits, and waits for it.
+  ~BackgroundReportScript();
+  BackgroundReportScript(const BackgroundReportScript&) = delete;
+  BackgroundReportScript& operator=(const BackgroundReportScript&) = delete;
+
+  // Call once OUT_DIR/report-data.json is written: waits for the script and checks it as
+  // RunReportScript does (Error naming the script when it failed or wrote no index.html).
+  void Finish();
+
+ private:
+  std::string script_;
+  std::string out_dir_;
+  int code_ = 0;
+  bool finished_ = false;
+  std::thread thread_;
+};
 
 }  // namespace ibrdf

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <map>
 #include <memory>
 #include <optional>
@@ -279,10 +280,13 @@ void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector
   for (const uint32_t image : HeldOutImages(samples, count)) {
     try {
       Timer timer;
-      std::vector<BrdfSample> fit;
-      fit.reserve(samples.size());
-      for (const BrdfSample& s : samples) {
-        if (s.image != image) fit.push_back(s);
+      // The fit leaves the photo's samples out by flag (copying the other 1.1 M samples of the demo
+      // cost more than the flags).
+      std::vector<uint8_t> leave_out(samples.size());
+      size_t fit_samples = 0;
+      for (size_t i = 0; i < samples.size(); ++i) {
+        leave_out[i] = samples[i].image == image;
+        fit_samples += !leave_out[i];
       }
       const std::vector<const BrdfSample*> own = PhotoSamples(samples, image);
       std::vector<Eigen::Vector3d> points;
@@ -291,7 +295,7 @@ void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector
       ReliabilityCounts reliability;
       std::vector<Estimate> estimates;
       {
-        const LocalRegression regression(fit, regression_options);
+        const LocalRegression regression(samples, leave_out, regression_options);
         estimates = regression.EvaluateMany(points, &reliability);
       }
       std::vector<Eigen::Vector3d> values(own.size());
@@ -308,7 +312,7 @@ void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector
           RenderPhoto(*session, image, photos[image], own, photo_models, "held-out-" + std::to_string(image), tmp);
       const std::vector<float>& phase = photos[image].phase;
       photo["phase_deg"] = phase.empty() ? 0.0 : Percentile(phase, 0.5) / kDeg;
-      photo["fit_samples"] = fit.size();
+      photo["fit_samples"] = fit_samples;
       photo["unsupported"] = unsupported;
       photo["seconds"] = timer.ElapsedSeconds();
       HeldOutRender shown;
@@ -544,6 +548,13 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   const std::string python = options.python.empty() ? ReportPython() : options.python;
   RequireFile(script, "the report's plotting script (IBRDF_REPORT_SCRIPT)");
   RequireFile(python, "python3 with matplotlib (Debian: python3-matplotlib)");
+  AtomicDirectory directory(out, options.overwrite);
+  const fs::path tmp(directory.temporary_path());
+  // The script starts now (matplotlib's import and the figures of the run folder alone beside the work
+  // below) and draws the rest once report-data.json is written; destroyed before `directory`.
+  BackgroundReportScript plotting(python, script, run_dir.string(), tmp.string());
+  // OpenImageIO's module (the PNG writer) loads beside the reading below instead of at the first image.
+  const std::future<void> image_module = std::async(std::launch::async, PreloadImageModule);
   const RunModels models = LoadRunModels(run_dir, options.reconstruction);
 
   const std::vector<BrdfSample> samples = ReadSamples(samples_path);
@@ -567,8 +578,6 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   for (const NamedModel& m : models.named) names.push_back(m.name);
   data["models"] = names;
 
-  AtomicDirectory directory(out, options.overwrite);
-  const fs::path tmp(directory.temporary_path());
   const std::optional<Session> session = SamplesSession(samples_path, &result.photo_note);
   WritePhoto(session, samples, photos[chosen.photo], chosen, models, tmp, &data, &result);
   WriteHeldOutPhotos(session, samples, photos, options.held_out_photos, models, tmp, &data, &result);
@@ -579,7 +588,7 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   data["incidence_plane"] = IncidencePlanes(samples, models, options.angles_deg, tmp, &result);
   if (options.explorer) data["explorer"] = ExplorerGrids(samples, models, tmp);
   WriteJsonFile((tmp / "report-data.json").string(), data);
-  RunReportScript(python, script, run_dir.string(), tmp.string());
+  plotting.Finish();
   if (options.explorer) RequireFile((tmp / "explorer.html").string(), script + ": wrote no explorer.html");
   directory.Commit();
   result.index_html = (fs::path(out) / "index.html").string();

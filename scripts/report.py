@@ -1,7 +1,10 @@
 #!/usr/bin/python3
 """Draws the consistency report of an `ibrdf run` folder (run by `ibrdf report`, docs/report.md).
 
-Usage: report.py RUN_DIR OUT_DIR
+Usage: report.py RUN_DIR OUT_DIR [--data-later]
+
+With --data-later (how `ibrdf report` runs it), the figures of the run folder alone are drawn first, then
+the script waits for OUT_DIR/report-data.json (or stops quietly at OUT_DIR/report-abort).
 
 Reads RUN_DIR's samples.npy (+ sidecar), consistency.json, truth-comparison.json, reconstruction/,
 stamps/*.json, and what `ibrdf report` wrote into OUT_DIR: report-data.json (title, models, the photo and
@@ -20,6 +23,7 @@ import html
 import json
 import os
 import sys
+import time
 
 import matplotlib
 
@@ -335,7 +339,7 @@ def held_out_difference_figure(data, out, photo):
     return save(fig, out, f"held-out-{photo['index']}-difference.png")
 
 
-def held_out_html(data, out):
+def held_out_html(data, out, figures):
     """Held-out photos, shown as the main photo is: measured beside rendered, and the signed difference."""
     held = data.get("held_out") or []
     if not held:
@@ -362,7 +366,7 @@ def held_out_html(data, out):
                 if r["model"] == "held-out" else "the reconstruction (its table; saw this photo)"
             parts.append(figure_html(out, r["file"], f"{who}, rendered from the photo's camera{enlarged}",
                                      zoom_width=shown))
-        parts.append("<br>" + figure_html(out, held_out_difference_figure(data, out, photo),
+        parts.append("<br>" + figure_html(out, figures.get(f"held_out_{photo['index']}"),
                                           f"signed difference from held-out photo {photo['index']}"))
     return "\n".join(parts)
 
@@ -819,62 +823,126 @@ draw();
 """
 
 
-_JOBS = []  # the figure functions, inherited by the forked workers of run_figures
+_JOBS = []  # the early figure functions, inherited by the forked workers of run_figures
+_DATA = {}  # report-data.json, read once per process (late_figure)
 
 
 def _run_job(index):
     return _JOBS[index]()
 
 
-def run_figures(jobs, explorer_job):
-    """Runs the figure functions (name -> function returning the figure's file name) in forked worker
-    processes, one per CPU this process may use, in the order given (the slowest first balances them),
-    while this process writes the explorer; returns ({name: file name}, the explorer's result). The
-    figures are the same as run one after another (each function draws and saves its own figure with
-    its own random generator); only the wall time changes. One CPU: no workers."""
-    workers = min(len(jobs), len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1)
+def report_data(out):
+    """OUT_DIR/report-data.json (what `ibrdf report` computed), read once per process; {} without it."""
+    if "data" not in _DATA:
+        _DATA["data"] = load_json(os.path.join(out, "report-data.json")) or {}
+    return _DATA["data"]
+
+
+def late_figure_names(data):
+    """The figures drawn from report-data.json, the slowest first."""
+    return ["plane", "reciprocity_curves", "difference"] + \
+        [f"held_out_{p['index']}" for p in data.get("held_out") or [] if "note" not in p]
+
+
+def late_figure(name, out):
+    """Draws one of late_figure_names (in whichever process runs it); returns the PNG's name or None."""
+    data = report_data(out)
+    if name == "plane":
+        return incidence_plane_figure(data, data.get("models", []), out)
+    if name == "reciprocity_curves":
+        return reciprocity_curves_figure(data, out)
+    if name == "difference":
+        return photo_difference_figure(data, out)
+    index = int(name[len("held_out_"):])
+    photo = next(p for p in data.get("held_out") or [] if p.get("index") == index and "note" not in p)
+    return held_out_difference_figure(data, out, photo)
+
+
+def wait_for_data(out):
+    """With --data-later, `ibrdf report` starts this script before it has written report-data.json (so the
+    figures of the run folder alone are drawn beside its work): True once the file is there (written
+    atomically), False when OUT_DIR/report-abort appears instead (the C++ part failed; nothing to draw)."""
+    data_path, abort = os.path.join(out, "report-data.json"), os.path.join(out, "report-abort")
+    while not os.path.exists(data_path):
+        if os.path.exists(abort):
+            return False
+        time.sleep(0.01)
+    return True
+
+
+def run_figures(early, out, ready, explorer_job):
+    """Runs the early figure functions (name -> function returning the figure's file name; they need only
+    the run folder) and, once ready() says report-data.json is there, the late ones (late_figure), in
+    forked worker processes, one per CPU this process may use, in the order given (the slowest first
+    balances them), while this process writes the explorer; returns ({name: file name}, the explorer's
+    result), or None when ready() gave up. The figures are the same as run one after another (each
+    function draws and saves its own figure with its own random generator); only the wall time changes.
+    One CPU: no workers."""
+    workers = min(len(early), len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1)
     if workers <= 1:
-        return {name: job() for name, job in jobs.items()}, explorer_job()
+        figures = {name: job() for name, job in early.items()}
+        if not ready():
+            return None
+        figures.update({name: late_figure(name, out) for name in late_figure_names(report_data(out))})
+        return figures, explorer_job()
     import concurrent.futures
     import multiprocessing
-    _JOBS[:] = list(jobs.values())
+    _JOBS[:] = list(early.values())
     context = multiprocessing.get_context("fork")
     with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
-        futures = [pool.submit(_run_job, i) for i in range(len(_JOBS))]
+        futures = {name: pool.submit(_run_job, i) for i, name in enumerate(early)}
+        if not ready():
+            pool.shutdown(wait=True, cancel_futures=True)
+            return None
+        for name in late_figure_names(report_data(out)):
+            futures[name] = pool.submit(late_figure, name, out)
         explorer = explorer_job()
-        names = [future.result() for future in futures]
-    return dict(zip(jobs.keys(), names)), explorer
+        figures = {name: future.result() for name, future in futures.items()}
+    return figures, explorer
 
 
 def main():
-    if len(sys.argv) != 3:
-        sys.exit("usage: report.py RUN_DIR OUT_DIR")
-    run_dir, out = sys.argv[1], sys.argv[2]
-    s = np.load(os.path.join(run_dir, "samples.npy"))
-    side = load_json(os.path.join(run_dir, "samples.npy.json")) or {}
-    c = load_json(os.path.join(run_dir, "consistency.json"))
-    t = load_json(os.path.join(run_dir, "truth-comparison.json"))
-    data = load_json(os.path.join(out, "report-data.json")) or {}
-    recon = data.get("reconstruction")
-    r = load_json(os.path.join(os.path.dirname(recon), "summary.json")) if recon else None
-    times = stamps(run_dir)
-    models = data.get("models", [])
-    title = data.get("title") or os.path.basename(os.path.abspath(run_dir))
+    args = [a for a in sys.argv[1:] if a != "--data-later"]
+    data_later = len(args) + 1 < len(sys.argv)
+    if len(args) != 2:
+        sys.exit("usage: report.py RUN_DIR OUT_DIR [--data-later]")
+    run_dir, out = args
+    ready = (lambda: wait_for_data(out)) if data_later else (lambda: True)
+    try:
+        s = np.load(os.path.join(run_dir, "samples.npy"), mmap_mode="r")  # read where the figures use it
+        side = load_json(os.path.join(run_dir, "samples.npy.json")) or {}
+        c = load_json(os.path.join(run_dir, "consistency.json"))
+        t = load_json(os.path.join(run_dir, "truth-comparison.json"))
+        times = stamps(run_dir)
+    except Exception:
+        # Started early (--data-later): a run folder `ibrdf report` refuses is its error to report.
+        if data_later and not ready():
+            sys.exit(3)
+        raise
 
-    jobs = {
-        # The slowest first (the coverage and incidence-plane figures take the most CPU on the demo).
+    early = {
+        # The slowest first (the coverage figure takes the most CPU of these on the demo).
         "coverage": lambda: coverage_figure(s, out),
-        "plane": lambda: incidence_plane_figure(data, models, out),
         "reciprocity": lambda: consistency_figure(c, "reciprocity", "Reciprocity: each sample against the measured "
                                                   "sample nearest its reciprocal point f(te, ti, -dphi)", out),
         "bilateral": lambda: consistency_figure(c, "bilateral_symmetry", "Bilateral symmetry: each sample against "
                                                 "the measured sample nearest f(ti, te, -dphi)", out),
-        "reciprocity_curves": lambda: reciprocity_curves_figure(data, out),
-        "difference": lambda: photo_difference_figure(data, out),
         "timings": lambda: timings_figure(times, side.get("counts", {}), out),
         "bands": lambda: truth_bands_figure(t, out),
     }
-    figures, explorer = run_figures(jobs, lambda: write_explorer(data, out, title))
+
+    def explorer_job():
+        data = report_data(out)
+        return write_explorer(data, out, data.get("title") or os.path.basename(os.path.abspath(run_dir)))
+
+    result = run_figures(early, out, ready, explorer_job)
+    if result is None:
+        sys.exit(3)
+    figures, explorer = result
+    data = report_data(out)
+    recon = data.get("reconstruction")
+    r = load_json(os.path.join(os.path.dirname(recon), "summary.json")) if recon else None
+    title = data.get("title") or os.path.basename(os.path.abspath(run_dir))
     rows = headline_rows(s, side, c, t, r, data, times)
     table = "\n".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>" for k, v in rows)
     explorer_link = (f'<p><a href="{explorer}">Open the BRDF explorer</a> (explorer.html beside this file: '
@@ -901,7 +969,7 @@ BRDF Measurement. Every figure is embedded in this file; the same PNGs lie besid
 pixel that gave a sample, f_model(wi, wo) times the irradiance term E cos(theta_i) the derenderer divided by
 (so sphere, cylinder or scanned mesh alike, shadows included), on the photo's tone scale; and the signed difference.</p>
 {appearance_html(data, out, figures)}
-{held_out_html(data, out)}
+{held_out_html(data, out, figures)}
 {lights_section(out, data)}
 <h2>Sample coverage</h2>
 {figure_html(out, figures['coverage'], 'exitant directions sampled at each incidence angle')}

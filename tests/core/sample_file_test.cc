@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/npy.h"
 #include "tests/error_of.h"
 #include "tests/scratch_dir.h"
 
@@ -126,6 +127,45 @@ TEST_F(SampleFileTest, RoundTrip) {
 TEST_F(SampleFileTest, EmptyRoundTrip) {
   WriteSamples(Path("empty.npy"), {});
   EXPECT_TRUE(ReadSamples(Path("empty.npy")).empty());
+}
+
+// Files larger than ReadSamples' read buffer (8192 rows): every row round-trips, and an invalid row
+// far into the file is named by its index.
+TEST_F(SampleFileTest, ManyRowsRoundTripAndLateErrorsNameTheRow) {
+  const std::vector<BrdfSample> pattern = TestSamples();
+  std::vector<BrdfSample> samples;
+  for (size_t i = 0; i < 20001; ++i) {
+    BrdfSample s = pattern[i % pattern.size()];
+    s.pixel[0] = static_cast<uint32_t>(i);  // every row distinct
+    samples.push_back(s);
+  }
+  WriteSamples(Path("many.npy"), samples);
+  ExpectSameSamples(ReadSamples(Path("many.npy")), samples);
+  samples[19000].theta_i = 3.0f;
+  WriteSamples(Path("many.npy"), samples);
+  const std::string message = testing::ErrorOf([&] { ReadSamples(Path("many.npy")); });
+  EXPECT_NE(message.find(Path("many.npy") + ": sample 19000: theta_i"), std::string::npos) << message;
+}
+
+// A version 1 file (72-byte rows) larger than the read buffer: each row is the version 2 row's prefix,
+// every channel valid, exposures 0.
+TEST_F(SampleFileTest, ManyVersion1RowsAreConverted) {
+  std::vector<BrdfSample> samples;
+  for (size_t i = 0; i < 17000; ++i) {
+    BrdfSample s = TestSamples()[i % 3];
+    s.pixel[1] = static_cast<uint32_t>(i);
+    samples.push_back(s);
+  }
+  std::string rows;
+  for (const BrdfSample& s : samples) rows.append(reinterpret_cast<const char*>(&s), 72);
+  WriteNpy(Path("v1.npy"), BrdfSampleDtypeVersion1(), {samples.size()}, 72, rows.data(), rows.size());
+  const std::vector<BrdfSample> read = ReadSamples(Path("v1.npy"));
+  ASSERT_EQ(read.size(), samples.size());
+  for (size_t i = 0; i < read.size(); ++i) {
+    ASSERT_EQ(std::memcmp(&read[i], &samples[i], 72), 0) << "row " << i;
+    ASSERT_TRUE(read[i].AllValid()) << "row " << i;
+    ASSERT_EQ(read[i].exposures, 0) << "row " << i;
+  }
 }
 
 // The .npy 1.0 layout: magic, version, little-endian header length, a header padded to a multiple of

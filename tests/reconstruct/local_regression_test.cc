@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "reconstruct/reconstruction_error.h"
 #include "tests/reconstruct/reconstruct_test_util.h"
 
@@ -219,6 +220,51 @@ TEST(LocalRegression, BinningAgreesWithPerSampleFit) {
   EXPECT_TRUE(std::isfinite(cv_binned.loo_rms));
   EXPECT_NEAR(cv_binned.loo_rms, cv_exact.loo_rms, 0.5 * cv_exact.loo_rms + 0.01);
   EXPECT_NEAR(cv_binned.mean_leverage, cv_exact.mean_leverage, 0.5 * cv_exact.mean_leverage);
+}
+
+// Leaving samples out by flag is the regression of a copy without them, to the bit: the held-out photo
+// of the report, with a channel some samples did not measure (its own regression) and non-finite
+// samples (skipped and counted) among those kept and those left out.
+TEST(LocalRegression, LeaveOutFlagsEqualACopyWithoutThem) {
+  const auto material = LoadMaterial(MaterialPath("bluepaint"));
+  std::vector<BrdfSample> samples = SessionSamples(*material, CameraEffects(), 6, 200, 150);
+  ASSERT_GT(samples.size(), 1000u);
+  for (size_t i = 0; i < samples.size(); i += 97) samples[i].valid[2] = 0;
+  for (size_t i = 5; i < samples.size(); i += 301) samples[i].brdf[1] = NAN;
+  std::vector<uint8_t> leave_out(samples.size());
+  std::vector<BrdfSample> kept;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    leave_out[i] = samples[i].image == 2 || i % 11 == 0;
+    if (!leave_out[i]) kept.push_back(samples[i]);
+  }
+  const LocalRegression flagged(samples, leave_out, LocalRegressionOptions()), copied(kept, LocalRegressionOptions()),
+      all(samples, LocalRegressionOptions());
+  EXPECT_EQ(flagged.size(), copied.size());
+  EXPECT_LT(flagged.size(), all.size());
+  EXPECT_EQ(flagged.points(), copied.points());
+  EXPECT_EQ(flagged.skipped_samples(), copied.skipped_samples());
+  EXPECT_GT(flagged.skipped_samples(), 0u);
+  EXPECT_EQ(flagged.separate_channels(), copied.separate_channels());
+  EXPECT_EQ(flagged.separate_channels(), 4);
+  std::vector<Eigen::Vector3d> points;
+  for (const BrdfSample& s : samples) {
+    if (s.image != 2) continue;
+    points.push_back(RegressionCoordinates(Eigen::Vector3d(s.wi[0], s.wi[1], s.wi[2]).normalized(),
+                                           Eigen::Vector3d(s.wo[0], s.wo[1], s.wo[2]).normalized()));
+  }
+  ASSERT_GT(points.size(), 100u);
+  const std::vector<Estimate> a = flagged.EvaluateMany(points, nullptr), b = copied.EvaluateMany(points, nullptr),
+                              c = all.EvaluateMany(points, nullptr);
+  size_t differs_from_all = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    ASSERT_EQ(a[i].value, b[i].value) << "point " << i;
+    ASSERT_EQ(a[i].neighbors, b[i].neighbors) << "point " << i;
+    ASSERT_EQ(a[i].status, b[i].status) << "point " << i;
+    differs_from_all += a[i].value != c[i].value;
+  }
+  EXPECT_GT(differs_from_all, points.size() / 2);
+  std::vector<uint8_t> short_flags(samples.size() - 1);
+  EXPECT_THROW({ const LocalRegression bad(samples, short_flags, LocalRegressionOptions()); }, InternalError);
 }
 
 }  // namespace

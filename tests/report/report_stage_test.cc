@@ -211,6 +211,24 @@ TEST(ReportStage, AFolderWithoutSamplesIsAnErrorNamingThem) {
   EXPECT_FALSE(fs::exists(dir / "report"));
 }
 
+// A damaged sample file: the error names it, the plotting script (started first) is stopped, and no
+// report folder or temporary is left.
+TEST(ReportStage, ADamagedSampleFileStopsTheScriptAndLeavesNothing) {
+  ScratchDir dir;
+  std::ofstream(dir / "samples.npy") << "not a .npy file";
+  std::string message;
+  try {
+    WriteReport(dir.str(), ReportOptions());
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find(dir / "samples.npy"), std::string::npos) << message;
+  EXPECT_NE(message.find("bad magic"), std::string::npos) << message;
+  for (const auto& entry : fs::directory_iterator(dir.str())) {
+    EXPECT_EQ(entry.path().filename(), "samples.npy") << "left behind: " << entry.path();
+  }
+}
+
 TEST(ReportStage, OptionsCheckNamesTheRenderSize) {
   std::string why;
   EXPECT_TRUE(ReportOptions().Check(&why)) << why;
