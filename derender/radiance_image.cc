@@ -348,7 +348,9 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
     const std::string path = ResolvePath(impl.directory, exposures[e].file);
     Timer timer;
     ReserveWithHugePages(&images[e].pixels, 3 * size_t(impl.width) * impl.height);
-    ReadImage(path, &images[e]);
+    // Only the window is read below (the floor's ring and the merge stay inside it): a PNG is
+    // converted there only and decoded no further than its last row.
+    ReadImageRegion(path, ImageRegion{window.x0, window.y0, window.x1, window.y1}, &images[e]);
     if (decode_s) *decode_s += timer.ElapsedSeconds();
     if (images[e].width != impl.width || images[e].height != impl.height) {
       ThrowError(path, "is " + std::to_string(images[e].width) + "x" + std::to_string(images[e].height) +
