@@ -451,21 +451,21 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels&
   }
 }
 
-// DerenderPhoto (derenderer.h) on either kind of radiometry (ImagePixels, WindowPixels), for a
-// surface of type Surface (a concrete analytic shape: its Intersect is inlined into the pixel loop).
+// The analytic path's per-pixel work on the traced rows y_begin, y_begin + stride, ... below y_end of
+// one photo (`view`), for a surface of type Surface (a concrete analytic shape: its Intersect is inlined
+// into the pixel loop) and either kind of radiometry (ImagePixels, WindowPixels): appends the accepted
+// samples in row-major order, counts the rejections and (when `exposure` is given) tallies the pixels
+// that reach the radiometric tests. Returns the number of pixels traced.
 template <class Pixels, class Surface>
-void DerenderAnalyticPhoto(const Session& session, size_t photo_index, const Pixels& image,
-                           const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
-                           const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
-                           ExposureTally* exposure) {
-  const PhotoView view(session, photo_index, options, sample);
-  const int stride = options.pixel_stride;
+uint64_t DerenderAnalyticRows(const Session& session, size_t photo_index, const PhotoView& photo_view,
+                              const Pixels& image, const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
+                              int stride, int y_begin, int y_end, std::vector<BrdfSample>* samples,
+                              ReasonCounts* reason_counts, ExposureTally* exposure) {
+  const PhotoView view = photo_view;  // a local copy: its fields stay in registers across the stores below
   ReasonCounts counts{};
-
-  // Only the pixels that can see the sample are traced; the others are off the sample by construction.
   uint64_t traced = 0;
   SurfaceHit hit;  // reused: Intersect sets every field it reports
-  for (int y = view.y_start; y < view.box.y1; y += stride) {
+  for (int y = y_begin; y < y_end; y += stride) {
     for (int x = view.x_start; x < view.box.x1; x += stride) {
       ++traced;
       const Eigen::Vector3d direction = view.Direction(rays[size_t(y) * session.camera.width + x]);
@@ -502,6 +502,61 @@ void DerenderAnalyticPhoto(const Session& session, size_t photo_index, const Pix
       }
       samples->push_back(MakeSample(pixel, hit.normal, incidence, wo_world, photo_index, x, y));
     }
+  }
+  for (int r = 0; r < kNumReasons; ++r) (*reason_counts)[r] += counts[r];
+  return traced;
+}
+
+// DerenderPhoto (derenderer.h) on either kind of radiometry, one thread.
+template <class Pixels, class Surface>
+void DerenderAnalyticPhoto(const Session& session, size_t photo_index, const Pixels& image,
+                           const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
+                           const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
+                           ExposureTally* exposure) {
+  const PhotoView view(session, photo_index, options, sample);
+  const int stride = options.pixel_stride;
+  // Only the pixels that can see the sample are traced; the others are off the sample by construction.
+  ReasonCounts counts{};
+  const uint64_t traced = DerenderAnalyticRows(session, photo_index, view, image, rays, sample, stride, view.y_start,
+                                               view.box.y1, samples, &counts, exposure);
+  counts[kOff] += PixelsPerImage(session.camera, stride) - traced;
+  AddCounts(counts, rejected);
+}
+
+// The same in blocks of rows across threads (the stage's pipeline: the last photos in flight use every
+// thread): `blocks` gets each block's samples in row-major order (resized to the block count; the
+// inner buffers are reused from photo to photo), the counts and the tally are summed over the blocks.
+template <class Pixels, class Surface>
+void DerenderAnalyticPhotoBlocks(const Session& session, size_t photo_index, const Pixels& image,
+                                 const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
+                                 const DerenderOptions& options, std::vector<std::vector<BrdfSample>>* blocks_out,
+                                 RejectionCounts* rejected, ExposureTally* exposure) {
+  const PhotoView view(session, photo_index, options, sample);
+  const int stride = options.pixel_stride;
+  for (std::vector<BrdfSample>& block : *blocks_out) block.clear();
+  const int rows = view.box.y1 > view.y_start ? (view.box.y1 - view.y_start + stride - 1) / stride : 0;
+  const size_t columns = view.box.x1 > view.x_start ? size_t(view.box.x1 - view.x_start + stride - 1) / stride : 0;
+  constexpr int kRowsPerBlock = 16;
+  const size_t blocks = size_t(rows + kRowsPerBlock - 1) / kRowsPerBlock;
+  if (blocks_out->size() < blocks) blocks_out->resize(blocks);
+  std::vector<ReasonCounts> block_counts(blocks, ReasonCounts{});
+  std::vector<ExposureTally> block_tallies(exposure ? blocks : 0);
+  std::vector<uint64_t> block_traced(blocks, 0);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+    const int first = int(b) * kRowsPerBlock, last = std::min(rows, first + kRowsPerBlock);
+    std::vector<BrdfSample>& out = (*blocks_out)[b];
+    // Room for every traced pixel: no regrowth copies.
+    ReserveWithHugePages(&out, columns * size_t(last - first));
+    block_traced[b] = DerenderAnalyticRows(session, photo_index, view, image, rays, sample, stride,
+                                           view.y_start + first * stride, view.y_start + last * stride, &out,
+                                           &block_counts[b], exposure ? &block_tallies[b] : nullptr);
+  });
+  ReasonCounts counts{};
+  uint64_t traced = 0;
+  for (size_t b = 0; b < blocks; ++b) {
+    for (int r = 0; r < kNumReasons; ++r) counts[r] += block_counts[b][r];
+    traced += block_traced[b];
+    if (exposure) exposure->Merge(block_tallies[b]);
   }
   counts[kOff] += PixelsPerImage(session.camera, stride) - traced;
   AddCounts(counts, rejected);
@@ -743,16 +798,10 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
                                             options, &w->parts, &w->mesh_stats);
                           AddCounts(w->mesh_stats.counts, &w->rejected);
                         } else {
-                          if (w->parts.empty()) w->parts.resize(1);
-                          std::vector<BrdfSample>& samples = w->parts.front();
-                          samples.clear();
-                          // Room for every examined pixel: reserved once per buffer (regrowth copies and page
-                          // faults cost more than the per-pixel geometry).
-                          ReserveWithHugePages(&samples, PixelsPerImage(session.camera, options.pixel_stride));
                           const WindowPixels pixels(w->image);
                           const auto derender = [&](const auto& surface) {
-                            DerenderAnalyticPhoto(session, groups[g].front(), pixels, rays, surface, options, &samples,
-                                                  &w->rejected, &w->exposure);
+                            DerenderAnalyticPhotoBlocks(session, groups[g].front(), pixels, rays, surface, options,
+                                                        &w->parts, &w->rejected, &w->exposure);
                           };
                           if (const auto* sphere = dynamic_cast<const SphereSample*>(&sample)) {
                             derender(*sphere);
