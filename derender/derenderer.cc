@@ -764,76 +764,87 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   ProgressBar progress("photos", groups.size());
   size_t next_group = 0;
   tbb::parallel_pipeline(
-      tokens, tbb::make_filter<void, PhotoWork*>(tbb::filter_mode::serial_in_order,
-                                                 [&](tbb::flow_control& control) -> PhotoWork* {
-                                                   if (next_group == groups.size()) {
-                                                     control.stop();
-                                                     return nullptr;
-                                                   }
-                                                   PhotoWork* w = nullptr;
-                                                   IBRDF_CHECK(idle.try_pop(w)) << "no idle photo buffers";
-                                                   w->group = next_group++;
-                                                   return w;
-                                                 }) &
-                  tbb::make_filter<PhotoWork*, PhotoWork*>(
-                      tbb::filter_mode::parallel,
-                      [&](PhotoWork* w) {
-                        const size_t g = w->group;
-                        const PixelBox& box = boxes[g];
-                        std::vector<PhotoSpec> exposures;
-                        for (size_t i : groups[g]) exposures.push_back(session.photos[i]);
-                        w->rejected.clear();
-                        w->mesh_stats = MeshPhotoStats();
-                        w->exposure = ExposureTally();
-                        w->decode_s = 0.0;
-                        reader.PrepareWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1},
-                                             &w->image, &w->decode_s);
-                        if (shared_masks[g]) {
-                          w->image.mask = *shared_masks[g];
-                        } else {
-                          w->image.mask = ReadGroupMask(session, groups[g]);
-                        }
-                        if (mesh_path) {
-                          DerenderMeshPhoto(session, groups[g].front(), WindowPixels(w->image), rays, *mesh_path,
-                                            options, &w->parts, &w->mesh_stats);
-                          AddCounts(w->mesh_stats.counts, &w->rejected);
-                        } else {
-                          const WindowPixels pixels(w->image);
-                          const auto derender = [&](const auto& surface) {
-                            DerenderAnalyticPhotoBlocks(session, groups[g].front(), pixels, rays, surface, options,
-                                                        &w->parts, &w->rejected, &w->exposure);
-                          };
-                          if (const auto* sphere = dynamic_cast<const SphereSample*>(&sample)) {
-                            derender(*sphere);
-                          } else if (const auto* cylinder = dynamic_cast<const CylinderSample*>(&sample)) {
-                            derender(*cylinder);
-                          } else {
-                            derender(sample);
-                          }
-                        }
-                        // Counted here, while the photo's samples are in cache, not over the whole result afterwards.
-                        w->channels_not_measured = {};
-                        for (const std::vector<BrdfSample>& part : w->parts) {
-                          for (const BrdfSample& s : part) {
-                            for (int c = 0; c < 3; ++c) w->channels_not_measured[c] += s.valid[c] == 0;
-                          }
-                        }
-                        return w;
-                      }) &
-                  tbb::make_filter<PhotoWork*, void>(tbb::filter_mode::serial_in_order, [&](PhotoWork* w) {
-                    for (const std::vector<BrdfSample>& part : w->parts) {
-                      result.samples.insert(result.samples.end(), part.begin(), part.end());
-                    }
-                    for (const auto& [reason, count] : w->rejected) result.summary.rejected[reason] += count;
-                    result.summary.decode_s += w->decode_s;
-                    for (int c = 0; c < 3; ++c) result.summary.channels_not_measured[c] += w->channels_not_measured[c];
-                    result.summary.shadow_rays += w->mesh_stats.shadow_rays;
-                    result.summary.shadow_tests_skipped += w->mesh_stats.shadow_tests_skipped;
-                    result.summary.exposure.Merge(w->exposure);
-                    result.summary.exposure.Merge(w->mesh_stats.exposure);
-                    idle.push(w);
-                    progress.Add(1);
-                  }));
+      tokens,
+      tbb::make_filter<void,
+                       PhotoWork*>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& control) -> PhotoWork* {
+        if (next_group == groups.size()) {
+          control.stop();
+          return nullptr;
+        }
+        PhotoWork* w = nullptr;
+        IBRDF_CHECK(idle.try_pop(w)) << "no idle photo buffers";
+        w->group = next_group++;
+        return w;
+      }) & tbb::make_filter<PhotoWork*, PhotoWork*>(tbb::filter_mode::parallel, [&](PhotoWork* w) {
+        const size_t g = w->group;
+        const PixelBox& box = boxes[g];
+        std::vector<PhotoSpec> exposures;
+        for (size_t i : groups[g]) exposures.push_back(session.photos[i]);
+        w->rejected.clear();
+        w->mesh_stats = MeshPhotoStats();
+        w->exposure = ExposureTally();
+        w->decode_s = 0.0;
+        reader.PrepareWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1}, &w->image,
+                             &w->decode_s);
+        if (shared_masks[g]) {
+          w->image.mask = *shared_masks[g];
+        } else {
+          w->image.mask = ReadGroupMask(session, groups[g]);
+        }
+        if (mesh_path) {
+          DerenderMeshPhoto(session, groups[g].front(), WindowPixels(w->image), rays, *mesh_path, options, &w->parts,
+                            &w->mesh_stats);
+          AddCounts(w->mesh_stats.counts, &w->rejected);
+        } else {
+          const WindowPixels pixels(w->image);
+          // The last two photos in rows blocks across threads (a thread done with its photo then
+          // takes blocks of the other's, instead of waiting; a one-photo session uses every
+          // thread); the others one per thread into one reused buffer (fewer, larger pages).
+          const bool split = g + 2 >= groups.size();
+          if (w->parts.empty()) w->parts.resize(1);
+          for (std::vector<BrdfSample>& part : w->parts) part.clear();
+          if (!split) {
+            ReserveWithHugePages(&w->parts.front(), PixelsPerImage(session.camera, options.pixel_stride));
+          }
+          const auto derender = [&](const auto& surface) {
+            if (split) {
+              DerenderAnalyticPhotoBlocks(session, groups[g].front(), pixels, rays, surface, options, &w->parts,
+                                          &w->rejected, &w->exposure);
+            } else {
+              DerenderAnalyticPhoto(session, groups[g].front(), pixels, rays, surface, options, &w->parts.front(),
+                                    &w->rejected, &w->exposure);
+            }
+          };
+          if (const auto* sphere = dynamic_cast<const SphereSample*>(&sample)) {
+            derender(*sphere);
+          } else if (const auto* cylinder = dynamic_cast<const CylinderSample*>(&sample)) {
+            derender(*cylinder);
+          } else {
+            derender(sample);
+          }
+        }
+        // Counted here, while the photo's samples are in cache, not over the whole result afterwards.
+        w->channels_not_measured = {};
+        for (const std::vector<BrdfSample>& part : w->parts) {
+          for (const BrdfSample& s : part) {
+            for (int c = 0; c < 3; ++c) w->channels_not_measured[c] += s.valid[c] == 0;
+          }
+        }
+        return w;
+      }) & tbb::make_filter<PhotoWork*, void>(tbb::filter_mode::serial_in_order, [&](PhotoWork* w) {
+        for (const std::vector<BrdfSample>& part : w->parts) {
+          result.samples.insert(result.samples.end(), part.begin(), part.end());
+        }
+        for (const auto& [reason, count] : w->rejected) result.summary.rejected[reason] += count;
+        result.summary.decode_s += w->decode_s;
+        for (int c = 0; c < 3; ++c) result.summary.channels_not_measured[c] += w->channels_not_measured[c];
+        result.summary.shadow_rays += w->mesh_stats.shadow_rays;
+        result.summary.shadow_tests_skipped += w->mesh_stats.shadow_tests_skipped;
+        result.summary.exposure.Merge(w->exposure);
+        result.summary.exposure.Merge(w->mesh_stats.exposure);
+        idle.push(w);
+        progress.Add(1);
+      }));
   progress.Finish();
   const size_t measured = groups.size();
   result.summary.photos = measured;
