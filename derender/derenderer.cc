@@ -111,7 +111,9 @@ PixelBox SampleBox(const Camera& camera, const Rigid3d& camera_from_world, const
 // PixelRays (derenderer.h) for the pixels inside `box` only; the others are left unset (Eigen does
 // not initialize them, so their pages are never touched).
 std::vector<Eigen::Vector2f> PixelRaysInBox(const Camera& camera, const PixelBox& box) {
-  std::vector<Eigen::Vector2f> rays(size_t(camera.width) * camera.height);
+  std::vector<Eigen::Vector2f> rays;
+  ReserveWithHugePages(&rays, size_t(camera.width) * camera.height);
+  rays.resize(size_t(camera.width) * camera.height);
   if (box.Empty()) return rays;
   tbb::parallel_for(tbb::blocked_range<int>(box.y0, box.y1), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y) {
@@ -127,7 +129,9 @@ std::vector<Eigen::Vector2f> PixelRaysInBox(const Camera& camera, const PixelBox
 // of the (width + 1) x (height + 1) grid) only; the others are left unset.
 std::vector<Eigen::Vector2f> PixelCornerRaysInBox(const Camera& camera, const PixelBox& box) {
   const int columns = camera.width + 1;
-  std::vector<Eigen::Vector2f> rays(size_t(columns) * (camera.height + 1));
+  std::vector<Eigen::Vector2f> rays;
+  ReserveWithHugePages(&rays, size_t(columns) * (camera.height + 1));
+  rays.resize(size_t(columns) * (camera.height + 1));
   if (box.Empty()) return rays;
   tbb::parallel_for(tbb::blocked_range<int>(box.y0, box.y1), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y) {
