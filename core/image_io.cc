@@ -86,8 +86,9 @@ namespace {
 
 // Reads a plain PNG (8- or 16-bit grey or RGB, not interlaced, no transparency) with libpng, as
 // OpenImageIO would: file values / (2^bits - 1) as float. Returns false, having read nothing, for any
-// other PNG (those go through OpenImageIO). `image` null: the header only, into `spec`.
-bool ReadPlainPng(const std::string& path, Image* image, ImageSpec* spec) {
+// other PNG (those go through OpenImageIO). `image` null: the header only, into `spec`. `region`
+// non-null: only its pixels are converted, and decoding stops after its last row (ReadImageRegion).
+bool ReadPlainPng(const std::string& path, Image* image, ImageSpec* spec, const ImageRegion* region = nullptr) {
   FILE* file = std::fopen(path.c_str(), "rb");
   if (!file) return false;
   png_byte signature[8];
@@ -127,6 +128,11 @@ bool ReadPlainPng(const std::string& path, Image* image, ImageSpec* spec) {
     return plain;
   }
   if (bit_depth == 16) png_set_swap(png);  // native byte order (little-endian machines)
+#ifdef PNG_IGNORE_ADLER32
+  // A region that ends above the last row never reaches the stream's Adler-32 checksum (it follows
+  // the last row), so computing it would be wasted; each chunk's CRC is still checked as it is read.
+  if (region && region->y1 < int64_t(height)) png_set_option(png, PNG_IGNORE_ADLER32, PNG_OPTION_ON);
+#endif
   png_read_update_info(png, info);
   image->width = int(width);
   image->height = int(height);
@@ -134,14 +140,27 @@ bool ReadPlainPng(const std::string& path, Image* image, ImageSpec* spec) {
   image->pixels.resize(size_t(width) * height * channels);
   const size_t values = size_t(width) * channels;
   row.resize(values * (bit_depth / 8));
-  float* out = image->pixels.data();
-  for (png_uint_32 y = 0; y < height; ++y, out += values) {
+  // The rows and values converted: all, or the region's (clipped to the image). A PNG is one deflate
+  // stream of rows filtered against the row above, so the rows before the region are decoded (not
+  // converted) and those after it are never decoded.
+  png_uint_32 row_begin = 0, row_end = height;
+  size_t value_begin = 0, value_end = values;
+  if (region) {
+    const auto clip = [](int v, png_uint_32 size) { return png_uint_32(std::clamp<int64_t>(v, 0, int64_t(size))); };
+    row_begin = clip(region->y0, height);
+    row_end = std::max(row_begin, clip(region->y1, height));
+    value_begin = size_t(clip(region->x0, width)) * channels;
+    value_end = std::max(value_begin, size_t(clip(region->x1, width)) * channels);
+  }
+  for (png_uint_32 y = 0; y < row_end; ++y) {
     png_read_row(png, row.data(), nullptr);
+    if (y < row_begin) continue;
+    float* out = image->pixels.data() + size_t(y) * values;
     if (bit_depth == 16) {
       const uint16_t* in = reinterpret_cast<const uint16_t*>(row.data());
-      for (size_t i = 0; i < values; ++i) out[i] = float(in[i]) * (1.0f / 65535.0f);
+      for (size_t i = value_begin; i < value_end; ++i) out[i] = float(in[i]) * (1.0f / 65535.0f);
     } else {
-      for (size_t i = 0; i < values; ++i) out[i] = float(row[i]) * (1.0f / 255.0f);
+      for (size_t i = value_begin; i < value_end; ++i) out[i] = float(row[i]) * (1.0f / 255.0f);
     }
   }
   png_destroy_read_struct(&png, &info, nullptr);
@@ -330,6 +349,15 @@ Image ReadImage(const std::string& path) {
 void ReadImage(const std::string& path, Image* image) {
   RequireFile(path, "image");
   if (LowerExtension(path) == ".png" && ReadPlainPng(path, image, nullptr)) {
+    image->floating_point = false;
+    return;
+  }
+  ReadImageThroughOpenImageIO(path, image);
+}
+
+void ReadImageRegion(const std::string& path, const ImageRegion& region, Image* image) {
+  RequireFile(path, "image");
+  if (LowerExtension(path) == ".png" && ReadPlainPng(path, image, nullptr, &region)) {
     image->floating_point = false;
     return;
   }

@@ -44,6 +44,17 @@ Image ReadImage(const std::string& path);
 // libraries are not loaded by a process that never needs them).
 void ReadImage(const std::string& path, Image* image);
 
+// A rectangle of pixels [x0, x1) x [y0, y1).
+struct ImageRegion {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+// As ReadImage(path, image), for a caller that reads only the pixels inside `region`: `image` gets the
+// file's full size, the region's pixels (clipped to the image) hold exactly ReadImage's values, the
+// others are unspecified. Plain PNGs convert only the region's pixels and stop decoding after its last
+// row (so damage to the file after that row goes unnoticed); other formats are decoded whole.
+void ReadImageRegion(const std::string& path, const ImageRegion& region, Image* image);
+
 // ReadImage through OpenImageIO whatever the file (the reference for the PNG fast path).
 void ReadImageThroughOpenImageIO(const std::string& path, Image* image);
 

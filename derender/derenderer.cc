@@ -111,7 +111,9 @@ PixelBox SampleBox(const Camera& camera, const Rigid3d& camera_from_world, const
 // PixelRays (derenderer.h) for the pixels inside `box` only; the others are left unset (Eigen does
 // not initialize them, so their pages are never touched).
 std::vector<Eigen::Vector2f> PixelRaysInBox(const Camera& camera, const PixelBox& box) {
-  std::vector<Eigen::Vector2f> rays(size_t(camera.width) * camera.height);
+  std::vector<Eigen::Vector2f> rays;
+  ReserveWithHugePages(&rays, size_t(camera.width) * camera.height);
+  rays.resize(size_t(camera.width) * camera.height);
   if (box.Empty()) return rays;
   tbb::parallel_for(tbb::blocked_range<int>(box.y0, box.y1), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y) {
@@ -127,7 +129,9 @@ std::vector<Eigen::Vector2f> PixelRaysInBox(const Camera& camera, const PixelBox
 // of the (width + 1) x (height + 1) grid) only; the others are left unset.
 std::vector<Eigen::Vector2f> PixelCornerRaysInBox(const Camera& camera, const PixelBox& box) {
   const int columns = camera.width + 1;
-  std::vector<Eigen::Vector2f> rays(size_t(columns) * (camera.height + 1));
+  std::vector<Eigen::Vector2f> rays;
+  ReserveWithHugePages(&rays, size_t(columns) * (camera.height + 1));
+  rays.resize(size_t(columns) * (camera.height + 1));
   if (box.Empty()) return rays;
   tbb::parallel_for(tbb::blocked_range<int>(box.y0, box.y1), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y) {
@@ -221,6 +225,35 @@ uint64_t PixelsPerImage(const Camera& camera, int stride) {
   return uint64_t((camera.width + stride - 1) / stride) * uint64_t((camera.height + stride - 1) / stride);
 }
 
+// One photo as the per-pixel loops see it: its pose, light and grazing limits, and the pixels traced
+// (those of its sample box on the stride's grid; the others cannot see the sample).
+struct PhotoView {
+  PhotoView(const Session& session, size_t photo_index, const DerenderOptions& options, const SampleSurface& sample)
+      : light(session.PhotoLight(photo_index)) {
+    const Rigid3d& camera_from_world = *session.photos[photo_index].camera_from_world;
+    const Rigid3d world_from_camera = camera_from_world.Inverse();
+    world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
+    camera_center = world_from_camera.translation;
+    cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
+    cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
+    box = SampleBox(session.camera, camera_from_world, sample);
+    const int stride = options.pixel_stride;
+    x_start = (box.x0 + stride - 1) / stride * stride;
+    y_start = (box.y0 + stride - 1) / stride * stride;
+  }
+  // The unit world direction of the ray through the undistorted image-plane point `xy`.
+  Eigen::Vector3d Direction(const Eigen::Vector2f& xy) const {
+    return (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+  }
+
+  const Light& light;
+  Eigen::Matrix3d world_from_camera_rotation;
+  Eigen::Vector3d camera_center;
+  double cos_max_i = 0.0, cos_max_e = 0.0;  // cosines of the grazing limits
+  PixelBox box;                             // the pixels that can see the sample
+  int x_start = 0, y_start = 0;             // the box's first column and row on the stride's grid
+};
+
 // Everything the mesh path prepares once per session.
 struct MeshPath {
   std::unique_ptr<MeshSample> mesh;
@@ -263,30 +296,24 @@ Reason ShadowTest(const MeshSample& mesh, const Light& light, const Incidence& i
 }
 
 // The mesh path's per-pixel work for one photo: rows of pixels in blocks across threads, each row's
-// rays handed to Embree together; samples in row-major order.
+// rays handed to Embree together. `blocks` gets the samples of each block of rows in row-major order
+// (resized to the block count; the inner buffers are reused from photo to photo, so their samples are
+// copied once, into the stage's result, and their memory is touched once per run).
 template <class Pixels>
 void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels& image,
                        const std::vector<Eigen::Vector2f>& rays, const MeshPath& path, const DerenderOptions& options,
-                       std::vector<BrdfSample>* samples, MeshPhotoStats* stats) {
+                       std::vector<std::vector<BrdfSample>>* blocks_out, MeshPhotoStats* stats) {
   const MeshSample& mesh = *path.mesh;
-  const PhotoSpec& photo = session.photos[photo_index];
-  const Light& light = session.PhotoLight(photo_index);
-  const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
-  const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
-  const Eigen::Vector3d camera_center = world_from_camera.translation;
-  const double cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
-  const double cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
-  const int stride = options.pixel_stride;
+  const PhotoView view(session, photo_index, options, mesh);
   const int width = session.camera.width;
   const bool mask_mixed = options.mask_mixed_pixels && !path.corner_rays.empty();
 
-  const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, mesh);
-  const int x_start = (box.x0 + stride - 1) / stride * stride, y_start = (box.y0 + stride - 1) / stride * stride;
   std::vector<int> xs, ys;
-  for (int x = x_start; x < box.x1; x += stride) xs.push_back(x);
-  for (int y = y_start; y < box.y1; y += stride) ys.push_back(y);
-  const uint64_t examined = PixelsPerImage(session.camera, stride);
+  for (int x = view.x_start; x < view.box.x1; x += options.pixel_stride) xs.push_back(x);
+  for (int y = view.y_start; y < view.box.y1; y += options.pixel_stride) ys.push_back(y);
+  const uint64_t examined = PixelsPerImage(session.camera, options.pixel_stride);
   stats->counts[kOff] += examined - uint64_t(xs.size()) * ys.size();
+  for (std::vector<BrdfSample>& block : *blocks_out) block.clear();
   if (xs.empty() || ys.empty()) return;
   // Corner columns used by the row's pixels: x and x + 1 of each.
   std::vector<int> corner_xs;
@@ -297,9 +324,12 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels&
   std::vector<int> corner_index(size_t(width) + 1, -1);
   for (size_t k = 0; k < corner_xs.size(); ++k) corner_index[corner_xs[k]] = int(k);
 
-  constexpr int kRowsPerBlock = 8;
+  // A block's first row traces its top corners anew (the rows inside a block share them), so blocks
+  // are long enough to make that cheap and many enough (tens per photo) to balance the threads.
+  constexpr int kRowsPerBlock = 16;
   const size_t blocks = (ys.size() + kRowsPerBlock - 1) / kRowsPerBlock;
-  std::vector<std::vector<BrdfSample>> block_samples(blocks);
+  if (blocks_out->size() < blocks) blocks_out->resize(blocks);
+  std::vector<std::vector<BrdfSample>>& block_samples = *blocks_out;
   std::vector<MeshPhotoStats> block_stats(blocks);
   tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
     std::vector<BrdfSample>& out = block_samples[b];
@@ -314,19 +344,20 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels&
     auto trace_corners = [&](int row, std::vector<double>* depths) {
       for (size_t k = 0; k < nc; ++k) {
         const Eigen::Vector2f& xy = path.corner_rays[size_t(row) * (width + 1) + corner_xs[k]];
-        corner_directions[k] = (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+        corner_directions[k] = view.Direction(xy);
       }
-      mesh.DepthBatch(camera_center, corner_directions.data(), nc, depths->data());
+      mesh.DepthBatch(view.camera_center, corner_directions.data(), nc, depths->data());
     };
     const size_t row_end = std::min(ys.size(), (b + 1) * kRowsPerBlock);
-    out.reserve(nx * (row_end - b * kRowsPerBlock));  // no regrowth: each copy costs more than the pixel's work
+    // No regrowth: each copy costs more than the pixel's work.
+    ReserveWithHugePages(&out, nx * (row_end - b * kRowsPerBlock));
     for (size_t r = b * kRowsPerBlock; r < row_end; ++r) {
       const int y = ys[r];
       for (size_t i = 0; i < nx; ++i) {
         const Eigen::Vector2f& xy = rays[size_t(y) * width + xs[i]];
-        directions[i] = (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
+        directions[i] = view.Direction(xy);
       }
-      mesh.IntersectBatch(camera_center, directions.data(), nx, hits.data(), found.get());
+      mesh.IntersectBatch(view.camera_center, directions.data(), nx, hits.data(), found.get());
       bool any_hit = false;
       for (size_t i = 0; i < nx; ++i) any_hit |= found[i];
       if (!any_hit) {
@@ -365,7 +396,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels&
             continue;
           }
         }
-        if (path.occluders && path.occluders->Blocks(camera_center, direction, hit.t)) {
+        if (path.occluders && path.occluders->Blocks(view.camera_center, direction, hit.t)) {
           ++local.counts[kTarget];
           continue;
         }
@@ -381,22 +412,22 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels&
           ++local.counts[kBackfacing];
           continue;
         }
-        const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
+        const Incidence incidence = IncidenceAt(view.light, hit.point, hit.normal);
         if (!incidence.lit) {
           ++local.counts[kUnlit];
           continue;
         }
-        if (!(cos_e >= cos_max_e)) {
+        if (!(cos_e >= view.cos_max_e)) {
           ++local.counts[kGrazingE];
           continue;
         }
-        if (!(incidence.cos_theta >= cos_max_i)) {
+        if (!(incidence.cos_theta >= view.cos_max_i)) {
           ++local.counts[kGrazingI];
           continue;
         }
         if (path.shadow_rays) {
-          const Reason shadow =
-              ShadowTest(mesh, light, incidence, hit.point, hit.normal, hit.fit_rms_m, options, &local.shadow_rays);
+          const Reason shadow = ShadowTest(mesh, view.light, incidence, hit.point, hit.normal, hit.fit_rms_m, options,
+                                           &local.shadow_rays);
           if (shadow != kNumReasons) {
             ++local.counts[shadow];
             continue;
@@ -416,11 +447,7 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels&
       }
     }
   });
-  size_t total = samples->size();
-  for (const auto& block : block_samples) total += block.size();
-  ReserveWithHugePages(samples, total);
   for (size_t b = 0; b < blocks; ++b) {
-    samples->insert(samples->end(), block_samples[b].begin(), block_samples[b].end());
     for (int r = 0; r < kNumReasons; ++r) stats->counts[r] += block_stats[b].counts[r];
     stats->shadow_rays += block_stats[b].shadow_rays;
     stats->shadow_tests_skipped += block_stats[b].shadow_tests_skipped;
@@ -428,35 +455,25 @@ void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels&
   }
 }
 
-// DerenderPhoto (derenderer.h) on either kind of radiometry (ImagePixels, WindowPixels), for a
-// surface of type Surface (a concrete analytic shape: its Intersect is inlined into the pixel loop).
+// The analytic path's per-pixel work on the traced rows y_begin, y_begin + stride, ... below y_end of
+// one photo (`view`), for a surface of type Surface (a concrete analytic shape: its Intersect is inlined
+// into the pixel loop) and either kind of radiometry (ImagePixels, WindowPixels): appends the accepted
+// samples in row-major order, counts the rejections and (when `exposure` is given) tallies the pixels
+// that reach the radiometric tests. Returns the number of pixels traced.
 template <class Pixels, class Surface>
-void DerenderAnalyticPhoto(const Session& session, size_t photo_index, const Pixels& image,
-                           const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
-                           const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
-                           ExposureTally* exposure) {
-  const PhotoSpec& photo = session.photos[photo_index];
-  const Light& light = session.PhotoLight(photo_index);
-  const Rigid3d world_from_camera = photo.camera_from_world->Inverse();
-  const Eigen::Matrix3d world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
-  const Eigen::Vector3d camera_center = world_from_camera.translation;
-  const double cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
-  const double cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
-  const int stride = options.pixel_stride;
+uint64_t DerenderAnalyticRows(const Session& session, size_t photo_index, const PhotoView& photo_view,
+                              const Pixels& image, const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
+                              int stride, int y_begin, int y_end, std::vector<BrdfSample>* samples,
+                              ReasonCounts* reason_counts, ExposureTally* exposure) {
+  const PhotoView view = photo_view;  // a local copy: its fields stay in registers across the stores below
   ReasonCounts counts{};
-
-  // Only the pixels that can see the sample are traced; the others are off the sample by construction.
-  const PixelBox box = SampleBox(session.camera, *photo.camera_from_world, sample);
-  const int x_start = (box.x0 + stride - 1) / stride * stride, y_start = (box.y0 + stride - 1) / stride * stride;
   uint64_t traced = 0;
   SurfaceHit hit;  // reused: Intersect sets every field it reports
-  for (int y = y_start; y < box.y1; y += stride) {
-    for (int x = x_start; x < box.x1; x += stride) {
+  for (int y = y_begin; y < y_end; y += stride) {
+    for (int x = view.x_start; x < view.box.x1; x += stride) {
       ++traced;
-      const Eigen::Vector2f& xy = rays[size_t(y) * session.camera.width + x];
-      const Eigen::Vector3d direction =
-          (world_from_camera_rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
-      if (!sample.Intersect(camera_center, direction, &hit)) {
+      const Eigen::Vector3d direction = view.Direction(rays[size_t(y) * session.camera.width + x]);
+      if (!sample.Intersect(view.camera_center, direction, &hit)) {
         ++counts[kOff];
         continue;
       }
@@ -464,18 +481,18 @@ void DerenderAnalyticPhoto(const Session& session, size_t photo_index, const Pix
         ++counts[kMasked];
         continue;
       }
-      const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
+      const Incidence incidence = IncidenceAt(view.light, hit.point, hit.normal);
       if (!incidence.lit) {
         ++counts[kUnlit];
         continue;
       }
       const Eigen::Vector3d wo_world = -direction;
       const double cos_e = wo_world.dot(hit.normal);
-      if (!(cos_e >= cos_max_e)) {
+      if (!(cos_e >= view.cos_max_e)) {
         ++counts[kGrazingE];
         continue;
       }
-      if (!(incidence.cos_theta >= cos_max_i)) {
+      if (!(incidence.cos_theta >= view.cos_max_i)) {
         ++counts[kGrazingI];
         continue;
       }
@@ -489,6 +506,61 @@ void DerenderAnalyticPhoto(const Session& session, size_t photo_index, const Pix
       }
       samples->push_back(MakeSample(pixel, hit.normal, incidence, wo_world, photo_index, x, y));
     }
+  }
+  for (int r = 0; r < kNumReasons; ++r) (*reason_counts)[r] += counts[r];
+  return traced;
+}
+
+// DerenderPhoto (derenderer.h) on either kind of radiometry, one thread.
+template <class Pixels, class Surface>
+void DerenderAnalyticPhoto(const Session& session, size_t photo_index, const Pixels& image,
+                           const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
+                           const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
+                           ExposureTally* exposure) {
+  const PhotoView view(session, photo_index, options, sample);
+  const int stride = options.pixel_stride;
+  // Only the pixels that can see the sample are traced; the others are off the sample by construction.
+  ReasonCounts counts{};
+  const uint64_t traced = DerenderAnalyticRows(session, photo_index, view, image, rays, sample, stride, view.y_start,
+                                               view.box.y1, samples, &counts, exposure);
+  counts[kOff] += PixelsPerImage(session.camera, stride) - traced;
+  AddCounts(counts, rejected);
+}
+
+// The same in blocks of rows across threads (the stage's pipeline: the last photos in flight use every
+// thread): `blocks` gets each block's samples in row-major order (resized to the block count; the
+// inner buffers are reused from photo to photo), the counts and the tally are summed over the blocks.
+template <class Pixels, class Surface>
+void DerenderAnalyticPhotoBlocks(const Session& session, size_t photo_index, const Pixels& image,
+                                 const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
+                                 const DerenderOptions& options, std::vector<std::vector<BrdfSample>>* blocks_out,
+                                 RejectionCounts* rejected, ExposureTally* exposure) {
+  const PhotoView view(session, photo_index, options, sample);
+  const int stride = options.pixel_stride;
+  for (std::vector<BrdfSample>& block : *blocks_out) block.clear();
+  const int rows = view.box.y1 > view.y_start ? (view.box.y1 - view.y_start + stride - 1) / stride : 0;
+  const size_t columns = view.box.x1 > view.x_start ? size_t(view.box.x1 - view.x_start + stride - 1) / stride : 0;
+  constexpr int kRowsPerBlock = 16;
+  const size_t blocks = size_t(rows + kRowsPerBlock - 1) / kRowsPerBlock;
+  if (blocks_out->size() < blocks) blocks_out->resize(blocks);
+  std::vector<ReasonCounts> block_counts(blocks, ReasonCounts{});
+  std::vector<ExposureTally> block_tallies(exposure ? blocks : 0);
+  std::vector<uint64_t> block_traced(blocks, 0);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+    const int first = int(b) * kRowsPerBlock, last = std::min(rows, first + kRowsPerBlock);
+    std::vector<BrdfSample>& out = (*blocks_out)[b];
+    // Room for every traced pixel: no regrowth copies.
+    ReserveWithHugePages(&out, columns * size_t(last - first));
+    block_traced[b] = DerenderAnalyticRows(session, photo_index, view, image, rays, sample, stride,
+                                           view.y_start + first * stride, view.y_start + last * stride, &out,
+                                           &block_counts[b], exposure ? &block_tallies[b] : nullptr);
+  });
+  ReasonCounts counts{};
+  uint64_t traced = 0;
+  for (size_t b = 0; b < blocks; ++b) {
+    for (int r = 0; r < kNumReasons; ++r) counts[r] += block_counts[b][r];
+    traced += block_traced[b];
+    if (exposure) exposure->Merge(block_tallies[b]);
   }
   counts[kOff] += PixelsPerImage(session.camera, stride) - traced;
   AddCounts(counts, rejected);
@@ -668,7 +740,8 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   struct PhotoWork {
     size_t group = 0;
     RadianceWindow image;  // the decoded exposures, merged pixel by pixel on demand
-    std::vector<BrdfSample> samples;
+    // The photo's samples in order: one part (analytic path) or one per block of rows (mesh path).
+    std::vector<std::vector<BrdfSample>> parts;
     RejectionCounts rejected;
     MeshPhotoStats mesh_stats;
     ExposureTally exposure;  // analytic path
@@ -695,76 +768,87 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
   ProgressBar progress("photos", groups.size());
   size_t next_group = 0;
   tbb::parallel_pipeline(
-      tokens, tbb::make_filter<void, PhotoWork*>(tbb::filter_mode::serial_in_order,
-                                                 [&](tbb::flow_control& control) -> PhotoWork* {
-                                                   if (next_group == groups.size()) {
-                                                     control.stop();
-                                                     return nullptr;
-                                                   }
-                                                   PhotoWork* w = nullptr;
-                                                   IBRDF_CHECK(idle.try_pop(w)) << "no idle photo buffers";
-                                                   w->group = next_group++;
-                                                   return w;
-                                                 }) &
-                  tbb::make_filter<PhotoWork*, PhotoWork*>(
-                      tbb::filter_mode::parallel,
-                      [&](PhotoWork* w) {
-                        const size_t g = w->group;
-                        const PixelBox& box = boxes[g];
-                        std::vector<PhotoSpec> exposures;
-                        for (size_t i : groups[g]) exposures.push_back(session.photos[i]);
-                        w->samples.clear();
-                        w->rejected.clear();
-                        w->mesh_stats = MeshPhotoStats();
-                        w->exposure = ExposureTally();
-                        w->decode_s = 0.0;
-                        reader.PrepareWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1},
-                                             &w->image, &w->decode_s);
-                        if (shared_masks[g]) {
-                          w->image.mask = *shared_masks[g];
-                        } else {
-                          w->image.mask = ReadGroupMask(session, groups[g]);
-                        }
-                        // Room for every examined pixel: reserved once per buffer (regrowth copies and page faults
-                        // cost more than the per-pixel geometry).
-                        ReserveWithHugePages(&w->samples, PixelsPerImage(session.camera, options.pixel_stride));
-                        if (mesh_path) {
-                          DerenderMeshPhoto(session, groups[g].front(), WindowPixels(w->image), rays, *mesh_path,
-                                            options, &w->samples, &w->mesh_stats);
-                          AddCounts(w->mesh_stats.counts, &w->rejected);
-                        } else {
-                          const WindowPixels pixels(w->image);
-                          const auto derender = [&](const auto& surface) {
-                            DerenderAnalyticPhoto(session, groups[g].front(), pixels, rays, surface, options,
-                                                  &w->samples, &w->rejected, &w->exposure);
-                          };
-                          if (const auto* sphere = dynamic_cast<const SphereSample*>(&sample)) {
-                            derender(*sphere);
-                          } else if (const auto* cylinder = dynamic_cast<const CylinderSample*>(&sample)) {
-                            derender(*cylinder);
-                          } else {
-                            derender(sample);
-                          }
-                        }
-                        // Counted here, while the photo's samples are in cache, not over the whole result afterwards.
-                        w->channels_not_measured = {};
-                        for (const BrdfSample& s : w->samples) {
-                          for (int c = 0; c < 3; ++c) w->channels_not_measured[c] += s.valid[c] == 0;
-                        }
-                        return w;
-                      }) &
-                  tbb::make_filter<PhotoWork*, void>(tbb::filter_mode::serial_in_order, [&](PhotoWork* w) {
-                    result.samples.insert(result.samples.end(), w->samples.begin(), w->samples.end());
-                    for (const auto& [reason, count] : w->rejected) result.summary.rejected[reason] += count;
-                    result.summary.decode_s += w->decode_s;
-                    for (int c = 0; c < 3; ++c) result.summary.channels_not_measured[c] += w->channels_not_measured[c];
-                    result.summary.shadow_rays += w->mesh_stats.shadow_rays;
-                    result.summary.shadow_tests_skipped += w->mesh_stats.shadow_tests_skipped;
-                    result.summary.exposure.Merge(w->exposure);
-                    result.summary.exposure.Merge(w->mesh_stats.exposure);
-                    idle.push(w);
-                    progress.Add(1);
-                  }));
+      tokens,
+      tbb::make_filter<void,
+                       PhotoWork*>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& control) -> PhotoWork* {
+        if (next_group == groups.size()) {
+          control.stop();
+          return nullptr;
+        }
+        PhotoWork* w = nullptr;
+        IBRDF_CHECK(idle.try_pop(w)) << "no idle photo buffers";
+        w->group = next_group++;
+        return w;
+      }) & tbb::make_filter<PhotoWork*, PhotoWork*>(tbb::filter_mode::parallel, [&](PhotoWork* w) {
+        const size_t g = w->group;
+        const PixelBox& box = boxes[g];
+        std::vector<PhotoSpec> exposures;
+        for (size_t i : groups[g]) exposures.push_back(session.photos[i]);
+        w->rejected.clear();
+        w->mesh_stats = MeshPhotoStats();
+        w->exposure = ExposureTally();
+        w->decode_s = 0.0;
+        reader.PrepareWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1}, &w->image,
+                             &w->decode_s);
+        if (shared_masks[g]) {
+          w->image.mask = *shared_masks[g];
+        } else {
+          w->image.mask = ReadGroupMask(session, groups[g]);
+        }
+        if (mesh_path) {
+          DerenderMeshPhoto(session, groups[g].front(), WindowPixels(w->image), rays, *mesh_path, options, &w->parts,
+                            &w->mesh_stats);
+          AddCounts(w->mesh_stats.counts, &w->rejected);
+        } else {
+          const WindowPixels pixels(w->image);
+          // The last two photos in rows blocks across threads (a thread done with its photo then
+          // takes blocks of the other's, instead of waiting; a one-photo session uses every
+          // thread); the others one per thread into one reused buffer (fewer, larger pages).
+          const bool split = g + 2 >= groups.size();
+          if (w->parts.empty()) w->parts.resize(1);
+          for (std::vector<BrdfSample>& part : w->parts) part.clear();
+          if (!split) {
+            ReserveWithHugePages(&w->parts.front(), PixelsPerImage(session.camera, options.pixel_stride));
+          }
+          const auto derender = [&](const auto& surface) {
+            if (split) {
+              DerenderAnalyticPhotoBlocks(session, groups[g].front(), pixels, rays, surface, options, &w->parts,
+                                          &w->rejected, &w->exposure);
+            } else {
+              DerenderAnalyticPhoto(session, groups[g].front(), pixels, rays, surface, options, &w->parts.front(),
+                                    &w->rejected, &w->exposure);
+            }
+          };
+          if (const auto* sphere = dynamic_cast<const SphereSample*>(&sample)) {
+            derender(*sphere);
+          } else if (const auto* cylinder = dynamic_cast<const CylinderSample*>(&sample)) {
+            derender(*cylinder);
+          } else {
+            derender(sample);
+          }
+        }
+        // Counted here, while the photo's samples are in cache, not over the whole result afterwards.
+        w->channels_not_measured = {};
+        for (const std::vector<BrdfSample>& part : w->parts) {
+          for (const BrdfSample& s : part) {
+            for (int c = 0; c < 3; ++c) w->channels_not_measured[c] += s.valid[c] == 0;
+          }
+        }
+        return w;
+      }) & tbb::make_filter<PhotoWork*, void>(tbb::filter_mode::serial_in_order, [&](PhotoWork* w) {
+        for (const std::vector<BrdfSample>& part : w->parts) {
+          result.samples.insert(result.samples.end(), part.begin(), part.end());
+        }
+        for (const auto& [reason, count] : w->rejected) result.summary.rejected[reason] += count;
+        result.summary.decode_s += w->decode_s;
+        for (int c = 0; c < 3; ++c) result.summary.channels_not_measured[c] += w->channels_not_measured[c];
+        result.summary.shadow_rays += w->mesh_stats.shadow_rays;
+        result.summary.shadow_tests_skipped += w->mesh_stats.shadow_tests_skipped;
+        result.summary.exposure.Merge(w->exposure);
+        result.summary.exposure.Merge(w->mesh_stats.exposure);
+        idle.push(w);
+        progress.Add(1);
+      }));
   progress.Finish();
   const size_t measured = groups.size();
   result.summary.photos = measured;

@@ -7,7 +7,6 @@
 #include <mutex>
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "core/error.h"
@@ -348,7 +347,9 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
     const std::string path = ResolvePath(impl.directory, exposures[e].file);
     Timer timer;
     ReserveWithHugePages(&images[e].pixels, 3 * size_t(impl.width) * impl.height);
-    ReadImage(path, &images[e]);
+    // Only the window is read below (the floor's ring and the merge stay inside it): a PNG is
+    // converted there only and decoded no further than its last row.
+    ReadImageRegion(path, ImageRegion{window.x0, window.y0, window.x1, window.y1}, &images[e]);
     if (decode_s) *decode_s += timer.ElapsedSeconds();
     if (images[e].width != impl.width || images[e].height != impl.height) {
       ThrowError(path, "is " + std::to_string(images[e].width) + "x" + std::to_string(images[e].height) +
@@ -373,7 +374,8 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
   // Every element is written before it is read, so the scratch memory is only grown, never cleared.
   std::vector<float>& scratch = *scratch_buffer;
   if (scratch.size() < 3 * area * m) {
-    ReserveWithHugePages(&scratch, 3 * area * m);
+    // Room for a whole frame at once: a later, larger window does not regrow it into fresh pages.
+    ReserveWithHugePages(&scratch, 3 * size_t(impl.width) * impl.height * m);
     scratch.resize(3 * area * m);
   }
   float* const expected = scratch.data();
@@ -400,22 +402,24 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
   }
   // Per thread: the linear signal and the horizontal sums of a block of rows and its kOuter rows above
   // and below, small enough to stay in cache (the blocks' halo rows are computed twice).
+  // They are per thread and kept for the process (sized for a whole block at once): fresh buffers for
+  // every photo were a third of the stage's page faults.
   struct RowBuffers {
     std::vector<float> linear, outer, inner;
   };
-  tbb::enumerable_thread_specific<RowBuffers> buffers;
+  static thread_local RowBuffers thread_buffers;
   constexpr int kBlockRows = 32;
+  const size_t block_values = row_values * size_t(kBlockRows + 2 * kOuter);
   for (size_t e = 0; e < m; ++e) {
     const Image& image = images[e];
     float* exp = &expected[3 * area * e];
     tbb::parallel_for(tbb::blocked_range<int>(0, height, kBlockRows), [&](const tbb::blocked_range<int>& rows) {
       const int first = std::max(rows.begin() - kOuter, 0), last = std::min(rows.end() + kOuter, height);
-      RowBuffers& local = buffers.local();
-      const size_t needed = row_values * size_t(last - first);
-      if (local.linear.size() < needed) {
-        local.linear.resize(needed);
-        local.outer.resize(needed);
-        local.inner.resize(needed);
+      RowBuffers& local = thread_buffers;
+      if (local.linear.size() < block_values) {
+        local.linear.resize(block_values);
+        local.outer.resize(block_values);
+        local.inner.resize(block_values);
       }
       // The linear signal and the horizontal sums of rows first .. last - 1.
       for (int j = first; j < last; ++j) {

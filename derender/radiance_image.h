@@ -105,7 +105,8 @@ class RadianceReader {
   RadianceImage Read(const std::vector<PhotoSpec>& exposures, double min_signal, double* decode_s = nullptr) const;
 
   // As Read, into buffers reused from photo to photo (the derenderer's loop): `decoded` holds the
-  // decoded files and `out` the radiance image, both resized only when the camera's size changes.
+  // decoded files (their pixels inside `window` only: core/image_io.h, ReadImageRegion) and `out` the
+  // radiance image, both resized only when the camera's size changes.
   // Only the pixels inside `window` are linearized and merged; outside it `out` keeps whatever it
   // held, so the caller must read nothing there. Within the window the values are those of Read.
   void ReadWindow(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,

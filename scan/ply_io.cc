@@ -93,9 +93,13 @@ std::string ReadWholeFile(const std::string& path) {
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) ThrowError(path, "cannot open for reading");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
+  // Read in one piece into a string of the file's size (a growing string stream copied a 400 k-face
+  // mesh several times into fresh memory: most of derender's page faults on such a mesh).
+  std::string data(size_t(bytes), '\0');
+  in.read(data.data(), std::streamsize(bytes));
+  if (in.bad()) ThrowError(path, "cannot read the file");
+  data.resize(size_t(in.gcount()));
+  return data;
 }
 
 std::vector<std::string> Split(const std::string& line) {
@@ -502,6 +506,7 @@ void StoreInstance(const ElementLayout& layout, uint64_t i, const InstanceValues
 // Checks the indices (faces, grid cells) and coordinates; triangulates the polygons into mesh->faces.
 void FinishMesh(const std::vector<std::vector<int>>& polygons, const std::string& path, ScanMesh* mesh) {
   const int n = static_cast<int>(mesh->points.size());
+  mesh->faces.reserve(mesh->faces.size() + polygons.size());  // one triangle per polygon at least
   for (size_t i = 0; i < polygons.size(); ++i) {
     for (int v : polygons[i]) {
       if (v < 0 || v >= n) {
@@ -567,6 +572,7 @@ ScanMesh ReadPly(const std::string& path) {
   bool have_grid = false;
   std::vector<std::vector<int>> polygons;
   for (const Element& element : header.elements) {
+    if (element.name == "face") polygons.reserve(size_t(element.count));
     const ElementLayout layout = PrepareElement(element, header, path, &have_grid, &mesh);
     InstanceValues values;
     for (uint64_t i = 0; i < element.count; ++i) {

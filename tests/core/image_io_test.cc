@@ -238,6 +238,71 @@ TEST_F(ImageIoTest, PlainPngFastPathMatchesOpenImageIO) {
   ExpectErrorNamingPath([&] { ReadImage(corrupt, &image); }, corrupt);
 }
 
+// Issue 15: ReadImageRegion gives ReadImage's values inside the region (clipped to the image) for PNGs
+// (8 and 16 bits, grey and RGB: the libpng path stops after the region's last row) and for a format
+// decoded whole (EXR); a region reaching past the image or empty reads without error; a PNG cut off
+// inside the region is an error naming the file, one cut off after it is not (its rows are never
+// decoded).
+TEST_F(ImageIoTest, RegionReadMatchesTheWholeImageInside) {
+  struct Case {
+    std::string name;
+    PixelFormat format;
+    int channels;
+  };
+  const std::vector<Case> cases = {{"r16.png", PixelFormat::kUint16, 3},
+                                   {"g16.png", PixelFormat::kUint16, 1},
+                                   {"r8.png", PixelFormat::kUint8, 3},
+                                   {"r.exr", PixelFormat::kFloat, 3}};
+  const std::vector<ImageRegion> regions = {{0, 0, 57, 43}, {5, 7, 30, 20},   {0, 30, 57, 43}, {40, 0, 80, 10},
+                                            {-3, -2, 4, 3}, {10, 10, 10, 20}, {56, 42, 57, 43}};
+  for (const Case& c : cases) {
+    const std::string path = Path(c.name);
+    WriteImage(path, RandomImage(57, 43, c.channels, 7), c.format);
+    const Image whole = ReadImage(path);
+    Image part;  // reused across regions, as the derenderer reuses its buffers
+    for (const ImageRegion& r : regions) {
+      SCOPED_TRACE(c.name + " region " + std::to_string(r.x0) + "," + std::to_string(r.y0) + " to " +
+                   std::to_string(r.x1) + "," + std::to_string(r.y1));
+      // Fill the reused buffer with a value no file holds, so a pixel the read skipped would show.
+      std::fill(part.pixels.begin(), part.pixels.end(), -1.0f);
+      ReadImageRegion(path, r, &part);
+      ASSERT_EQ(part.width, whole.width);
+      ASSERT_EQ(part.height, whole.height);
+      ASSERT_EQ(part.channels, whole.channels);
+      ASSERT_EQ(part.pixels.size(), whole.pixels.size());
+      EXPECT_EQ(part.floating_point, whole.floating_point);
+      size_t compared = 0, different = 0;
+      for (int y = std::max(r.y0, 0); y < std::min(r.y1, whole.height); ++y) {
+        for (int x = std::max(r.x0, 0); x < std::min(r.x1, whole.width); ++x) {
+          for (int k = 0; k < whole.channels; ++k) {
+            ++compared;
+            different += part.at(x, y, k) != whole.at(x, y, k);
+          }
+        }
+      }
+      EXPECT_EQ(different, 0u);
+      if (r.x1 > r.x0 && r.y1 > r.y0) {
+        EXPECT_GT(compared, 0u);
+      }
+    }
+  }
+  // A PNG cut off at half its bytes (large enough that libpng's reads of 8 KiB stay clear of the cut
+  // for the first rows): a region above the cut reads; one reaching below it is an error naming the file.
+  const std::string full = Path("big.png"), cut = Path("cut.png");
+  WriteImage(full, RandomImage(300, 200, 3, 11), PixelFormat::kUint16);
+  {
+    std::ifstream in(full, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    bytes.resize(bytes.size() / 2);
+    std::ofstream(cut, std::ios::binary) << bytes;
+  }
+  const Image whole = ReadImage(full);
+  Image part;
+  ReadImageRegion(cut, ImageRegion{10, 0, 300, 5}, &part);
+  for (int x = 10; x < 300; ++x) EXPECT_EQ(part.at(x, 4, 2), whole.at(x, 4, 2));
+  ExpectErrorNamingPath([&] { ReadImageRegion(cut, ImageRegion{0, 150, 300, 200}, &part); }, cut);
+}
+
 TEST(IsRawExtension, KnowsCameraRawFormats) {
   EXPECT_TRUE(IsRawExtension("a/IMG_0001.CR2"));
   EXPECT_TRUE(IsRawExtension("b.nef"));

@@ -71,6 +71,32 @@ TEST(HugePages, AdvisedRangeIsEligibleWhereTheKernelOffersThem) {
   const int eligible = ThpEligible(middle);
   if (eligible < 0) GTEST_SKIP() << "/proc/self/smaps has no THPeligible field on this kernel";
   EXPECT_EQ(eligible, 1);
+  // Issue 15: the buffer's first and last pages too (the advice is widened to whole 2 MiB pages), for
+  // an odd size and an element that does not divide 2 MiB.
+  struct Row {
+    char bytes[76];
+  };
+  std::vector<Row> rows;
+  ReserveWithHugePages(&rows, 123457);  // 9.4 MB
+  EXPECT_EQ(ThpEligible(rows.data()), 1);
+  EXPECT_EQ(ThpEligible(rows.data() + rows.capacity() - 1), 1);
+}
+
+// The capacity is n under 4 MiB, and above it at least n and the largest that keeps the allocation
+// (with malloc's header) within whole 2 MiB pages.
+TEST(HugePages, CapacityFillsWholeHugePages) {
+  EXPECT_EQ(HugePageCapacity(1000, 4), 1000u);
+  EXPECT_EQ(HugePageCapacity(0, 76), 0u);
+  for (size_t n : {size_t(1) << 20, size_t(1234567), size_t(3) << 21}) {
+    for (size_t element : {size_t(4), size_t(8), size_t(76)}) {
+      constexpr size_t kHuge = size_t(2) << 20;
+      const size_t capacity = HugePageCapacity(n, element);
+      const size_t whole = (n * element + 64 + kHuge - 1) / kHuge * kHuge;  // whole huge pages for n
+      EXPECT_GE(capacity, n);
+      EXPECT_LE(capacity * element + 64, whole) << n << " x " << element;
+      EXPECT_GT((capacity + 1) * element + 64, whole) << n << " x " << element;
+    }
+  }
 }
 
 }  // namespace
