@@ -56,11 +56,10 @@ Eigen::Vector3d MerlBrdf::Lookup(const Eigen::Vector3d& wi, const Eigen::Vector3
   const size_t cell = MerlFlatIndex(MerlThetaHalfIndex(angles.theta_h), MerlThetaDiffIndex(angles.theta_d),
                                     MerlPhiDiffIndex(angles.phi_d));
   if (!table_.Measured(cell)) return Eigen::Vector3d::Constant(-1.0);
-  // The reader's index coordinates before truncation (core/merl_format.cc, the same arithmetic).
-  const double u_h = std::sqrt(std::max(0.0, (angles.theta_h / (M_PI / 2.0)) * kMerlThetaH) * kMerlThetaH);
-  const double u_d = std::max(0.0, angles.theta_d / (M_PI * 0.5) * kMerlThetaD);
-  const double phi_d = angles.phi_d < 0.0 ? angles.phi_d + M_PI : angles.phi_d;
-  const double u_p = phi_d / M_PI * (2 * kMerlPhiD) / 2;
+  // The reader's index coordinates before truncation.
+  const double u_h = MerlThetaHalfCoordinate(angles.theta_h);
+  const double u_d = std::max(0.0, MerlThetaDiffCoordinate(angles.theta_d));
+  const double u_p = MerlPhiDiffCoordinate(angles.phi_d);
   int h[2], d[2], p[2];
   double th, td, tp;
   Neighbours(u_h, kMerlThetaH, false, &h[0], &h[1], &th);

@@ -11,32 +11,36 @@ namespace ibrdf {
 
 const double kMerlScale[3] = {1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0};
 
-// The three index functions follow BRDFRead.cpp line by line (including its arithmetic order), so a
+// The three coordinate functions follow BRDFRead.cpp line by line (including its arithmetic order), so a
 // direction lands in the same cell as in the reader.
-int MerlThetaHalfIndex(double theta_h) {
-  if (theta_h <= 0.0) return 0;
+double MerlThetaHalfCoordinate(double theta_h) {
+  if (theta_h <= 0.0) return 0.0;
   const double theta_half_deg = (theta_h / (M_PI / 2.0)) * kMerlThetaH;
-  const double temp = std::sqrt(theta_half_deg * kMerlThetaH);
-  int index = static_cast<int>(temp);
-  if (index < 0) index = 0;
-  if (index >= kMerlThetaH) index = kMerlThetaH - 1;
-  return index;
+  return std::sqrt(theta_half_deg * kMerlThetaH);
 }
 
-int MerlThetaDiffIndex(double theta_d) {
-  int index = static_cast<int>(theta_d / (M_PI * 0.5) * kMerlThetaD);
-  if (index < 0) return 0;
-  if (index < kMerlThetaD - 1) return index;
-  return kMerlThetaD - 1;
-}
+double MerlThetaDiffCoordinate(double theta_d) { return theta_d / (M_PI * 0.5) * kMerlThetaD; }
 
-int MerlPhiDiffIndex(double phi_d) {
+double MerlPhiDiffCoordinate(double phi_d) {
   if (phi_d < 0.0) phi_d += M_PI;
-  int index = static_cast<int>(phi_d / M_PI * (2 * kMerlPhiD) / 2);
-  if (index < 0) return 0;
-  if (index < kMerlPhiD - 1) return index;
-  return kMerlPhiD - 1;
+  return phi_d / M_PI * (2 * kMerlPhiD) / 2;
 }
+
+namespace {
+// The reader's truncation of a coordinate, clamped to [0, cells - 1].
+int ClampedIndex(double coordinate, int cells) {
+  const int index = static_cast<int>(coordinate);
+  if (index < 0) return 0;
+  if (index < cells - 1) return index;
+  return cells - 1;
+}
+}  // namespace
+
+int MerlThetaHalfIndex(double theta_h) { return ClampedIndex(MerlThetaHalfCoordinate(theta_h), kMerlThetaH); }
+
+int MerlThetaDiffIndex(double theta_d) { return ClampedIndex(MerlThetaDiffCoordinate(theta_d), kMerlThetaD); }
+
+int MerlPhiDiffIndex(double phi_d) { return ClampedIndex(MerlPhiDiffCoordinate(phi_d), kMerlPhiD); }
 
 HalfDiffAngles MerlCellCentre(int i, int j, int k) {
   HalfDiffAngles angles;

@@ -25,7 +25,13 @@ constexpr size_t kMerlCells = size_t(kMerlThetaH) * kMerlThetaD * kMerlPhiD;
 // The reader's per-channel scales: value = stored * scale.
 extern const double kMerlScale[3];
 
-// The reader's index functions (clamped to the table).
+// The reader's index coordinates before truncation (BRDFRead.cpp's arithmetic, in its order): cell i spans
+// [i, i + 1), its centre at i + 0.5. theta_h <= 0 gives 0; phi_d < 0 is folded onto phi_d + pi. Not
+// clamped: theta_d beyond pi/2 gives more than 90.
+double MerlThetaHalfCoordinate(double theta_h);
+double MerlThetaDiffCoordinate(double theta_d);
+double MerlPhiDiffCoordinate(double phi_d);
+// The reader's index functions: the coordinates above truncated and clamped to the table.
 int MerlThetaHalfIndex(double theta_h);
 int MerlThetaDiffIndex(double theta_d);
 int MerlPhiDiffIndex(double phi_d);

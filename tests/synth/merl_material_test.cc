@@ -16,10 +16,12 @@
 #include "derender/derenderer.h"
 #include "synth/synthetic.h"
 #include "tests/scratch_dir.h"
+#include "tests/synth/holey_merl_table.h"
 
 namespace ibrdf {
 namespace {
 
+using testing::HoleyMerlTable;
 using testing::ScratchDir;
 
 // A table linear in the three cell indices (so that linear interpolation between centres is exact).
@@ -108,23 +110,12 @@ SynthOptions SmallSession(SynthNoData no_data) {
   return options;
 }
 
-std::string HoleyTable(const ScratchDir& dir) {
-  MerlTable table;
-  for (int i = 0; i < kMerlThetaH; ++i) {
-    for (int j = 0; j < 30; ++j) {
-      for (int k = 0; k < kMerlPhiD; ++k) table.SetCell(MerlFlatIndex(i, j, k), Eigen::Vector3d(0.1, 0.2, 0.3));
-    }
-  }
-  WriteMerl(dir / "holey.binary", table);
-  return dir / "holey.binary";
-}
-
 // The default, skip: every pixel that looked up a cell without data is left out of the samples by its
 // photo's mask and counted the same in synth's summary, truth.json and derender's `masked`; no sample
 // is zero-valued and none lies beyond the table's data.
 TEST(SynthMerl, NoDataPixelsAreLeftOutByMasksAndCounted) {
   ScratchDir dir;
-  const MerlBrdf material(HoleyTable(dir));
+  const MerlBrdf material(HoleyMerlTable(dir));
   const SynthSummary summary =
       WriteSyntheticSession(SmallSession(SynthNoData::kSkip), material, "holey", dir / "s", false);
   EXPECT_TRUE(summary.tabulated);
@@ -157,7 +148,7 @@ TEST(SynthMerl, NoDataPixelsAreLeftOutByMasksAndCounted) {
 // near-zero samples); error refuses the material and leaves no folder behind.
 TEST(SynthMerl, NoDataZeroRendersBlackAndErrorRefuses) {
   ScratchDir dir;
-  const MerlBrdf material(HoleyTable(dir));
+  const MerlBrdf material(HoleyMerlTable(dir));
   SynthOptions noisy = SmallSession(SynthNoData::kZero);
   noisy.effects = CameraEffects();
   const SynthSummary zero = WriteSyntheticSession(noisy, material, "holey", dir / "z", false);

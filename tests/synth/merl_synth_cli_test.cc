@@ -9,31 +9,21 @@
 #include "core/merl_format.h"
 #include "tests/run_ibrdf.h"
 #include "tests/scratch_dir.h"
+#include "tests/synth/holey_merl_table.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
 namespace {
 
+using testing::HoleyMerlTable;
 using testing::RunIbrdf;
 using testing::ScratchDir;
-
-// A table with data only below theta_d 30 degrees.
-std::string HoleyTable(const ScratchDir& dir) {
-  MerlTable table;
-  for (int i = 0; i < kMerlThetaH; ++i) {
-    for (int j = 0; j < 30; ++j) {
-      for (int k = 0; k < kMerlPhiD; ++k) table.SetCell(MerlFlatIndex(i, j, k), Eigen::Vector3d(0.1, 0.2, 0.3));
-    }
-  }
-  WriteMerl(dir / "holey.binary", table);
-  return dir / "holey.binary";
-}
 
 const char kSmall[] = " --width 200 --height 150 --photos 4 --effects none";
 
 TEST(SynthMerlCli, LinearLookupAndSkippedPixelsAreSaidAndRecorded) {
   ScratchDir dir;
-  const std::string table = HoleyTable(dir);
+  const std::string table = HoleyMerlTable(dir);
   const auto run = RunIbrdf("synth --out " + (dir / "s") + " --material " + table + " --merl-lookup linear" + kSmall,
                             /*quiet=*/true);
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -54,7 +44,7 @@ TEST(SynthMerlCli, LinearLookupAndSkippedPixelsAreSaidAndRecorded) {
 
 TEST(SynthMerlCli, NoDataErrorAndLookupOnAModelAreRefused) {
   ScratchDir dir;
-  const std::string table = HoleyTable(dir);
+  const std::string table = HoleyMerlTable(dir);
   const auto refused = RunIbrdf("synth --out " + (dir / "e") + " --material " + table + " --no-data error" + kSmall);
   EXPECT_NE(refused.exit_code, 0);
   EXPECT_NE(refused.output.find("holey.binary"), std::string::npos) << refused.output;
