@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "reconstruct/normal_accumulation.h"
 
 namespace ibrdf {
 namespace {
@@ -87,8 +88,10 @@ struct NormalEquations {
   double b[kMaxCoefficients][3] = {};                 // by Accumulate()
   // Per point with non-zero weight: count * w^2, count * w, its basis row and its mean value (kRowSize
   // doubles a point).
-  static constexpr int kSquaredWeight = 0, kWeight = 1, kBasis = 2, kMean = kBasis + kMaxCoefficients;
-  static constexpr int kRowSize = kMean + 3;
+  static constexpr int kSquaredWeight = kNormalSquaredWeight, kWeight = kNormalWeight, kBasis = kNormalBasis,
+                       kMean = kNormalMean;
+  static constexpr int kRowSize = kNormalRowSize;
+  static_assert(kMaxCoefficients == kNormalCoefficients);
   std::vector<double>* rows = nullptr;
   size_t rows_used = 0;  // doubles of `rows` in use
   double sum_w = 0.0, sum_w2 = 0.0;
@@ -166,33 +169,9 @@ struct NormalEquations {
     ++points;
     return true;
   }
-  // Row I of `a` (j >= I) and of `b` from the kept rows.
-  template <int I>
-  void AccumulateRow() {
-    constexpr int kColumns = kMaxCoefficients - I;
-    double sum[kColumns] = {}, rhs[3] = {};
-    for (size_t p = 0; p < rows_used; p += kRowSize) {
-      const double* row = rows->data() + p;
-      const double wb = row[kWeight] * row[kBasis + I];
-      for (int j = 0; j < kColumns; ++j) sum[j] += wb * row[kBasis + I + j];
-      for (int c = 0; c < 3; ++c) rhs[c] += wb * row[kMean + c];
-    }
-    for (int j = 0; j < kColumns; ++j) a[I][I + j] = sum[j];
-    for (int c = 0; c < 3; ++c) b[I][c] = rhs[c];
-  }
-  // The normal equations (a, b) of the points the last full search found.
-  void Accumulate() {
-    AccumulateRow<0>();
-    AccumulateRow<1>();
-    AccumulateRow<2>();
-    AccumulateRow<3>();
-    AccumulateRow<4>();
-    AccumulateRow<5>();
-    AccumulateRow<6>();
-    AccumulateRow<7>();
-    AccumulateRow<8>();
-    AccumulateRow<9>();
-  }
+  // The normal equations (a, b) of the points the last full search found (reconstruct/normal_accumulation.h:
+  // each element summed over the points in the order the search found them).
+  void Accumulate() { AccumulateNormalEquations(rows->data(), rows_used / kRowSize, a, b); }
   // g' A2 g for the leading m coefficients g (A2: the normal matrix with squared weights).
   double Variance(const double* g, int m) const {
     double variance = 0.0;
