@@ -152,7 +152,9 @@ struct NormalEquations {
       high[c] = points == 0 ? point.high[c] : std::max(high[c], point.high[c]);
     }
     const double nw = n * w, nw2 = nw * w;
-    if (rows_used + kRowSize > rows->size()) rows->resize(std::max<size_t>(2 * rows->size(), 64 * kRowSize));
+    if (rows_used + kRowSize + kNormalRowPadding > rows->size()) {
+      rows->resize(std::max<size_t>(2 * rows->size(), 64 * kRowSize + kNormalRowPadding));
+    }
     double* row = rows->data() + rows_used;
     rows_used += kRowSize;
     row[kSquaredWeight] = nw2;

@@ -18,9 +18,13 @@ constexpr int kNormalCoefficients = 10;
 constexpr int kNormalSquaredWeight = 0, kNormalWeight = 1, kNormalBasis = 2;
 constexpr int kNormalMean = kNormalBasis + kNormalCoefficients;
 constexpr int kNormalRowSize = kNormalMean + 3;
+// Doubles after the last row that the kernel may read (and discard): the buffer holds
+// count * kNormalRowSize + kNormalRowPadding doubles.
+constexpr int kNormalRowPadding = 16;
 
 // a[i][j] = sum_p w_p b_pi b_pj for j >= i (the upper triangle; the rest is left as it is) and
-// b[i][c] = sum_p w_p b_pi m_pc over the `count` rows at `rows`, p in order.
+// b[i][c] = sum_p w_p b_pi m_pc over the `count` rows at `rows`, p in order. The rows are followed by
+// kNormalRowPadding readable doubles (any values).
 void AccumulateNormalEquations(const double* rows, size_t count, double a[kNormalCoefficients][kNormalCoefficients],
                                double b[kNormalCoefficients][3]);
 
