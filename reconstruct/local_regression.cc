@@ -518,6 +518,18 @@ void LocalRegression::Build(const std::vector<BrdfSample>& all_samples, const st
   impl.sample_values = std::move(values);
   impl.tree = std::make_unique<Tree>(3, impl.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(24));
   if (kept > 0) impl.tree->buildIndex();
+  // The points in the tree's leaf order (a leaf's points contiguous, so a search reads whole cache lines
+  // of neighbours, not points scattered over the array): the tree itself is unchanged, so every search
+  // visits the same points in the same order, with their indices renumbered (docs/decisions.md).
+  std::vector<Point> ordered(impl.cloud.points.size());
+  std::vector<uint32_t> renumbered(impl.cloud.points.size());
+  for (size_t k = 0; k < impl.tree->vAcc.size(); ++k) {
+    ordered[k] = impl.cloud.points[impl.tree->vAcc[k]];
+    renumbered[impl.tree->vAcc[k]] = static_cast<uint32_t>(k);
+    impl.tree->vAcc[k] = static_cast<uint32_t>(k);
+  }
+  impl.cloud.points = std::move(ordered);
+  for (uint32_t& point : impl.sample_point) point = renumbered[point];
 }
 
 LocalRegression::~LocalRegression() = default;
