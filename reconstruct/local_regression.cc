@@ -104,7 +104,7 @@ struct NormalEquations {
   float worstDist() const { return radius_squared; }
   size_t size() const { return points; }
   bool full() const { return true; }
-  bool addPoint(float distance_squared, uint32_t index) {
+  [[gnu::always_inline]] bool addPoint(float distance_squared, uint32_t index) {
     if (distance_squared >= radius_squared) return true;
     const Point& point = cloud[index];
     const float* p = point.xyz;
