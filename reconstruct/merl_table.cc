@@ -3,10 +3,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <mutex>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 #include "core/error.h"
 #include "core/file_util.h"
@@ -81,6 +84,10 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
   const double margin = options.domain.theta_d_margin_deg * M_PI / 180.0;
   const double theta_d_low = regression.theta_d_min() - margin, theta_d_high = regression.theta_d_max() + margin;
   std::mutex mutex;
+  // Each range's counts, merged in cell order after: the ranges are the same on every run and thread
+  // count (a simple partitioner halves the cells down to the grain), so the mean effective sample
+  // count is the same number every time (merged in the order ranges finished, its last bits varied).
+  std::map<size_t, std::pair<ReliabilityCounts, DomainCounts>> range_counts;
   ProgressBar progress("tabulate", cells.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 512), [&](const tbb::blocked_range<size_t>& range) {
     ReliabilityCounts reliability;
@@ -127,9 +134,12 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
     }
     progress.Add(range.size());
     std::lock_guard<std::mutex> lock(mutex);
-    local.reliability.Merge(reliability);
-    local.domain.Merge(counts);
-  });
+    range_counts[range.begin()] = {reliability, counts};
+  }, tbb::simple_partitioner());
+  for (const auto& [begin, counts] : range_counts) {
+    local.reliability.Merge(counts.first);
+    local.domain.Merge(counts.second);
+  }
   progress.Finish();
   local.evaluations = local.reliability.evaluations;
   local.seconds = timer.ElapsedSeconds();
