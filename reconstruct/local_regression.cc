@@ -328,6 +328,58 @@ Eigen::Vector3d RegressionCoordinates(const Eigen::Vector3d& wi, const Eigen::Ve
 
 namespace {
 
+// 0, 1, ..., n - 1.
+std::vector<uint32_t> Identity(size_t n) {
+  std::vector<uint32_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(i);
+  return order;
+}
+
+// Bits to hold 0..value.
+int BitWidth(uint64_t value) {
+  int bits = 0;
+  while (value >> bits) ++bits;
+  return bits;
+}
+
+// The sample indices sorted by (cell, index), lexicographically. Where the cells' ranges and the index
+// fit in 64 bits (always, for real sessions), each sample is one integer key, offsets of its cell from
+// the cells' minimum then its index, whose order is that of (cell, index) exactly; else the pairs.
+std::vector<uint32_t> SortedByCell(const std::vector<std::array<int32_t, 3>>& cell_of) {
+  const size_t n = cell_of.size();
+  if (n == 0) return {};
+  std::array<int32_t, 3> low = cell_of[0], high = cell_of[0];
+  for (const std::array<int32_t, 3>& cell : cell_of) {
+    for (int k = 0; k < 3; ++k) {
+      low[k] = std::min(low[k], cell[k]);
+      high[k] = std::max(high[k], cell[k]);
+    }
+  }
+  int bits[3], index_bits = BitWidth(n - 1);
+  for (int k = 0; k < 3; ++k) bits[k] = BitWidth(uint64_t(int64_t(high[k]) - low[k]));
+  std::vector<uint32_t> order(n);
+  if (bits[0] + bits[1] + bits[2] + index_bits <= 64) {
+    std::vector<uint64_t> keys(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        uint64_t key = 0;
+        for (int k = 0; k < 3; ++k) key = (key << bits[k]) | uint64_t(int64_t(cell_of[i][k]) - low[k]);
+        keys[i] = (key << index_bits) | i;
+      }
+    });
+    tbb::parallel_sort(keys.begin(), keys.end());
+    const uint64_t mask = index_bits == 0 ? 0 : ~uint64_t(0) >> (64 - index_bits);
+    for (size_t r = 0; r < n; ++r) order[r] = static_cast<uint32_t>(keys[r] & mask);
+    return order;
+  }
+  using Keyed = std::pair<std::array<int32_t, 3>, uint32_t>;
+  std::vector<Keyed> keyed(n);
+  for (size_t i = 0; i < n; ++i) keyed[i] = {cell_of[i], static_cast<uint32_t>(i)};
+  tbb::parallel_sort(keyed.begin(), keyed.end());
+  for (size_t r = 0; r < n; ++r) order[r] = keyed[r].second;
+  return order;
+}
+
 // The samples a channel's own regression uses: those that measured channel c, with its value in all
 // three channels (so the regression's three channels are one).
 std::vector<BrdfSample> ChannelSamples(const std::vector<BrdfSample>& samples, int c,
@@ -457,11 +509,10 @@ void LocalRegression::Build(const std::vector<BrdfSample>& all_samples, const st
   xyz.shrink_to_fit();
   values.shrink_to_fit();
 
-  // Bins: sort the samples by cell key, then one point per run of equal keys.
+  // Bins: the samples in order of their cell (three int32 indices; unique per sample without binning) and
+  // then of their index, one point per run of equal cells.
   const bool binning = options.bin_fraction_h > 0.0 && options.bin_fraction_d > 0.0;
-  // Key: the cell (three int32 indices; unique per sample without binning) and the sample index.
-  using Keyed = std::pair<std::array<int32_t, 3>, uint32_t>;
-  std::vector<Keyed> keyed(kept);
+  std::vector<std::array<int32_t, 3>> cell_of(kept);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, kept, 4096), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       std::array<int32_t, 3> cell = {static_cast<int32_t>(i), 0, 0};
@@ -471,40 +522,46 @@ void LocalRegression::Build(const std::vector<BrdfSample>& all_samples, const st
           cell[k] = static_cast<int32_t>(std::clamp(std::floor(xyz[3 * i + k] / edge), -2.0e9, 2.0e9));
         }
       }
-      keyed[i] = {cell, static_cast<uint32_t>(i)};
+      cell_of[i] = cell;
     }
   });
-  if (binning) tbb::parallel_sort(keyed.begin(), keyed.end());
-  impl.sample_point.resize(kept);
-  for (size_t begin = 0; begin < kept;) {
-    size_t end = begin + 1;
-    while (end < kept && keyed[end].first == keyed[begin].first) ++end;
-    const uint32_t point = static_cast<uint32_t>(impl.cloud.points.size());
-    double centroid[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
-    float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};
-    for (size_t r = begin; r < end; ++r) {
-      const uint32_t i = keyed[r].second;
-      impl.sample_point[i] = point;
-      for (int k = 0; k < 3; ++k) {
-        centroid[k] += xyz[3 * i + k];
-        const float f = values[3 * i + k];
-        mean[k] += f;
-        low[k] = r == begin ? f : std::min(low[k], f);
-        high[k] = r == begin ? f : std::max(high[k], f);
-      }
-    }
-    const double count = double(end - begin);
-    Point& p = impl.cloud.points.emplace_back();
-    for (int k = 0; k < 3; ++k) {
-      p.xyz[k] = static_cast<float>(centroid[k] / count);
-      p.value[k] = static_cast<float>(mean[k] / count);
-      p.low[k] = low[k];
-      p.high[k] = high[k];
-    }
-    p.count = static_cast<uint32_t>(end - begin);
-    begin = end;
+  const std::vector<uint32_t> order = binning ? SortedByCell(cell_of) : Identity(kept);
+  // Where each run of equal cells begins (in `order`), then each run's point, TBB-parallel: a run's sums
+  // run over its samples in order, as the one-thread loop did.
+  std::vector<size_t> runs;
+  for (size_t r = 0; r < kept; ++r) {
+    if (r == 0 || cell_of[order[r]] != cell_of[order[r - 1]]) runs.push_back(r);
   }
-  impl.cloud.points.shrink_to_fit();
+  runs.push_back(kept);
+  impl.sample_point.resize(kept);
+  impl.cloud.points.resize(runs.size() - 1);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, runs.size() - 1, 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t point = range.begin(); point != range.end(); ++point) {
+      const size_t begin = runs[point], end = runs[point + 1];
+      double centroid[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
+      float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};
+      for (size_t r = begin; r < end; ++r) {
+        const uint32_t i = order[r];
+        impl.sample_point[i] = static_cast<uint32_t>(point);
+        for (int k = 0; k < 3; ++k) {
+          centroid[k] += xyz[3 * i + k];
+          const float f = values[3 * i + k];
+          mean[k] += f;
+          low[k] = r == begin ? f : std::min(low[k], f);
+          high[k] = r == begin ? f : std::max(high[k], f);
+        }
+      }
+      const double count = double(end - begin);
+      Point& p = impl.cloud.points[point];
+      for (int k = 0; k < 3; ++k) {
+        p.xyz[k] = static_cast<float>(centroid[k] / count);
+        p.value[k] = static_cast<float>(mean[k] / count);
+        p.low[k] = low[k];
+        p.high[k] = high[k];
+      }
+      p.count = static_cast<uint32_t>(end - begin);
+    }
+  });
   if (kept > 0) {
     float low = xyz[2], high = xyz[2];
     for (size_t i = 1; i < kept; ++i) {

@@ -67,9 +67,8 @@ template <int I>
 }
 
 template <int I>
-[[gnu::target("avx512f"), gnu::always_inline]] inline void StoreRow512(const Vector8 (&sum)[2],
-                                                                       double a[kNormalCoefficients][kNormalCoefficients],
-                                                                       double b[kNormalCoefficients][3]) {
+[[gnu::target("avx512f"), gnu::always_inline]] inline void StoreRow512(
+    const Vector8 (&sum)[2], double a[kNormalCoefficients][kNormalCoefficients], double b[kNormalCoefficients][3]) {
   double lanes[16];
   __builtin_memcpy(lanes, &sum[0], sizeof(Vector8));
   if constexpr (kVectors<I> == 2) __builtin_memcpy(lanes + 8, &sum[1], sizeof(Vector8));
@@ -78,9 +77,9 @@ template <int I>
 }
 
 template <int... I>
-[[gnu::target("avx512f"), gnu::always_inline]] inline void Accumulate512(const double* rows, size_t count,
-                                                                         double a[kNormalCoefficients][kNormalCoefficients],
-                                                                         double b[kNormalCoefficients][3]) {
+[[gnu::target("avx512f"), gnu::always_inline]] inline void Accumulate512(
+    const double* rows, size_t count, double a[kNormalCoefficients][kNormalCoefficients],
+    double b[kNormalCoefficients][3]) {
   Vector8 sums[sizeof...(I)][2] = {};
   for (size_t p = 0; p < count; ++p) {
     const double* row = rows + p * kNormalRowSize;

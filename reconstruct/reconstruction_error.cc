@@ -150,14 +150,14 @@ std::vector<ReconstructionError> CompareTableWithTruth(const MerlTable& table, c
   // flat index order, as one comparison alone would: the same bits as evaluating every cell's truth
   // into a table of cell records first, without that table's 200 MB (docs/decisions.md).
   struct Scored {
-    Eigen::Vector3d rel;   // (f - f_true) / f_true; unset where the truth is not positive
-    uint8_t domains = 0;   // bit d: comparison d scores the cell
-    int8_t band = -1;      // theta_h band; -1: the truth is not positive (the cell is not counted)
+    Eigen::Vector3d rel;  // (f - f_true) / f_true; unset where the truth is not positive
+    uint8_t domains = 0;  // bit d: comparison d scores the cell
+    int8_t band = -1;     // theta_h band; -1: the truth is not positive (the cell is not counted)
   };
   struct Row {
     std::vector<Scored> cells;
-    size_t within = 0;                   // cells within the theta limit
-    std::array<size_t, 8> scored = {};   // per comparison: cells it scores
+    size_t within = 0;                  // cells within the theta limit
+    std::array<size_t, 8> scored = {};  // per comparison: cells it scores
   };
   const double cos_limit = std::cos(max_theta_deg * M_PI / 180.0);
   std::vector<Row> rows(kMerlThetaH);
