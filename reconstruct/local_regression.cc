@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "reconstruct/normal_accumulation.h"
 
 namespace ibrdf {
 namespace {
@@ -87,8 +88,10 @@ struct NormalEquations {
   double b[kMaxCoefficients][3] = {};                 // by Accumulate()
   // Per point with non-zero weight: count * w^2, count * w, its basis row and its mean value (kRowSize
   // doubles a point).
-  static constexpr int kSquaredWeight = 0, kWeight = 1, kBasis = 2, kMean = kBasis + kMaxCoefficients;
-  static constexpr int kRowSize = kMean + 3;
+  static constexpr int kSquaredWeight = kNormalSquaredWeight, kWeight = kNormalWeight, kBasis = kNormalBasis,
+                       kMean = kNormalMean;
+  static constexpr int kRowSize = kNormalRowSize;
+  static_assert(kMaxCoefficients == kNormalCoefficients);
   std::vector<double>* rows = nullptr;
   size_t rows_used = 0;  // doubles of `rows` in use
   double sum_w = 0.0, sum_w2 = 0.0;
@@ -101,7 +104,7 @@ struct NormalEquations {
   float worstDist() const { return radius_squared; }
   size_t size() const { return points; }
   bool full() const { return true; }
-  bool addPoint(float distance_squared, uint32_t index) {
+  [[gnu::always_inline]] bool addPoint(float distance_squared, uint32_t index) {
     if (distance_squared >= radius_squared) return true;
     const Point& point = cloud[index];
     const float* p = point.xyz;
@@ -149,7 +152,9 @@ struct NormalEquations {
       high[c] = points == 0 ? point.high[c] : std::max(high[c], point.high[c]);
     }
     const double nw = n * w, nw2 = nw * w;
-    if (rows_used + kRowSize > rows->size()) rows->resize(std::max<size_t>(2 * rows->size(), 64 * kRowSize));
+    if (rows_used + kRowSize + kNormalRowPadding > rows->size()) {
+      rows->resize(std::max<size_t>(2 * rows->size(), 64 * kRowSize + kNormalRowPadding));
+    }
     double* row = rows->data() + rows_used;
     rows_used += kRowSize;
     row[kSquaredWeight] = nw2;
@@ -166,33 +171,9 @@ struct NormalEquations {
     ++points;
     return true;
   }
-  // Row I of `a` (j >= I) and of `b` from the kept rows.
-  template <int I>
-  void AccumulateRow() {
-    constexpr int kColumns = kMaxCoefficients - I;
-    double sum[kColumns] = {}, rhs[3] = {};
-    for (size_t p = 0; p < rows_used; p += kRowSize) {
-      const double* row = rows->data() + p;
-      const double wb = row[kWeight] * row[kBasis + I];
-      for (int j = 0; j < kColumns; ++j) sum[j] += wb * row[kBasis + I + j];
-      for (int c = 0; c < 3; ++c) rhs[c] += wb * row[kMean + c];
-    }
-    for (int j = 0; j < kColumns; ++j) a[I][I + j] = sum[j];
-    for (int c = 0; c < 3; ++c) b[I][c] = rhs[c];
-  }
-  // The normal equations (a, b) of the points the last full search found.
-  void Accumulate() {
-    AccumulateRow<0>();
-    AccumulateRow<1>();
-    AccumulateRow<2>();
-    AccumulateRow<3>();
-    AccumulateRow<4>();
-    AccumulateRow<5>();
-    AccumulateRow<6>();
-    AccumulateRow<7>();
-    AccumulateRow<8>();
-    AccumulateRow<9>();
-  }
+  // The normal equations (a, b) of the points the last full search found (reconstruct/normal_accumulation.h:
+  // each element summed over the points in the order the search found them).
+  void Accumulate() { AccumulateNormalEquations(rows->data(), rows_used / kRowSize, a, b); }
   // g' A2 g for the leading m coefficients g (A2: the normal matrix with squared weights).
   double Variance(const double* g, int m) const {
     double variance = 0.0;
@@ -347,6 +328,58 @@ Eigen::Vector3d RegressionCoordinates(const Eigen::Vector3d& wi, const Eigen::Ve
 
 namespace {
 
+// 0, 1, ..., n - 1.
+std::vector<uint32_t> Identity(size_t n) {
+  std::vector<uint32_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(i);
+  return order;
+}
+
+// Bits to hold 0..value.
+int BitWidth(uint64_t value) {
+  int bits = 0;
+  while (value >> bits) ++bits;
+  return bits;
+}
+
+// The sample indices sorted by (cell, index), lexicographically. Where the cells' ranges and the index
+// fit in 64 bits (always, for real sessions), each sample is one integer key, offsets of its cell from
+// the cells' minimum then its index, whose order is that of (cell, index) exactly; else the pairs.
+std::vector<uint32_t> SortedByCell(const std::vector<std::array<int32_t, 3>>& cell_of) {
+  const size_t n = cell_of.size();
+  if (n == 0) return {};
+  std::array<int32_t, 3> low = cell_of[0], high = cell_of[0];
+  for (const std::array<int32_t, 3>& cell : cell_of) {
+    for (int k = 0; k < 3; ++k) {
+      low[k] = std::min(low[k], cell[k]);
+      high[k] = std::max(high[k], cell[k]);
+    }
+  }
+  int bits[3], index_bits = BitWidth(n - 1);
+  for (int k = 0; k < 3; ++k) bits[k] = BitWidth(uint64_t(int64_t(high[k]) - low[k]));
+  std::vector<uint32_t> order(n);
+  if (bits[0] + bits[1] + bits[2] + index_bits <= 64) {
+    std::vector<uint64_t> keys(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        uint64_t key = 0;
+        for (int k = 0; k < 3; ++k) key = (key << bits[k]) | uint64_t(int64_t(cell_of[i][k]) - low[k]);
+        keys[i] = (key << index_bits) | i;
+      }
+    });
+    tbb::parallel_sort(keys.begin(), keys.end());
+    const uint64_t mask = index_bits == 0 ? 0 : ~uint64_t(0) >> (64 - index_bits);
+    for (size_t r = 0; r < n; ++r) order[r] = static_cast<uint32_t>(keys[r] & mask);
+    return order;
+  }
+  using Keyed = std::pair<std::array<int32_t, 3>, uint32_t>;
+  std::vector<Keyed> keyed(n);
+  for (size_t i = 0; i < n; ++i) keyed[i] = {cell_of[i], static_cast<uint32_t>(i)};
+  tbb::parallel_sort(keyed.begin(), keyed.end());
+  for (size_t r = 0; r < n; ++r) order[r] = keyed[r].second;
+  return order;
+}
+
 // The samples a channel's own regression uses: those that measured channel c, with its value in all
 // three channels (so the regression's three channels are one).
 std::vector<BrdfSample> ChannelSamples(const std::vector<BrdfSample>& samples, int c,
@@ -476,11 +509,10 @@ void LocalRegression::Build(const std::vector<BrdfSample>& all_samples, const st
   xyz.shrink_to_fit();
   values.shrink_to_fit();
 
-  // Bins: sort the samples by cell key, then one point per run of equal keys.
+  // Bins: the samples in order of their cell (three int32 indices; unique per sample without binning) and
+  // then of their index, one point per run of equal cells.
   const bool binning = options.bin_fraction_h > 0.0 && options.bin_fraction_d > 0.0;
-  // Key: the cell (three int32 indices; unique per sample without binning) and the sample index.
-  using Keyed = std::pair<std::array<int32_t, 3>, uint32_t>;
-  std::vector<Keyed> keyed(kept);
+  std::vector<std::array<int32_t, 3>> cell_of(kept);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, kept, 4096), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       std::array<int32_t, 3> cell = {static_cast<int32_t>(i), 0, 0};
@@ -490,40 +522,46 @@ void LocalRegression::Build(const std::vector<BrdfSample>& all_samples, const st
           cell[k] = static_cast<int32_t>(std::clamp(std::floor(xyz[3 * i + k] / edge), -2.0e9, 2.0e9));
         }
       }
-      keyed[i] = {cell, static_cast<uint32_t>(i)};
+      cell_of[i] = cell;
     }
   });
-  if (binning) tbb::parallel_sort(keyed.begin(), keyed.end());
-  impl.sample_point.resize(kept);
-  for (size_t begin = 0; begin < kept;) {
-    size_t end = begin + 1;
-    while (end < kept && keyed[end].first == keyed[begin].first) ++end;
-    const uint32_t point = static_cast<uint32_t>(impl.cloud.points.size());
-    double centroid[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
-    float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};
-    for (size_t r = begin; r < end; ++r) {
-      const uint32_t i = keyed[r].second;
-      impl.sample_point[i] = point;
-      for (int k = 0; k < 3; ++k) {
-        centroid[k] += xyz[3 * i + k];
-        const float f = values[3 * i + k];
-        mean[k] += f;
-        low[k] = r == begin ? f : std::min(low[k], f);
-        high[k] = r == begin ? f : std::max(high[k], f);
-      }
-    }
-    const double count = double(end - begin);
-    Point& p = impl.cloud.points.emplace_back();
-    for (int k = 0; k < 3; ++k) {
-      p.xyz[k] = static_cast<float>(centroid[k] / count);
-      p.value[k] = static_cast<float>(mean[k] / count);
-      p.low[k] = low[k];
-      p.high[k] = high[k];
-    }
-    p.count = static_cast<uint32_t>(end - begin);
-    begin = end;
+  const std::vector<uint32_t> order = binning ? SortedByCell(cell_of) : Identity(kept);
+  // Where each run of equal cells begins (in `order`), then each run's point, TBB-parallel: a run's sums
+  // run over its samples in order, as the one-thread loop did.
+  std::vector<size_t> runs;
+  for (size_t r = 0; r < kept; ++r) {
+    if (r == 0 || cell_of[order[r]] != cell_of[order[r - 1]]) runs.push_back(r);
   }
-  impl.cloud.points.shrink_to_fit();
+  runs.push_back(kept);
+  impl.sample_point.resize(kept);
+  impl.cloud.points.resize(runs.size() - 1);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, runs.size() - 1, 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t point = range.begin(); point != range.end(); ++point) {
+      const size_t begin = runs[point], end = runs[point + 1];
+      double centroid[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
+      float low[3] = {0, 0, 0}, high[3] = {0, 0, 0};
+      for (size_t r = begin; r < end; ++r) {
+        const uint32_t i = order[r];
+        impl.sample_point[i] = static_cast<uint32_t>(point);
+        for (int k = 0; k < 3; ++k) {
+          centroid[k] += xyz[3 * i + k];
+          const float f = values[3 * i + k];
+          mean[k] += f;
+          low[k] = r == begin ? f : std::min(low[k], f);
+          high[k] = r == begin ? f : std::max(high[k], f);
+        }
+      }
+      const double count = double(end - begin);
+      Point& p = impl.cloud.points[point];
+      for (int k = 0; k < 3; ++k) {
+        p.xyz[k] = static_cast<float>(centroid[k] / count);
+        p.value[k] = static_cast<float>(mean[k] / count);
+        p.low[k] = low[k];
+        p.high[k] = high[k];
+      }
+      p.count = static_cast<uint32_t>(end - begin);
+    }
+  });
   if (kept > 0) {
     float low = xyz[2], high = xyz[2];
     for (size_t i = 1; i < kept; ++i) {
@@ -537,6 +575,18 @@ void LocalRegression::Build(const std::vector<BrdfSample>& all_samples, const st
   impl.sample_values = std::move(values);
   impl.tree = std::make_unique<Tree>(3, impl.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(24));
   if (kept > 0) impl.tree->buildIndex();
+  // The points in the tree's leaf order (a leaf's points contiguous, so a search reads whole cache lines
+  // of neighbours, not points scattered over the array): the tree itself is unchanged, so every search
+  // visits the same points in the same order, with their indices renumbered (docs/decisions.md).
+  std::vector<Point> ordered(impl.cloud.points.size());
+  std::vector<uint32_t> renumbered(impl.cloud.points.size());
+  for (size_t k = 0; k < impl.tree->vAcc.size(); ++k) {
+    ordered[k] = impl.cloud.points[impl.tree->vAcc[k]];
+    renumbered[impl.tree->vAcc[k]] = static_cast<uint32_t>(k);
+    impl.tree->vAcc[k] = static_cast<uint32_t>(k);
+  }
+  impl.cloud.points = std::move(ordered);
+  for (uint32_t& point : impl.sample_point) point = renumbered[point];
 }
 
 LocalRegression::~LocalRegression() = default;

@@ -3,10 +3,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <mutex>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 #include "core/error.h"
 #include "core/file_util.h"
@@ -81,55 +84,65 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
   const double margin = options.domain.theta_d_margin_deg * M_PI / 180.0;
   const double theta_d_low = regression.theta_d_min() - margin, theta_d_high = regression.theta_d_max() + margin;
   std::mutex mutex;
+  // Each range's counts, merged in cell order after: the ranges are the same on every run and thread
+  // count (a simple partitioner halves the cells down to the grain), so the mean effective sample
+  // count is the same number every time (merged in the order ranges finished, its last bits varied).
+  std::map<size_t, std::pair<ReliabilityCounts, DomainCounts>> range_counts;
   ProgressBar progress("tabulate", cells.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 512), [&](const tbb::blocked_range<size_t>& range) {
-    ReliabilityCounts reliability;
-    DomainCounts counts;
-    for (size_t p = range.begin(); p != range.end(); ++p) {
-      const size_t flat = cells[p];
-      const int k = static_cast<int>(flat % kMerlPhiD);
-      const int j = static_cast<int>((flat / kMerlPhiD) % kMerlThetaD);
-      const int i = static_cast<int>(flat / (size_t(kMerlPhiD) * kMerlThetaD));
-      const HalfDiffAngles angles = MerlCellCentre(i, j, k);
-      // Beyond the samples' theta_d range a cell is unmeasured whatever its estimate: evaluated only
-      // when --fill extrapolate wants the estimate.
-      const bool beyond = angles.theta_d < theta_d_low || angles.theta_d > theta_d_high;
-      const Estimate e = beyond && options.fill != FillMode::kExtrapolate
-                             ? Estimate()
-                             : regression.EvaluateAt(RegressionCoordinates(angles));
-      if (!beyond || options.fill == FillMode::kExtrapolate) reliability.Add(e);
-      DomainClass c = ClassifyEstimate(e, angles.theta_d, regression, options.domain);
-      if (e.effective_samples < options.min_effective_samples) c = DomainClass::kUnmeasured;
-      Eigen::Vector3d value = e.value;
-      bool has_value = c != DomainClass::kUnmeasured;
-      if (!has_value && options.fill == FillMode::kExtrapolate && e.status != EstimateStatus::kUnsupported) {
-        has_value = true;
-      } else if (!has_value && options.fill == FillMode::kModel) {
-        Eigen::Vector3d wi, wo;
-        FromHalfDiff(angles, &wi, &wo);
-        value = fill_model->Eval(wi, wo);
-        has_value = value.allFinite();
-      }
-      // The mirrored cell is inside the horizon whenever this one is (bilateral symmetry of the geometry).
-      const int targets = mirror ? 2 : 1;
-      for (int t = 0; t < targets; ++t) {
-        const size_t target = t == 0 ? flat : flat - k + (kMerlPhiD - 1 - k);
-        counts.Add(c);
-        if (c == DomainClass::kUnmeasured && has_value) ++counts.filled;
-        if (has_value) {
-          table.SetCell(target, value);
-        } else {
-          table.SetUnmeasured(target);
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, cells.size(), 512),
+      [&](const tbb::blocked_range<size_t>& range) {
+        ReliabilityCounts reliability;
+        DomainCounts counts;
+        for (size_t p = range.begin(); p != range.end(); ++p) {
+          const size_t flat = cells[p];
+          const int k = static_cast<int>(flat % kMerlPhiD);
+          const int j = static_cast<int>((flat / kMerlPhiD) % kMerlThetaD);
+          const int i = static_cast<int>(flat / (size_t(kMerlPhiD) * kMerlThetaD));
+          const HalfDiffAngles angles = MerlCellCentre(i, j, k);
+          // Beyond the samples' theta_d range a cell is unmeasured whatever its estimate: evaluated only
+          // when --fill extrapolate wants the estimate.
+          const bool beyond = angles.theta_d < theta_d_low || angles.theta_d > theta_d_high;
+          const Estimate e = beyond && options.fill != FillMode::kExtrapolate
+                                 ? Estimate()
+                                 : regression.EvaluateAt(RegressionCoordinates(angles));
+          if (!beyond || options.fill == FillMode::kExtrapolate) reliability.Add(e);
+          DomainClass c = ClassifyEstimate(e, angles.theta_d, regression, options.domain);
+          if (e.effective_samples < options.min_effective_samples) c = DomainClass::kUnmeasured;
+          Eigen::Vector3d value = e.value;
+          bool has_value = c != DomainClass::kUnmeasured;
+          if (!has_value && options.fill == FillMode::kExtrapolate && e.status != EstimateStatus::kUnsupported) {
+            has_value = true;
+          } else if (!has_value && options.fill == FillMode::kModel) {
+            Eigen::Vector3d wi, wo;
+            FromHalfDiff(angles, &wi, &wo);
+            value = fill_model->Eval(wi, wo);
+            has_value = value.allFinite();
+          }
+          // The mirrored cell is inside the horizon whenever this one is (bilateral symmetry of the geometry).
+          const int targets = mirror ? 2 : 1;
+          for (int t = 0; t < targets; ++t) {
+            const size_t target = t == 0 ? flat : flat - k + (kMerlPhiD - 1 - k);
+            counts.Add(c);
+            if (c == DomainClass::kUnmeasured && has_value) ++counts.filled;
+            if (has_value) {
+              table.SetCell(target, value);
+            } else {
+              table.SetUnmeasured(target);
+            }
+            if (domain) (*domain)[target] = static_cast<uint8_t>(c);
+            if (effective_samples && c != DomainClass::kUnmeasured) (*effective_samples)[target] = e.effective_samples;
+          }
         }
-        if (domain) (*domain)[target] = static_cast<uint8_t>(c);
-        if (effective_samples && c != DomainClass::kUnmeasured) (*effective_samples)[target] = e.effective_samples;
-      }
-    }
-    progress.Add(range.size());
-    std::lock_guard<std::mutex> lock(mutex);
-    local.reliability.Merge(reliability);
-    local.domain.Merge(counts);
-  });
+        progress.Add(range.size());
+        std::lock_guard<std::mutex> lock(mutex);
+        range_counts[range.begin()] = {reliability, counts};
+      },
+      tbb::simple_partitioner());
+  for (const auto& [begin, counts] : range_counts) {
+    local.reliability.Merge(counts.first);
+    local.domain.Merge(counts.second);
+  }
   progress.Finish();
   local.evaluations = local.reliability.evaluations;
   local.seconds = timer.ElapsedSeconds();

@@ -1,6 +1,7 @@
 #include "reconstruct/reconstruction_error.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -64,15 +65,25 @@ class Accumulator {
   }
   void Add(const Eigen::Vector3d& f, const Eigen::Vector3d& truth, double theta_h) {
     if (!(truth.array() > 0.0).all()) return;
-    const Eigen::Vector3d rel = (f - truth).cwiseQuotient(truth);
-    const int band = std::clamp(static_cast<int>(theta_h * 180.0 / M_PI / kThetaHBandDeg), 0, kThetaHBands - 1);
+    AddRelative((f - truth).cwiseQuotient(truth), Band(theta_h));
+  }
+  // The theta_h band of a cell.
+  static int Band(double theta_h) {
+    return std::clamp(static_cast<int>(theta_h * 180.0 / M_PI / kThetaHBandDeg), 0, kThetaHBands - 1);
+  }
+  // Add() with the relative error (f - truth) / truth and the band already computed.
+  void AddRelative(const Eigen::Vector3d& rel, int band) {
     ++error_.theta_h_bands[band].points;
     error_.theta_h_bands[band].mean_rel += rel;
     sum_ += rel.cwiseAbs2();
     for (int c = 0; c < 3; ++c) abs_[c].push_back(std::abs(rel[c]));
     ++error_.points;
   }
-  void Outside() { ++error_.outside; }
+  void Outside(size_t cells = 1) { error_.outside += cells; }
+  // Room for `points` Add() calls (no reallocation while adding).
+  void Reserve(size_t points) {
+    for (std::vector<double>& values : abs_) values.reserve(points);
+  }
   ReconstructionError Finish() {
     if (error_.points > 0) {
       error_.rel_rms = (sum_ / double(error_.points)).cwiseSqrt();
@@ -132,30 +143,65 @@ std::vector<ReconstructionError> CompareTableWithTruth(const MerlTable& table, c
                                                        double max_theta_deg,
                                                        const std::vector<const std::vector<uint8_t>*>& domains) {
   for (const std::vector<uint8_t>* domain : domains) IBRDF_CHECK(!domain || domain->size() == kMerlCells);
-  const std::vector<Cell> cells = Cells(max_theta_deg, 1);
-  // The truth where some comparison scores the cell; the sums below run in cell order, as one
-  // comparison alone would.
-  auto scored = [&](const Cell& cell, const std::vector<uint8_t>* domain) {
-    return table.Measured(cell.flat) && (!domain || (*domain)[cell.flat]);
+  IBRDF_CHECK(domains.size() <= 8);
+  // Per theta_h row (TBB-parallel): the cells within the theta limit, and for each one some comparison
+  // scores, its relative error against the truth (the truth evaluated once for all comparisons), its
+  // theta_h band and which comparisons score it. The sums below then run over the rows and cells in
+  // flat index order, as one comparison alone would: the same bits as evaluating every cell's truth
+  // into a table of cell records first, without that table's 200 MB (docs/decisions.md).
+  struct Scored {
+    Eigen::Vector3d rel;  // (f - f_true) / f_true; unset where the truth is not positive
+    uint8_t domains = 0;  // bit d: comparison d scores the cell
+    int8_t band = -1;     // theta_h band; -1: the truth is not positive (the cell is not counted)
   };
-  std::vector<Eigen::Vector3d> truth_values(cells.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t n = range.begin(); n != range.end(); ++n) {
-      const Cell& cell = cells[n];
-      bool needed = false;
-      for (const std::vector<uint8_t>* domain : domains) needed = needed || scored(cell, domain);
-      if (needed) truth_values[n] = truth.Eval(cell.wi, cell.wo);
+  struct Row {
+    std::vector<Scored> cells;
+    size_t within = 0;                  // cells within the theta limit
+    std::array<size_t, 8> scored = {};  // per comparison: cells it scores
+  };
+  const double cos_limit = std::cos(max_theta_deg * M_PI / 180.0);
+  std::vector<Row> rows(kMerlThetaH);
+  tbb::parallel_for(0, kMerlThetaH, [&](int i) {
+    Row& row = rows[i];
+    row.cells.reserve(size_t(kMerlThetaD) * kMerlPhiD);  // address space only: pages are touched as written
+    for (int j = 0; j < kMerlThetaD; ++j) {
+      for (int k = 0; k < kMerlPhiD; ++k) {
+        const HalfDiffAngles angles = MerlCellCentre(i, j, k);
+        Eigen::Vector3d wi, wo;
+        FromHalfDiff(angles, &wi, &wo);
+        if (!(wi.z() >= cos_limit && wo.z() >= cos_limit)) continue;
+        ++row.within;
+        const size_t flat = MerlFlatIndex(i, j, k);
+        if (!table.Measured(flat)) continue;
+        Scored cell;
+        for (size_t d = 0; d < domains.size(); ++d) {
+          if (!domains[d] || (*domains[d])[flat]) {
+            cell.domains |= uint8_t(1u << d);
+            ++row.scored[d];
+          }
+        }
+        if (cell.domains == 0) continue;
+        const Eigen::Vector3d truth_value = truth.Eval(wi, wo);
+        if ((truth_value.array() > 0.0).all()) {
+          cell.rel = (table.Cell(flat) - truth_value).cwiseQuotient(truth_value);
+          cell.band = static_cast<int8_t>(Accumulator::Band(angles.theta_h));
+        }
+        row.cells.push_back(cell);
+      }
     }
   });
   std::vector<ReconstructionError> errors(domains.size());
   tbb::parallel_for(size_t(0), domains.size(), [&](size_t d) {
     Accumulator accumulator;
-    for (size_t n = 0; n < cells.size(); ++n) {
-      if (!scored(cells[n], domains[d])) {
-        accumulator.Outside();
-        continue;
+    size_t scored = 0;
+    for (const Row& row : rows) scored += row.scored[d];
+    accumulator.Reserve(scored);
+    const uint8_t bit = uint8_t(1u << d);
+    for (const Row& row : rows) {
+      accumulator.Outside(row.within - row.scored[d]);
+      for (const Scored& cell : row.cells) {
+        if ((cell.domains & bit) && cell.band >= 0) accumulator.AddRelative(cell.rel, cell.band);
       }
-      accumulator.Add(table.Cell(cells[n].flat), truth_values[n], cells[n].angles.theta_h);
     }
     errors[d] = accumulator.Finish();
   });
