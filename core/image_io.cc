@@ -207,6 +207,8 @@ std::pair<uint32_t, uint32_t> Rational(double value) {
   return {static_cast<uint32_t>(h1), static_cast<uint32_t>(k1)};
 }
 
+}  // namespace
+
 // A little-endian TIFF structure holding the EXIF fields of `metadata` (IFD0: Make, Model, DateTime and
 // the Exif IFD pointer; the Exif IFD: exposure, f-number, ISO, original time, focal length and the focal
 // plane resolution). OpenImageIO 2.4's own encoder turns some exposure times into infinity (0.5 s) and
@@ -279,6 +281,8 @@ std::string EncodeExif(const PhotoMetadata& m) {
   write_ifd(exif, exif_offset, &tiff);
   return tiff;
 }
+
+namespace {
 
 // OpenImageIO 2.4 writes no EXIF into PNG files but reads the eXIf chunk (PNG 1.5): insert one, with
 // EncodeExif's block, after the IHDR chunk of the PNG file `path`.

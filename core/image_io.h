@@ -95,6 +95,10 @@ void PreloadImageModule();
 void WriteImage(const std::string& path, const Image& image, PixelFormat format,
                 const PhotoMetadata* metadata = nullptr);
 
+// The EXIF block WriteImage puts into a PNG's eXIf chunk (a little-endian TIFF structure of the set
+// fields of `metadata`), for a PNG writer of its own (synth's photos).
+std::string EncodeExif(const PhotoMetadata& metadata);
+
 // True for file extensions OpenImageIO's RAW reader handles (.cr2, .nef, .arw, .dng ...).
 bool IsRawExtension(const std::string& path);
 

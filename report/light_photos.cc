@@ -16,6 +16,7 @@
 #include "core/sample_file.h"
 #include "core/session.h"
 #include "core/statistics.h"
+#include "report/report_png.h"
 #include "report/tone_map.h"
 
 namespace fs = std::filesystem;
@@ -97,10 +98,9 @@ nlohmann::json WriteLightPhotos(const std::string& samples_path, const std::map<
       char name[32];
       std::snprintf(name, sizeof(name), "lights/%03zu.png", k);
       try {
-        WriteImage(
+        WriteReportPng(
             (fs::path(tmp_dir) / name).string(),
-            Thumbnail(session, static_cast<uint32_t>(best), photos.at(static_cast<uint32_t>(best)), thumbnail_size),
-            PixelFormat::kUint8);
+            Thumbnail(session, static_cast<uint32_t>(best), photos.at(static_cast<uint32_t>(best)), thumbnail_size));
         entry["file"] = name;
       } catch (const Error& e) {
         entry["note"] = e.what();

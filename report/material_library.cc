@@ -17,6 +17,7 @@
 #include "core/radiometry.h"
 #include "core/subprocess.h"
 #include "reconstruct/merl_table.h"
+#include "report/report_png.h"
 #include "report/report_script.h"
 #include "report/sphere_render.h"
 
@@ -155,7 +156,7 @@ void WriteSphere(const MerlTable& table, const LibraryOptions& options, const st
       }
     }
   }
-  WriteImage(path, image, PixelFormat::kUint8);
+  WriteReportPng(path, image);
 }
 
 // The table along the incidence plane at `theta_i_deg`: the exitance angle signed (positive on the

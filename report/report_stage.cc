@@ -1,6 +1,7 @@
 #include "report/report_stage.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <future>
@@ -31,6 +32,7 @@
 #include "report/light_photos.h"
 #include "report/photo_comparison.h"
 #include "report/photo_statistics.h"
+#include "report/report_png.h"
 #include "report/report_script.h"
 #include "report/sphere_render.h"
 #include "report/table_interpolation.h"
@@ -173,13 +175,13 @@ nlohmann::json RenderPhoto(const Session& session, uint32_t index, const PhotoSt
                std::min(photo.height - 1, p.y1 + pad)};
   const Image crop = CropPhoto(photo, box);
   double scale = 1.0;
-  WriteImage((tmp / (prefix + ".png")).string(), ToneMap(crop, &scale), PixelFormat::kUint8);
+  WriteReportPng((tmp / (prefix + ".png")).string(), ToneMap(crop, &scale));
   nlohmann::json renders = nlohmann::json::array();
   for (const PhotoModel& model : models) {
     const PhotoRender render = model.eval ? RenderPhotoPixels(photo, box, own, model.name, model.eval)
                                           : RenderPhotoPixels(photo, box, own, model.name, model.values);
     const std::string png = prefix + "-render-" + model.name + ".png", npy = prefix + "-diff-" + model.name + ".npy";
-    WriteImage((tmp / png).string(), ToneMapWithScale(render.linear, scale), PixelFormat::kUint8);
+    WriteReportPng((tmp / png).string(), ToneMapWithScale(render.linear, scale));
     WriteNpyArray((tmp / npy).string(), render.difference.pixels,
                   {size_t(render.difference.height), size_t(render.difference.width)});
     renders.push_back({{"model", model.name},
@@ -209,6 +211,20 @@ std::optional<Session> SamplesSession(const std::string& samples_path, std::stri
     *note = sidecar.string() + ": no session named (" + e.what() + ")";
   }
   return std::nullopt;
+}
+
+// True when the samples' session has a photo other than a PNG (TIFF, EXR, RAW ...): those decode through
+// OpenImageIO (the report's own PNGs do not need it, report/report_png.h).
+bool PhotosNeedImageModule(const std::string& samples_path) {
+  std::string note;
+  const std::optional<Session> session = SamplesSession(samples_path, &note);
+  if (!session) return false;
+  for (size_t i = 0; i < session->photos.size(); ++i) {
+    std::string ext = fs::path(session->PhotoPath(i)).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext != ".png") return true;
+  }
+  return false;
 }
 
 std::vector<const BrdfSample*> PhotoSamples(const std::vector<BrdfSample>& samples, uint32_t image) {
@@ -335,7 +351,7 @@ void WriteSpheres(const RunModels& models, int size, double phase, const fs::pat
   nlohmann::json spheres = nlohmann::json::array();
   for (const NamedModel& model : models.named) {
     const std::string file = "sphere-" + model.name + ".png";
-    WriteImage((tmp / file).string(), ToneMap(RenderSphere(size, phase, model.eval), nullptr), PixelFormat::kUint8);
+    WriteReportPng((tmp / file).string(), ToneMap(RenderSphere(size, phase, model.eval), nullptr));
     spheres.push_back({{"model", model.name}, {"file", file}, {"phase_deg", phase / kDeg}});
   }
   (*data)["spheres"] = spheres;
@@ -553,8 +569,11 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   // The script starts now (matplotlib's import and the figures of the run folder alone beside the work
   // below) and draws the rest once report-data.json is written; destroyed before `directory`.
   BackgroundReportScript plotting(python, script, run_dir.string(), tmp.string());
-  // OpenImageIO's module (the PNG writer) loads beside the reading below instead of at the first image.
-  const std::future<void> image_module = std::async(std::launch::async, PreloadImageModule);
+  // OpenImageIO's module, when the session's photos need it, loads beside the reading below instead of at
+  // the first photo.
+  const std::future<void> image_module = std::async(std::launch::async, [samples_path] {
+    if (PhotosNeedImageModule(samples_path)) PreloadImageModule();
+  });
   const RunModels models = LoadRunModels(run_dir, options.reconstruction);
 
   const std::vector<BrdfSample> samples = ReadSamples(samples_path);

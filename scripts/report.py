@@ -122,11 +122,13 @@ def binned_median(x, y, width=1.0):
     if x.size == 0:
         return np.array([]), np.array([])
     keys = np.floor(x / width).astype(int)
-    # One sort and a split instead of a mask per bin (the same medians: a median ignores order).
-    order = np.argsort(keys, kind="stable")
+    # One sort by bin, then by value within it, and each bin's middle value (odd count) or the mean of its
+    # two middle values (even count), as np.median gives them, without a median call per bin.
+    order = np.lexsort((y, keys))
     keys, y = keys[order], y[order]
-    unique, starts = np.unique(keys, return_index=True)
-    values = np.array([np.median(part) for part in np.split(y, starts[1:])])
+    unique, starts, counts = np.unique(keys, return_index=True, return_counts=True)
+    low, high = y[starts + (counts - 1) // 2], y[starts + counts // 2]
+    values = np.where(counts % 2 == 1, low, (low + high) / 2)
     return (unique + 0.5) * width, values
 
 

@@ -24,6 +24,7 @@
 #include "core/statistics.h"
 #include "derender/analytic_sample.h"
 #include "scan/ply_io.h"
+#include "synth/photo_png.h"
 #include "synth/pixel_rays.h"
 #include "synth/synthetic_colour_chart.h"
 #include "synth/synthetic_exif.h"
@@ -821,7 +822,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
     const std::string path = (fs::path(directory.temporary_path()) / photo.file).string();
     wait_for_writing();
     writing.run([&progress, image = std::move(image), exif, path, format] {
-      WriteImage(path, image, format, &exif);
+      WritePhotoPng(path, image, format, &exif);  // libpng directly, without OpenImageIO
       progress.Add(1);
     });
   }

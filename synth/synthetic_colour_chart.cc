@@ -13,6 +13,7 @@
 #include "core/json_reader.h"
 #include "core/light.h"
 #include "core/statistics.h"
+#include "synth/photo_png.h"
 #include "synth/pixel_rays.h"
 #include "synth/synthetic_exif.h"
 #include "synth/synthetic_radiometry.h"
@@ -158,7 +159,7 @@ nlohmann::json WriteSynthColour(const SynthOptions& options, const std::string& 
                                                            : PixelFormat::kUint16;
     fs::create_directories(fs::path(directory) / "calibration");
     const PhotoMetadata exif = SyntheticPhotoMetadata(*session, photo, session->photos.size());
-    WriteImage((fs::path(directory) / photo.file).string(), image, format, &exif);
+    WritePhotoPng((fs::path(directory) / photo.file).string(), image, format, &exif);
     ColourChartSpec chart;
     chart.space = colour.space;
     chart.photos.push_back(photo);

@@ -15,6 +15,7 @@
 #include "core/radiometry.h"
 #include "core/statistics.h"
 #include "synth/noise_random.h"
+#include "synth/photo_png.h"
 #include "synth/pixel_rays.h"
 #include "synth/synthetic_colour_chart.h"
 #include "synth/synthetic_exif.h"
@@ -339,7 +340,7 @@ void WriteSynthCalibration(const SynthOptions& options, const std::string& direc
       ApplyVignetting(session->camera, effects.vignetting, &image);
       SimulateSensor(effects, options.seed, 0xFFFFull + k, &image);
       const PhotoMetadata exif = SyntheticPhotoMetadata(*session, photo, session->photos.size());
-      WriteImage((fs::path(directory) / photo.file).string(), image, format, &exif);
+      WritePhotoPng((fs::path(directory) / photo.file).string(), image, format, &exif);
       stated.photos.push_back(photo);
     }
     for (Light& light : session->lights) light.has_intensity = false;  // the white reference measures it

@@ -1,0 +1,90 @@
+#include "synth/photo_png.h"
+
+#include <png.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cctype>
+#include <csetjmp>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <vector>
+
+#include "core/error.h"
+#include "core/file_util.h"
+
+namespace ibrdf {
+
+bool IsPlainPhotoPng(const std::string& path, const Image& image, PixelFormat format) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".png" && (image.channels == 1 || image.channels == 3) &&
+         (format == PixelFormat::kUint8 || format == PixelFormat::kUint16) && image.width > 0 && image.height > 0;
+}
+
+void WritePhotoPng(const std::string& path, const Image& image, PixelFormat format, const PhotoMetadata* metadata) {
+  if (!IsPlainPhotoPng(path, image, format)) {
+    WriteImage(path, image, format, metadata);
+    return;
+  }
+  IBRDF_CHECK(image.pixels.size() == size_t(image.width) * image.height * image.channels);
+  const bool sixteen = format == PixelFormat::kUint16;
+  const float levels = sixteen ? 65535.0f : 255.0f;
+  // The file's rows, big-endian as PNG stores them: v * levels + 0.5 in float arithmetic, truncated, as
+  // OpenImageIO converts (the same levels for every 8- and 16-bit level and 3 M random values; ties such
+  // as a 12-bit level's 37128.5 round up, which std::nearbyint would not).
+  const size_t values = image.pixels.size(), row_bytes = size_t(image.width) * image.channels * (sixteen ? 2 : 1);
+  std::vector<png_byte> bytes(values * (sixteen ? 2 : 1));
+  for (size_t i = 0; i < values; ++i) {
+    const float v = image.pixels[i];
+    const float scaled = (v > 0.0f ? std::min(v, 1.0f) : 0.0f) * levels;  // NaN: 0
+    const auto level = static_cast<uint32_t>(scaled + 0.5f);
+    if (sixteen) {
+      bytes[2 * i] = png_byte(level >> 8);
+      bytes[2 * i + 1] = png_byte(level & 0xff);
+    } else {
+      bytes[i] = png_byte(level);
+    }
+  }
+  const std::string exif = metadata ? EncodeExif(*metadata) : std::string();
+
+  AtomicFile file(path);
+  FILE* out = std::fopen(file.temporary_path().c_str(), "wb");
+  if (!out) ThrowError(path, "cannot write image: cannot create " + file.temporary_path());
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!info) {
+    png_destroy_write_struct(&png, nullptr);
+    std::fclose(out);
+    ThrowError(path, "cannot write image: out of memory");
+  }
+  // libpng reports errors by longjmp: nothing with a destructor is created between here and the writes.
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(out);
+    ThrowError(path, "cannot write image: the PNG encoder failed (disk full?)");
+  }
+  png_init_io(png, out);
+  png_set_IHDR(png, info, png_uint_32(image.width), png_uint_32(image.height), sixteen ? 16 : 8,
+               image.channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  // Deflate level 1, run-length matches only (Z_RLE), on unfiltered rows: on the demo's 20 photos 0.43 s
+  // of CPU and 15.7 MB against 0.64 s and 16.4 MB with zlib's default matching, and 1.87 s and 15.9 MB
+  // through OpenImageIO (libpng's adaptive filters); decoding as fast.
+  png_set_compression_level(png, 1);
+  png_set_compression_strategy(png, Z_RLE);
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
+  if (!exif.empty()) {
+    png_set_eXIf_1(png, info, png_uint_32(exif.size()),
+                   const_cast<png_bytep>(reinterpret_cast<const png_byte*>(exif.data())));
+  }
+  png_write_info(png, info);
+  for (int y = 0; y < image.height; ++y) png_write_row(png, bytes.data() + size_t(y) * row_bytes);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  if (std::fclose(out) != 0) ThrowError(path, "cannot write image: closing " + file.temporary_path() + " failed");
+  file.Commit();
+}
+
+}  // namespace ibrdf
