@@ -1,4 +1,4 @@
-#include "synth/photo_png.h"
+#include "core/png_writer.h"
 
 #include <png.h>
 #include <zlib.h>
@@ -16,24 +16,24 @@
 
 namespace ibrdf {
 
-bool IsPlainPhotoPng(const std::string& path, const Image& image, PixelFormat format) {
+bool IsPlainPng(const std::string& path, const Image& image, PixelFormat format) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext == ".png" && (image.channels == 1 || image.channels == 3) &&
          (format == PixelFormat::kUint8 || format == PixelFormat::kUint16) && image.width > 0 && image.height > 0;
 }
 
-void WritePhotoPng(const std::string& path, const Image& image, PixelFormat format, const PhotoMetadata* metadata) {
-  if (!IsPlainPhotoPng(path, image, format)) {
+void WritePlainPng(const std::string& path, const Image& image, PixelFormat format, PngEncoding encoding,
+                   const PhotoMetadata* metadata) {
+  if (!IsPlainPng(path, image, format)) {
     WriteImage(path, image, format, metadata);
     return;
   }
   IBRDF_CHECK(image.pixels.size() == size_t(image.width) * image.height * image.channels);
   const bool sixteen = format == PixelFormat::kUint16;
   const float levels = sixteen ? 65535.0f : 255.0f;
-  // The file's rows, big-endian as PNG stores them: v * levels + 0.5 in float arithmetic, truncated, as
-  // OpenImageIO converts (the same levels for every 8- and 16-bit level and 3 M random values; ties such
-  // as a 12-bit level's 37128.5 round up, which std::nearbyint would not).
+  // The file's rows, big-endian as PNG stores them (tests/synth/photo_png_test.cc and
+  // tests/report/report_png_test.cc compare every 8- and 16-bit level and random values with WriteImage).
   const size_t values = image.pixels.size(), row_bytes = size_t(image.width) * image.channels * (sixteen ? 2 : 1);
   std::vector<png_byte> bytes(values * (sixteen ? 2 : 1));
   for (size_t i = 0; i < values; ++i) {
@@ -69,12 +69,15 @@ void WritePhotoPng(const std::string& path, const Image& image, PixelFormat form
   png_set_IHDR(png, info, png_uint_32(image.width), png_uint_32(image.height), sixteen ? 16 : 8,
                image.channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  // Deflate level 1, run-length matches only (Z_RLE), on unfiltered rows: on the demo's 20 photos 0.43 s
-  // of CPU and 15.7 MB against 0.64 s and 16.4 MB with zlib's default matching, and 1.87 s and 15.9 MB
-  // through OpenImageIO (libpng's adaptive filters); decoding as fast.
-  png_set_compression_level(png, 1);
-  png_set_compression_strategy(png, Z_RLE);
-  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
+  png_set_compression_level(png, 1);  // as WriteImage asks OpenImageIO for
+  if (encoding == PngEncoding::kAsOpenImageIo) {
+    png_set_oFFs(png, info, 0, 0, PNG_OFFSET_PIXEL);  // as OpenImageIO writes it (the image's origin)
+  } else {
+    // libpng's adaptive per-row filter choice and zlib's general matching were most of the CPU; noise
+    // defeats long matches and the dark background is runs.
+    png_set_compression_strategy(png, Z_RLE);
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
+  }
   if (!exif.empty()) {
     png_set_eXIf_1(png, info, png_uint_32(exif.size()),
                    const_cast<png_bytep>(reinterpret_cast<const png_byte*>(exif.data())));
