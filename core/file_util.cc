@@ -3,7 +3,9 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstdlib>
 #include <filesystem>
@@ -133,6 +135,12 @@ bool SameFile(const std::string& a, const std::string& b) {
   std::error_code error;
   if (fs::exists(a) && fs::exists(b)) return fs::equivalent(a, b, error);
   return fs::weakly_canonical(a, error) == fs::weakly_canonical(b, error);
+}
+
+std::string LowerExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
 }
 
 }  // namespace ibrdf

@@ -65,4 +65,7 @@ std::string ResolvePath(const std::string& base_dir, const std::string& path);
 // True if two paths name the same existing file (or the same path when either does not exist).
 bool SameFile(const std::string& a, const std::string& b);
 
+// The extension of `path` in lower case, with its dot (".png", ".cr2"; "" when it has none).
+std::string LowerExtension(const std::string& path);
+
 }  // namespace ibrdf

@@ -1,7 +1,6 @@
 #include "core/image_io.h"
 
 #include <algorithm>
-#include <cctype>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -23,12 +22,6 @@
 
 namespace ibrdf {
 namespace {
-
-std::string LowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
-}
 
 // The OpenImageIO module (core/image_io_oiio.cc), loaded on first use.
 struct OiioModule {

@@ -4,11 +4,9 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <cctype>
 #include <csetjmp>
 #include <cstdint>
 #include <cstdio>
-#include <filesystem>
 #include <vector>
 
 #include "core/error.h"
@@ -17,9 +15,7 @@
 namespace ibrdf {
 
 bool IsPlainPng(const std::string& path, const Image& image, PixelFormat format) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".png" && (image.channels == 1 || image.channels == 3) &&
+  return LowerExtension(path) == ".png" && (image.channels == 1 || image.channels == 3) &&
          (format == PixelFormat::kUint8 || format == PixelFormat::kUint16) && image.width > 0 && image.height > 0;
 }
 

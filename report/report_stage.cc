@@ -1,7 +1,6 @@
 #include "report/report_stage.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <future>
@@ -213,16 +212,11 @@ std::optional<Session> SamplesSession(const std::string& samples_path, std::stri
   return std::nullopt;
 }
 
-// True when the samples' session has a photo other than a PNG (TIFF, EXR, RAW ...): those decode through
+// True when `session` has a photo other than a PNG (TIFF, EXR, RAW ...): those decode through
 // OpenImageIO (the report's own PNGs do not need it, report/report_png.h).
-bool PhotosNeedImageModule(const std::string& samples_path) {
-  std::string note;
-  const std::optional<Session> session = SamplesSession(samples_path, &note);
-  if (!session) return false;
-  for (size_t i = 0; i < session->photos.size(); ++i) {
-    std::string ext = fs::path(session->PhotoPath(i)).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext != ".png") return true;
+bool PhotosNeedImageModule(const Session& session) {
+  for (size_t i = 0; i < session.photos.size(); ++i) {
+    if (LowerExtension(session.PhotoPath(i)) != ".png") return true;
   }
   return false;
 }
@@ -569,10 +563,12 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   // The script starts now (matplotlib's import and the figures of the run folder alone beside the work
   // below) and draws the rest once report-data.json is written; destroyed before `directory`.
   BackgroundReportScript plotting(python, script, run_dir.string(), tmp.string());
-  // OpenImageIO's module, when the session's photos need it, loads beside the reading below instead of at
-  // the first photo.
-  const std::future<void> image_module = std::async(std::launch::async, [samples_path] {
-    if (PhotosNeedImageModule(samples_path)) PreloadImageModule();
+  // The samples' session, read once; OpenImageIO's module, when its photos need it, loads beside the
+  // reading below instead of at the first photo.
+  std::string photo_note;
+  const std::optional<Session> session = SamplesSession(samples_path, &photo_note);
+  const std::future<void> image_module = std::async(std::launch::async, [&session] {
+    if (session && PhotosNeedImageModule(*session)) PreloadImageModule();
   });
   const RunModels models = LoadRunModels(run_dir, options.reconstruction);
 
@@ -597,7 +593,7 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   for (const NamedModel& m : models.named) names.push_back(m.name);
   data["models"] = names;
 
-  const std::optional<Session> session = SamplesSession(samples_path, &result.photo_note);
+  result.photo_note = photo_note;
   WritePhoto(session, samples, photos[chosen.photo], chosen, models, tmp, &data, &result);
   WriteHeldOutPhotos(session, samples, photos, options.held_out_photos, models, tmp, &data, &result);
   // Multi-light sessions (a dome, a turntable): the lights and a photo under each.
