@@ -113,7 +113,7 @@ TEST_F(LightSideSphere, KnownRadiusHoldsTheCentre) {
 
 // The same on synth's default render, each pixel its centre's radiance (no real sensor samples a
 // point): the limb model assumes a pixel that averages light, and this render's lit limb comes out
-// about 0.06 px inside (docs/benchmarks.md, issue 13, "the lit limb's edge"). Measured and reported
+// about 0.06 px inside (docs/benchmarks.md, "Align: the sphere's lit limb"). Measured and reported
 // against the same bound: a miss is reported as skipped, not passed.
 TEST_F(LightSideSphere, KnownRadiusOnPixelCentreRender) {
   Session guess = RoughStart(*truth_);
