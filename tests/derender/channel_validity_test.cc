@@ -1,4 +1,4 @@
-// Per-channel validity and exposure advice (issue 13, part 8) on synthetic sessions: a gold-like paint
+// Per-channel validity and exposure advice on synthetic sessions: a gold-like paint
 // whose blue channel sits under the signal floor wherever its red highlight is absent, and a glossy
 // sphere whose single exposure clips the highlight.
 #include <algorithm>
