@@ -1,4 +1,4 @@
-// A COLMAP sparse model brought into the metric target frame (issue 4, part 6): COLMAP's poses are
+// A COLMAP sparse model brought into the metric target frame: COLMAP's poses are
 // right up to a similarity (its frame, scale and origin are arbitrary); the photos that the coded
 // targets posed fix it. The similarity world_from_colmap maps COLMAP's camera centres onto the
 // target-based ones (Umeyama's closed form, in double, inside an exhaustive or sampled consensus over

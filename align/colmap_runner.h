@@ -1,5 +1,5 @@
-// Runs the real COLMAP (Debian's colmap 3.8, CPU only, headless) on a session's photos (issue 4,
-// part 6): feature_extractor, exhaustive_matcher and mapper into a work folder, which appears only when
+// Runs the real COLMAP (Debian's colmap 3.8, CPU only, headless) on a session's photos:
+// feature_extractor, exhaustive_matcher and mapper into a work folder, which appears only when
 // a model was found. COLMAP reads 8-bit copies of the photos (linearized with the session's response,
 // scaled to their 99.9th percentile, sRGB-encoded), stored under the photos' session-relative names so
 // that the model's images match the session's photos by name (align/colmap_alignment.h).

@@ -1,5 +1,5 @@
-// The cylinder's pose from the markers fixed to it (issue 4: "a cylinder fitted to the 3D target
-// corners along its edges"). The session states each sample marker's corners in the cylinder's own
+// The cylinder's pose from the markers fixed to it: a cylinder fitted to the 3D target
+// corners along its edges. The session states each sample marker's corners in the cylinder's own
 // frame (origin at its centre, z along its axis; docs/session-format.md, targets.sample); the bundle
 // adjustment gives their world corners; the rigid transform between the two (Umeyama's closed form,
 // then Ceres with a Cauchy loss, markers that disagree left out) places the cylinder: its centre is

@@ -1,4 +1,4 @@
-// Camera intrinsics from photos of a ChArUco board (issue 4, part 2): ArUco markers in the white
+// Camera intrinsics from photos of a ChArUco board: ArUco markers in the white
 // squares of a chessboard identify the chessboard's inner corners, which are located at sub-pixel
 // precision (saddle points) and fed to OpenCV's calibration (Zhang's method with Levenberg-Marquardt
 // refinement) for the OPENCV model: fx, fy, cx, cy, k1, k2, p1, p2 (k3 fixed at 0, as COLMAP's OPENCV

@@ -1,4 +1,4 @@
-// Registration of a scanned mesh to the world (issue 5): the range scanner measured the platform's
+// Registration of a scanned mesh to the world: the range scanner measured the platform's
 // markers' corners in its own frame (the session's sample.scan_targets); the same markers' corners in
 // the world are the known layout (targets.reference). The similarity world_from_mesh that maps the
 // one onto the other is found in closed form (Umeyama 1991, "Least-squares estimation of

@@ -1,4 +1,4 @@
-// Print-ready targets (issue 13, part 1): the sheets a lab prints to capture a session ibrdf can align,
+// Print-ready targets: the sheets a lab prints to capture a session ibrdf can align,
 // and the session's matching "targets" block. Three sheets, each as SVG (vector, exact printed sizes in
 // millimetres) and PNG (at a stated DPI, with the DPI in the file):
 //   - platform: a dark disc (the sphere's silhouette stays against black) with a ring of ArUco markers
@@ -42,7 +42,7 @@ struct TargetSheetsOptions {
   double light_marker_size = 0.06;  // metres
   double light_drop = 0.08;         // metres, the row's centre line to the emitter, straight up the card
   double light_offset = 0.0;        // metres, in front of the card
-  // The white reference's card (issue 13, part 5): a white patch (Spectralon) of white_patch_size mounted
+  // The white reference's card: a white patch (Spectralon) of white_patch_size mounted
   // at the card's centre, framed by 4 markers of white_marker_size at the corners (ids from
   // white_marker_first_id: top-left, top-right, bottom-right, bottom-left), each card_margin marker sides
   // clear of the patch. white_patch_thickness: how far the patch's surface stands in front of the

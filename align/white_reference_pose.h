@@ -1,4 +1,4 @@
-// The white reference posed by its card's markers (issue 13, part 5): the card carries a flat white
+// The white reference posed by its card's markers: the card carries a flat white
 // patch (Spectralon) framed by ArUco markers whose corners are known in the card's frame
 // (targets.white_reference; `ibrdf targets` prints the card). Each white-reference photo is posed from
 // the platform's markers (their world corners after the bundle adjustment), the card from its own

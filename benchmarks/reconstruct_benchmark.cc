@@ -1,4 +1,4 @@
-// Speed of the reconstruct stage on the demo's samples (issues 14 and 15): the regression's set-up, the
+// Speed of the reconstruct stage on the demo's samples: the regression's set-up, the
 // MERL tabulation, the RGL .bsdf export and the whole stage, each on 1 and 2 threads.
 //
 //   build/benchmarks/reconstruct_benchmark [--benchmark_filter=...]
@@ -6,7 +6,7 @@
 // The samples are the demo's: `ibrdf synth` defaults (a 4 cm bluepaint sphere, 20 photos of 800x600)
 // derendered once per process (about 1.1 M samples). The CPU column is the whole process's CPU
 // (MeasureProcessCPUTime), so CPU / wall shows how well a part uses the threads. Figures go to
-// docs/benchmarks.md ("Issue 14 and 15: reconstruct speed").
+// docs/benchmarks.md ("Reconstruct").
 #include <unistd.h>
 
 #include <cstdlib>

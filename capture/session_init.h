@@ -1,4 +1,4 @@
-// `ibrdf session init`: a draft session.json from a camera's photos (issue 13, part 2). Every photo's
+// `ibrdf session init`: a draft session.json from a camera's photos. Every photo's
 // exposure time, ISO (as gain), f-number, focal length, make, model and size come from its metadata
 // (EXIF, read through OpenImageIO: core/image_io.h); consecutive photos taken within a burst with
 // exposures a bracket step apart form one exposure bracket; the camera comes from a calibration file or,

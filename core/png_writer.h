@@ -1,8 +1,7 @@
 // Plain PNGs (8- or 16-bit grey or RGB) written with libpng directly, so that a stage writing them never
 // loads OpenImageIO's ~260 libraries (half a second of CPU). Two encodings: byte for byte the file core
 // WriteImage writes through OpenImageIO (the report's images), or a fast one for synth's photos (the same
-// pixels in a quarter of the CPU). docs/decisions.md, "The demo run's other stages (issue 15, sixth
-// session)".
+// pixels in a quarter of the CPU). docs/decisions.md, "One PNG writer for synth and the report".
 #pragma once
 
 #include <string>

@@ -120,7 +120,7 @@ struct SampleTargetsSpec {
   std::vector<TargetSpec> markers;  // corners in the sample frame, metres; each a square
 };
 
-// Markers on the white reference's card (issue 13, part 5): their corners in the card's own frame
+// Markers on the white reference's card: their corners in the card's own frame
 // (origin at the white patch's centre on its surface, x to the right and y up the print, z out of the
 // patch: its normal), in OpenCV's order. `ibrdf align` poses the card from them and writes the
 // white reference's centre and normal (align/white_reference_pose.h).

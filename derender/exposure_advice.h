@@ -1,4 +1,4 @@
-// Exposure advice (issue 13, part 8): how much of the BRDF domain each channel failed to measure, per
+// Exposure advice: how much of the BRDF domain each channel failed to measure, per
 // band of theta_h (the half vector's angle from the normal, which orders a glossy sample from the
 // highlight core outwards), and what to change at capture when clipping or the signal floor removes a
 // region: exposure brackets, a longer or shorter exposure, a brighter or differently coloured light.

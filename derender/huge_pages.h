@@ -1,7 +1,7 @@
 // Large working buffers backed by transparent huge pages where the kernel allows it (madvise mode).
 // The derenderer's buffers (samples, radiance images, decoded photos) are tens of megabytes written
 // once; with 4 KiB pages each first touch is a page fault, and on virtual machines those faults cost
-// more than the per-pixel work (docs/benchmarks.md, issue 15). Advice only: contents never change.
+// more than the per-pixel work (docs/benchmarks.md, "Derender"). Advice only: contents never change.
 #pragma once
 
 #include <cstddef>

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Writes the seed corpora of the fuzz targets (fuzz/corpus/TARGET) and the regression inputs of
-issue 17 (fuzz/regressions/TARGET): small hand-made files in every format the readers accept, and the
+"""Writes the seed corpora of the fuzz targets (fuzz/corpus/TARGET) and the regression inputs
+(fuzz/regressions/TARGET): small hand-made files in every format the readers accept, and the
 malformed inputs that once crashed, hung or were silently accepted. Run from anywhere; rewrites both
 folders. Materials, sessions and truth files come from samples/ and from `ibrdf synth` output when
 SYNTH_DIR is given (a session folder written by `ibrdf synth`)."""
@@ -38,7 +38,7 @@ grid = ("ply\nformat ascii 1.0\nobj_info num_cols 3\nobj_info num_rows 2\nelemen
         "property float y\nproperty float z\nelement range_grid 6\nproperty list uchar int vertex_indices\nend_header\n"
         "0 0 0\n0.001 0 0\n0 0.001 0\n0.001 0.001 0\n1 0\n1 1\n0\n1 2\n1 3\n0\n")
 put("corpus", "ply", "range_grid.ply", grid)
-# Issue 17: a 300-byte PLY declaring a 100000 x 20000 range grid (8 GB before reading any data).
+# A 300-byte PLY declaring a 100000 x 20000 range grid (8 GB before reading any data).
 put("regressions", "ply", "huge_range_grid.ply",
     "ply\nformat ascii 1.0\nobj_info num_cols 100000\nobj_info num_rows 20000\nelement vertex 1\nproperty float x\n"
     "property float y\nproperty float z\nelement range_grid 2000000000\nproperty list uchar int vertex_indices\n"
@@ -144,7 +144,7 @@ put("regressions", "merl", "negative_dims.binary", struct.pack("<3i", -90, 90, 1
 put("regressions", "merl", "short.binary", b"\x5a")
 print("seeds written under", here)
 
-# RGL .bsdf tensor files (issue 14): header "tensor_file\0", version 1.0, field count, then per field
+# RGL .bsdf tensor files: header "tensor_file\0", version 1.0, field count, then per field
 # name length, name, rank, dtype, offset, shape; data at the offsets (core/tensor_file.cc).
 def tensor_file(fields, version=(1, 0)):
     header = b"tensor_file\0" + bytes(version) + struct.pack("<I", len(fields))

@@ -81,7 +81,7 @@ struct LocalRegressionOptions {
   // value (sum of weights, sum of squared weights and neighbour counts stay per sample). The cost of
   // an evaluation is then bounded by the cells in the kernel, not the samples, while no sample is
   // discarded; the approximation is second order in the cell edge. 0 turns binning off (every sample
-  // its own point). Measured in docs/benchmarks.md (issue 6).
+  // its own point). Measured in docs/benchmarks.md, "Reconstruct".
   double bin_fraction_h = 0.2;
   double bin_fraction_d = 0.1;
 

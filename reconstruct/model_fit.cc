@@ -129,7 +129,7 @@ std::vector<double> BandRelativeRms(const BrdfModel& model, const std::vector<Fi
 // Penalty keeping a lobe's maximum anywhere, max(|Cxy|, |Cz|)^n, below `cap`: the excess of n log(max)
 // over log(cap), weighted heavily (the data residuals are in sigmas). (The base's exact maximum is
 // max(|Cxy|, Cz): a negative Cz only lowers it; counting |Cz| is conservative, and relaxing it moved
-// the primer's fit to a worse minimum: docs/decisions.md, issue 14.)
+// the primer's fit to a worse minimum: docs/decisions.md, "Fit plausibility".)
 template <int kLobes>
 struct LobeCapPenalty {
   explicit LobeCapPenalty(double log_cap_in) : log_cap(log_cap_in) {}
@@ -211,7 +211,7 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
   // Every (channel, start) on a random subset of the samples, in parallel, to a looser tolerance: the
   // subset ranks the starts, and each channel's best is then refined on all samples (on the demo's and
   // the squash's samples this gives the same fit as every start on all samples at a third of the CPU:
-  // docs/benchmarks.md, issue 14).
+  // docs/benchmarks.md, "Reconstruct").
   const std::vector<size_t> all = AllIndices(samples.size());
   const std::vector<size_t> subset = StartSubset(samples.size(), options.start_samples, options.seed + 1);
   const bool two_phase = subset.size() < all.size();

@@ -440,7 +440,7 @@ nlohmann::json LibraryRecord(const LibraryEntry& entry) {
   nlohmann::json figures;
   figures["samples"] = At(summary, {"samples", "accepted"});
   figures["photos"] = At(summary, {"samples", "photos"});
-  // The table's classes (issue 14: measured / interpolated / unmeasured); older runs said "unsupported".
+  // The table's classes (measured / interpolated / unmeasured); older runs said "unsupported".
   const nlohmann::json measured = At(summary, {"reconstruction", "table", "cells_measured"});
   const nlohmann::json interpolated = At(summary, {"reconstruction", "table", "cells_interpolated"});
   nlohmann::json unmeasured = At(summary, {"reconstruction", "table", "cells_unmeasured"});

@@ -28,7 +28,7 @@ using TriangleTree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, TrianglePrimitive
 // The hull's traits with CGAL's filtered plane predicate (exact where the filter fails). CGAL's
 // triangle-soup overload of convex_hull_3 takes the kernel itself as its traits, whose planes are
 // inexact constructions: on near-coplanar points (a torus far from the origin) it dropped hull
-// vertices and gave distances wrong by 0.7 mm (issue 15). The Surface_mesh overload uses these
+// vertices and gave distances wrong by 0.7 mm. The Surface_mesh overload uses these
 // traits, but copying the hull into a halfedge mesh cost a third of the time.
 using HullTraits = CGAL::Convex_hull_traits_3<Kernel, CGAL::Default, CGAL::Tag_true>;
 using HullPoints = std::vector<Point>;

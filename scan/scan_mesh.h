@@ -1,7 +1,7 @@
 // The sample mesh of the scan stage: scan points in metres, triangles over them, and per-point
 // normals with the quality of their local-plane fit.
 //
-// Decision (issue 3): the mesh is this plain Eigen struct, not an OpenMesh TriMesh. Every later stage
+// Decision: the mesh is this plain Eigen struct, not an OpenMesh TriMesh. Every later stage
 // (derender intersects rays with it) reads points and triangles, and nothing else; OpenMesh, CGAL and
 // PCL are used inside scan/*.cc only (see docs/scan.md). Points are doubles so that a scan far from
 // the origin keeps its sub-micrometre detail.

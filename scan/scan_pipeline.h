@@ -1,4 +1,4 @@
-// The scan stage end to end (issue 3): read every input (each with its transform into the common
+// The scan stage end to end: read every input (each with its transform into the common
 // frame), tessellate range grids by their neighbours and reconstruct unorganized points (CGAL),
 // merge, clean, fit local-plane normals, and report convexity. `ibrdf scan` is a thin shell around it.
 #pragma once

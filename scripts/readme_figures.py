@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The README's demo figures, regenerated from a run rather than typed (issue 16).
+"""The README's demo figures, regenerated from a run rather than typed, so they cannot go stale.
 
 Usage: scripts/readme_figures.py RUN_DIR [--update README.md]
        scripts/readme_figures.py --check README.md

@@ -477,7 +477,7 @@ def appearance_html(data, out, figures):
     return "\n".join(parts)
 
 
-# ---- Multi-light sessions (issue 12, real rigs): kept apart from the rest of the page.
+# ---- Multi-light sessions (domes, turntables): kept apart from the rest of the page.
 def lights_section(out, data):
     """The session's lights (a dome, a turntable: a light per photo), what each gave and a photo under
     each; empty for a one-light session. `data["lights"]` is written by report/light_photos.cc."""

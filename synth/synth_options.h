@@ -164,7 +164,7 @@ struct SynthTargetOptions {
   int light_marker_count = 2;
   double light_marker_size = 0.06;  // metres, printed side (border included)
   double light_card_drop = 0.08;    // metres, light to the markers' centres, straight down
-  // The white reference on a card framed by markers (issue 13, part 5; needs radiometry.light_unknown):
+  // The white reference on a card framed by markers (needs radiometry.light_unknown):
   // the card of `ibrdf targets` (align/targets.h WhiteCardLayout: the patch of
   // radiometry.white_size framed by 4 markers of white_marker_size, ids white_marker_first_id ..),
   // printed paper of albedo 0.8 and ink of 0.03 lit by the light like the patch, standing where the

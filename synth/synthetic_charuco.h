@@ -1,4 +1,4 @@
-// Synthetic photos of a ChArUco board for the intrinsic calibration (issue 4, part 2): OpenCV draws
+// Synthetic photos of a ChArUco board for the intrinsic calibration: OpenCV draws
 // the board (cv::aruco::CharucoBoard::draw, through align/intrinsic_calibration.h) into a texture, which
 // is rendered as a textured plane through a session's camera, lens distortion included, from varied
 // seeded poses: pixels whose corners see different texels are supersampled (n x n rays), then shot

@@ -1,4 +1,4 @@
-// The EXIF a real camera would write into a synthetic photo (issue 13: a synthetic capture left as a
+// The EXIF a real camera would write into a synthetic photo (a synthetic capture left as a
 // camera leaves it, for `ibrdf session init`): exposure time, ISO (100 x the photo's gain), f-number,
 // focal length in millimetres for a sensor of kPixelPitchMm pixels, its 35 mm equivalent, the focal
 // plane resolution, make "ibrdf", model "synth" and a capture time: 10 s between poses, 1 s between

@@ -1,4 +1,4 @@
-// Irregular true shapes for synthetic mesh measurements (issue 5): a squash, a clay pot and a dented
+// Irregular true shapes for synthetic mesh measurements: a squash, a clay pot and a dented
 // sphere, each an exact implicit surface with exact ray hits and exact normals, so that a session
 // measured through a simulated range scan can be compared with the geometry it came from.
 //

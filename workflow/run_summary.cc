@@ -25,7 +25,7 @@ void AddSamples(const fs::path& dir, nlohmann::json* summary) {
                            {"pixels_examined", side->Count("/counts/pixels_examined", 0)},
                            {"accepted", side->Count("/counts/accepted", 0)},
                            {"rejected", side->ObjectOr("/counts/rejected", nlohmann::json::object())}};
-  // Exposure advice (issue 13, part 8): the sentences of derender's warnings, when it had any.
+  // Exposure advice: the sentences of derender's warnings, when it had any.
   nlohmann::json warnings = nlohmann::json::array();
   const nlohmann::json list = side->ValueOr("/exposure/warnings", nlohmann::json::array());
   if (list.is_array()) {

@@ -1,4 +1,4 @@
-// The align stage against synthetic sessions with markers: poses and the sphere within the issue's
+// The align stage against synthetic sessions with markers: poses and the sphere within the required
 // bounds, derendering from aligned poses as accurate as from the true ones, and hard or bad input
 // answered with a dropped photo or a clear error, never a silent wrong pose.
 #include "align/aligner.h"
@@ -38,7 +38,7 @@ TEST(Align, DefaultOptionsAreValid) {
   EXPECT_TRUE(AlignOptions().Check(&why)) << why;
 }
 
-// The bounds at the default resolution and camera noise: cameras within 0.5 mm and 0.05
+// The bounds at the default resolution and camera noise: cameras within 0.5 mm and 0.05
 // degrees, the sphere's centre within 0.2 mm and radius within 0.1 mm. Then the derender result of
 // the aligned session is as accurate as with the true poses (within a factor 1.5).
 TEST(Align, SphereSessionFromItsOwnPhotos) {
@@ -117,7 +117,7 @@ TEST(Align, MarkerIdListedTwiceIsAnError) {
   }
 }
 
-// The bound for the light: within 1 mm of the truth at the default noise, from the markers on
+// The bound for the light: within 1 mm of the truth at the default noise, from the markers on
 // its card seen in the target photos (whose poses come from the platform's ring). Target photos are
 // posed, kept in the aligned session and marked.
 TEST(Align, LightFromItsMarkers) {

@@ -1,6 +1,6 @@
 // The bundle adjustment without a known layout: a synthetic target session whose markers' layout is
 // withheld (one origin marker fixes the world frame) must give the markers' corners within 0.2 mm and
-// the cameras within the bounds (0.5 mm, 0.05 degrees) once the truth is put in that frame;
+// the cameras within the bounds (0.5 mm, 0.05 degrees) once the truth is put in that frame;
 // the mixed case (some markers known, the others estimated) needs no gauge transform at all.
 #include "align/bundle_adjustment.h"
 
@@ -108,7 +108,7 @@ TEST(BundleAdjustment, UncertaintyGrowsForNearlyCollinearCorners) {
   EXPECT_GT(strip.position_sigma_m, 10.0 * ring.position_sigma_m);
 }
 
-// The free-layout case end to end on rendered photos: layout withheld, marker 0 the origin.
+// The free-layout case end to end on rendered photos: layout withheld, marker 0 the origin.
 TEST(BundleAdjustment, UnknownLayoutFromRenderedPhotos) {
   ScratchDir dir;
   const auto material = LoadMaterial(MaterialPath("bluepaint"));

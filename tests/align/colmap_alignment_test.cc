@@ -108,7 +108,7 @@ TEST(ColmapAlignment, DefaultOptionsAreValid) {
   EXPECT_TRUE(ColmapAlignmentOptions().Check(&why)) << why;
 }
 
-// The test: a COLMAP model written from the true poses after a random similarity, through the
+// The alignment's test: a COLMAP model written from the true poses after a random similarity, through the
 // binary and the text writers and readers, recovered within 1e-6 relative; one image moved 5 cm is an
 // outlier and keeps no say in the similarity.
 TEST(ColmapAlignment, RecoversTheSimilarityOfASyntheticSession) {

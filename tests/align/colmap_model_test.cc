@@ -164,7 +164,7 @@ TEST(ColmapModelText, UnknownModelAndDanglingReferences) {
   EXPECT_EQ(model.points.at(5).track.size(), 1u);
 }
 
-// Issue 17: the text reader took "12x.5" as 12, "0.1" in an integer field as 0, ignored extra fields
+// The text reader once took "12x.5" as 12, "0.1" in an integer field as 0, ignored extra fields
 // and NaN, and let std::stod/std::stoll throw bare messages. Each is now one line naming file:line.
 TEST(ColmapModelText, NumbersAreWholeTokensAndFinite) {
   ScratchDir dir;

@@ -1,5 +1,5 @@
-// The cylinder's pose from the markers on its top cap (issue 4): a synthetic cylinder session with a
-// ring of reference markers and three small markers on the cap. The cameras within the issue's bounds,
+// The cylinder's pose from the markers on its top cap: a synthetic cylinder session with a
+// ring of reference markers and three small markers on the cap. The cameras within the bounds,
 // the axis and centre from the markers' bundle-adjusted corners, and derendering the aligned session
 // as accurate as with the true pose (within a factor 1.5).
 #include "align/cylinder_fit.h"

@@ -1,6 +1,6 @@
-// The align stage's hard cases (issue 4), on rendered photos at the default resolution and noise:
+// The align stage's hard cases, on rendered photos at the default resolution and noise:
 // nearly collinear markers, a single marker, exactly three markers, a camera beside the light, markers
-// partly hidden by the sample. Each photo must come out either within the issue's bounds (0.5 mm,
+// partly hidden by the sample. Each photo must come out either within the bounds (0.5 mm,
 // 0.05 degrees) or dropped with a reason: never a silent wrong pose.
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // Intrinsic calibration from synthetic ChArUco board photos: the camera that took them (distortion
-// included) recovered within the bounds, the board's layout as OpenCV defines it, too few
+// included) recovered within the bounds, the board's layout as OpenCV defines it, too few
 // usable photos refused with the reasons, and the align stage with calibration (align/align_stage.h) end to end.
 #include "align/intrinsic_calibration.h"
 
@@ -34,7 +34,7 @@ using testing::ErrorOf;
 // projects the true camera's ray through it. With `same_centre`, the estimate's principal point is
 // replaced by the true one first: a principal point off by a pixel moves every projection by that
 // pixel, which a photo's pose absorbs as a small turn, so this measures the focal lengths and the
-// distortion, what the 0.3 px bound is about.
+// distortion, what the 0.3 px bound is about.
 double MaxReprojectionDifference(const Camera& truth, Camera estimate, bool same_centre) {
   if (same_centre) {
     estimate.params[2] = truth.PrincipalX();
@@ -93,7 +93,7 @@ TEST(CharucoBoard, LayoutAndDrawing) {
   EXPECT_EQ(texels[size_t(height - 10) * width + 10], 0);  // rows are odd: the bottom-left is black too
 }
 
-// The bounds: focal length within 0.5 %, principal point within 2 px, the distortion such
+// The bounds: focal length within 0.5 %, principal point within 2 px, the distortion such
 // that the estimated camera reprojects the true camera's rays within 0.3 px over the whole image.
 TEST(IntrinsicCalibration, RecoversTheCameraThatTookTheBoardPhotos) {
   ScratchDir dir;

@@ -1,4 +1,4 @@
-// The sphere fit that cannot drift (issue 13, part 7) on synthetic sessions with markers: with every
+// The sphere fit that cannot drift on synthetic sessions with markers: with every
 // camera on the light's side only the lit limb is seen, so a free radius trades off against the
 // centre; the fit must say so (a warning in the result and in alignment.json, with the covariance),
 // and with the radius known it must put the centre within 0.05 mm. Exact tangent rays from one side
@@ -108,12 +108,12 @@ TEST_F(LightSideSphere, KnownRadiusHoldsTheCentre) {
   EXPECT_GT(result.sphere.covariance(0, 0), 0.0);
   EXPECT_LT(std::sqrt(result.sphere.covariance.topLeftCorner<3, 3>().trace()), 0.05e-3);
   EXPECT_TRUE(result.session.sample.radius_known);  // kept in the aligned session
-  EXPECT_LT(center_error, 0.05e-3);                 // the issue's bound
+  EXPECT_LT(center_error, 0.05e-3);                 // the bound
 }
 
 // The same on synth's default render, each pixel its centre's radiance (no real sensor samples a
 // point): the limb model assumes a pixel that averages light, and this render's lit limb comes out
-// about 0.06 px inside (docs/benchmarks.md, issue 13, "the lit limb's edge"). Measured and reported
+// about 0.06 px inside (docs/benchmarks.md, "Align: the sphere's lit limb"). Measured and reported
 // against the same bound: a miss is reported as skipped, not passed.
 TEST_F(LightSideSphere, KnownRadiusOnPixelCentreRender) {
   Session guess = RoughStart(*truth_);

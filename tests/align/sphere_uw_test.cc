@@ -5,7 +5,7 @@
 // inwards moves it away from that photo's light. The test fits all 12 photos together against the
 // hand-drawn mask's circle, then each photo alone with that radius, and compares the per-photo centres'
 // spread and their mean displacement towards the light between the threshold edge and the limb model
-// (docs/benchmarks.md, issue 13, "the lit limb's edge"). Skips with a message when the data folder is
+// (docs/benchmarks.md, "Align: the sphere's lit limb"). Skips with a message when the data folder is
 // absent.
 #include <cmath>
 #include <cstdio>
@@ -162,7 +162,7 @@ TEST(UwGreySphere, LitLimbsAgreeAcrossLights) {
   EXPECT_LT((after.center_px - circle.center_px).norm(), 1.5);
   EXPECT_NEAR(after.radius_px, circle.radius_px, 1.5);
   // The limb model is no worse than the threshold edge on real photos (measured: docs/benchmarks.md,
-  // issue 13, "the lit limb's edge"): on the lit limb its per-photo centres agree better and do not
+  // "Align: the sphere's lit limb"): on the lit limb its per-photo centres agree better and do not
   // move towards or away from their lights.
   EXPECT_LE(after.rms_px, before.rms_px);
   EXPECT_LE(after.lit_spread_px, before.lit_spread_px);

@@ -87,7 +87,7 @@ TEST(Targets, LightCardMatchesItsBlock) {
   }
 }
 
-// The white reference's card (issue 13, part 5): its 4 markers detected with the block's ids, their
+// The white reference's card: its 4 markers detected with the block's ids, their
 // corners where targets.json's white_reference block puts them in the card's frame (origin at the
 // patch's centre, x right, y up), within 0.1 mm.
 TEST(Targets, WhiteCardMatchesItsBlock) {

@@ -1,9 +1,9 @@
 // The mirror-sphere calibration on real photos: the UW photometric-stereo chrome sphere
 // (../shared/data/uw-photometric-spheres, 12 lights, fixed near-orthographic camera, 8-bit TGA). The 12
 // calibrated directions must agree with the data's own lights.txt: median under 3 degrees, each under
-// 10 (measured: docs/benchmarks.md, issue 12; lights.txt is itself an estimate, and disagrees with any
-// one reflection model by up to 5 px of highlight position: see there). Skips with a message when the
-// data folder is absent.
+// 10 (measured: docs/benchmarks.md, "Lights: mirror sphere and the UW spheres"; lights.txt is itself an
+// estimate, and disagrees with any one reflection model by up to 5 px of highlight position: see there).
+// Skips with a message when the data folder is absent.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

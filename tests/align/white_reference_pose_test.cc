@@ -1,4 +1,4 @@
-// The white reference posed by its card's markers (issue 13, part 5): `ibrdf synth --white-card`
+// The white reference posed by its card's markers: `ibrdf synth --white-card`
 // renders the card of `ibrdf targets` (a white patch framed by 4 markers) where the sample was, seen
 // with the platform; with its pose and the light's intensity dropped from session.json (nothing typed),
 // the align stage poses the card and the light calibration must then measure the light's intensity

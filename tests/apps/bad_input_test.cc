@@ -1,4 +1,4 @@
-// The crash, hang and silent-acceptance cases of issue 17 through the command line, each with the
+// The crash, hang and silent-acceptance cases the fuzzers found, through the command line, each with the
 // failing input: a non-zero exit, one line naming the file (and field) and what is wrong, no output.
 #include <sys/stat.h>
 

@@ -97,7 +97,7 @@ TEST(BatchCommand, SixSessionsSucceedTheBrokenOneFailsAloneAndReRunsRetryOnlyIt)
     EXPECT_EQ(m.at("status"), "ok") << name << ": " << m.dump();
     const nlohmann::json& f = m.at("figures");
     EXPECT_GT(f.at("samples").get<int>(), 1000) << name;
-    // Coverage counts measured and interpolated cells only (issue 14's honest table): a small session
+    // Coverage counts measured and interpolated cells only (the honest table): a small session
     // of 8 photos covers 10 to 50 % of the table.
     EXPECT_GT(f.at("table_coverage").get<double>(), 0.05) << name;
     EXPECT_LE(f.at("table_coverage").get<double>(), 1.0) << name;

@@ -1,4 +1,4 @@
-// The capture kit through the command line (issue 13): `ibrdf targets` writes the sheets and a targets
+// The capture kit through the command line: `ibrdf targets` writes the sheets and a targets
 // block equal to `ibrdf synth --targets`'s layout (in the platform's frame); `ibrdf session init` on a
 // synthetic capture's photos alone (their EXIF) drafts a session whose exposures are the synthetic ones,
 // says what is missing with exit status 2, and validates once it is given.

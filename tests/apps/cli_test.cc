@@ -118,7 +118,7 @@ TEST_F(CliTest, PhotoOfWrongSizeNamesThePhoto) {
   ExpectDerenderError({"000.png", "50x40", "96x72"});
 }
 
-// Real rigs (issue 12), bad input through the CLI: one clear error each, no output.
+// Real rigs (domes, turntables), bad input through the CLI: one clear error each, no output.
 TEST_F(CliTest, PhotoNamingAnUnknownLightNamesPhotoAndLights) {
   Edit([](nlohmann::json& j) {
     j["lights"] = {j["light"], j["light"]};

@@ -1,4 +1,4 @@
-// The output guard of every subcommand (issue 17): `--out` aimed at one of the command's inputs, or at
+// The output guard of every subcommand: `--out` aimed at one of the command's inputs, or at
 // a folder holding one, is refused even with --overwrite, with a one-line message naming the output,
 // and the input is left byte for byte as it was. Each case was a data-destroying run before (exit 0).
 #include <algorithm>

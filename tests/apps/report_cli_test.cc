@@ -1,4 +1,4 @@
-// The command-line rough edges of `check`, `report` and `run` (issue 16, part 4), each through the tool
+// The command-line rough edges of `check`, `report` and `run`, each through the tool
 // as a user types it: check's regression line says "invalid" rather than "0.00 % over 0 pairs"; help
 // texts without CLI11's "{false}"; unit-suffixed option names with the old names as aliases; `report`
 // finds the reconstruction it is given; a report titled from the run rather than "synth"; `run`

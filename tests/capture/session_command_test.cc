@@ -1,4 +1,4 @@
-// `ibrdf session init --chart-photos` as a user runs it (issue 13, part 6): a synthetic capture with a
+// `ibrdf session init --chart-photos` as a user runs it: a synthetic capture with a
 // colour-chart photo (`ibrdf synth --colour-chart`), drafted from the photos' EXIF with the chart's
 // photo and corner patches; the drafted session carries the colour_chart block with the chart photo's
 // EXIF exposure, and `ibrdf colour` fits its matrix from it. Without corners the block is drafted for

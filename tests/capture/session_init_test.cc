@@ -155,7 +155,7 @@ TEST(SessionInit, ListsWhatIsMissingThenValidates) {
   EXPECT_THROW(InitSession(options, dir / "out"), Error);
 }
 
-// White-reference photos (issue 13, part 5): with the white card's markers in the targets nothing of
+// White-reference photos: with the white card's markers in the targets nothing of
 // its pose is drafted or missing (`ibrdf align` poses it), the light needs no intensity; without them
 // its centre and normal are listed as missing, and so is its size when not given.
 TEST(SessionInit, WhiteReferencePhotosNeedNoPoseWithTheCardsMarkers) {

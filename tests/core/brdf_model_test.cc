@@ -355,7 +355,7 @@ TEST(LoadMaterial, ReadsFileAndNamesItInErrors) {
   std::filesystem::remove_all(dir);
 }
 
-// Issue 17: a material with Cz 1e300 made `synth` write exposure_s 0. Values are validated where read:
+// A material with Cz 1e300 once made `synth` write exposure_s 0. Values are validated where read:
 // each message names the file and the field.
 TEST(MaterialFromJson, ImplausibleValuesAreErrors) {
   json lafortune = Bluepaint().ToJson();

@@ -1,4 +1,4 @@
-// Camera files (issue 13, parts 2 to 4): EXIF written with a photo reads back (PNG, EXR, TIFF); a DNG
+// Camera files: EXIF written with a photo reads back (PNG, EXR, TIFF); a DNG
 // of known raw values decodes to (raw - black) / (white - black) per channel within quantization, the
 // black and white levels taken from the file; float photos have no saturation unless the session
 // states one, integer photos clip at full scale.

@@ -204,7 +204,7 @@ TEST_F(FileUtilTest, SameFile) {
   EXPECT_FALSE(SameFile(Path("new.txt"), Path("other.txt")));
 }
 
-// Issue 17: a killed writer's temporaries (".NAME.tmp-PID-N") were cleaned only by `ibrdf run`; now
+// A killed writer's temporaries (".NAME.tmp-PID-N") must not wait for `ibrdf run` to clean them:
 // the next writer of the same output removes them, and keeps those of live processes.
 TEST_F(FileUtilTest, StaleTemporariesAreRemovedByTheNextWriter) {
   // A process id that no longer exists: a child that has exited and been reaped.
@@ -225,7 +225,7 @@ TEST_F(FileUtilTest, StaleTemporariesAreRemovedByTheNextWriter) {
   EXPECT_EQ(Listing(), (std::vector<std::string>{".other.tmp-" + dead + "-1.npy", ".rec.tmp-" + live + "-9"}));
 }
 
-// Issue 17: the samples and their sidecar were renamed separately; stopped in between, a new file sat
+// Renaming the samples and their sidecar separately, a writer stopped in between would leave a new file
 // beside the previous run's sidecar. CommitWithManifest removes the old manifest first and moves the
 // new one last: a failure between leaves the data without a manifest, never paired with the old one.
 TEST_F(FileUtilTest, CommitWithManifestNeverPairsNewDataWithOldManifest) {

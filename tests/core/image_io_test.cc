@@ -238,7 +238,7 @@ TEST_F(ImageIoTest, PlainPngFastPathMatchesOpenImageIO) {
   ExpectErrorNamingPath([&] { ReadImage(corrupt, &image); }, corrupt);
 }
 
-// Issue 15: ReadImageRegion gives ReadImage's values inside the region (clipped to the image) for PNGs
+// ReadImageRegion gives ReadImage's values inside the region (clipped to the image) for PNGs
 // (8 and 16 bits, grey and RGB: the libpng path stops after the region's last row) and for a format
 // decoded whole (EXR); a region reaching past the image or empty reads without error; a PNG cut off
 // inside the region is an error naming the file, one cut off after it is not (its rows are never

@@ -250,7 +250,7 @@ TEST_F(JsonFileTest, WriteReadRoundTrip) {
   EXPECT_EQ(files, 1u);
 }
 
-// Issue 17: of two values of one key the library kept the last silently; now an Error naming the key.
+// Of two values of one key the JSON library keeps the last silently; ibrdf makes it an Error naming the key.
 TEST_F(JsonFileTest, DuplicateKeyIsAnError) {
   const std::string path = Path("twice.json");
   std::ofstream(path) << "{\"light\": {\"intensity\": 1, \"intensity\": 2}}\n";
@@ -260,7 +260,7 @@ TEST_F(JsonFileTest, DuplicateKeyIsAnError) {
   EXPECT_EQ(ReadJsonFile(path)["b"]["x"], 2);
 }
 
-// Issue 17: a run-folder stamp nested 10^5 deep overflowed the stack of a later recursive copy.
+// A run-folder stamp nested 10^5 deep would overflow the stack of a later recursive copy.
 TEST_F(JsonFileTest, DeepNestingIsAnError) {
   const std::string path = Path("deep.json");
   std::ofstream(path) << std::string(100000, '[') << std::string(100000, ']');

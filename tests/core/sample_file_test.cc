@@ -354,7 +354,7 @@ TEST_F(SampleFileTest, ReadsValidityWrittenByNumpy) {
   EXPECT_EQ(samples[0].exposures, 3);
 }
 
-// Issue 17: sample files with NaN or infinite values, angles out of range, |wi| != 1, negative sigma or
+// Sample files with NaN or infinite values, angles out of range, |wi| != 1, negative sigma or
 // BRDF were read silently (and NaN reached `check` and `compare` outputs). Each is now an Error naming
 // the file and the first bad sample.
 TEST_F(SampleFileTest, InvalidSamplesAreErrors) {

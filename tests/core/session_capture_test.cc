@@ -1,4 +1,4 @@
-// The session fields of the capture kit (issue 13), kept out of session_test.cc: `sample.radius_known`
+// The session fields of the capture kit, kept out of session_test.cc: `sample.radius_known`
 // round-trips; `radiometry.saturation_level` is written back only when the manifest stated it (so a
 // rebased session of float photos keeps "no saturation"); `light.intensity` may be left out when a
 // white reference measures it, and is still required without one.

@@ -1,4 +1,4 @@
-// Per-channel validity and exposure advice (issue 13, part 8) on synthetic sessions: a gold-like paint
+// Per-channel validity and exposure advice on synthetic sessions: a gold-like paint
 // whose blue channel sits under the signal floor wherever its red highlight is absent, and a glossy
 // sphere whose single exposure clips the highlight.
 #include <algorithm>
@@ -27,8 +27,8 @@ using testing::ScratchDir;
 // The gold-like paint (diffuse albedo 0.06, 0.03, 0.005 under a red-gold GGX highlight) at the default
 // noise: the blue channel of many pixels is under the floor while red is well measured. Before per-channel
 // validity those pixels were dropped whole (374 k of them), the blue survivors were selected by their
-// own noisy value (+1.9 % in the issue's run) and the blue reconstruction came out +6 % to +46 % high
-// at theta_h >= 40 degrees (docs/benchmarks.md, issue 13 part 8). Now: no pixel with a measured channel
+// own noisy value (+1.9 %) and the blue reconstruction came out +6 % to +46 % high at theta_h >= 40
+// degrees (docs/decisions.md, "Per-channel validity"). Now: no pixel with a measured channel
 // is dropped, the kept blue values are unbiased, and the blue reconstruction is within 2 % in every
 // theta_h band.
 TEST(ChannelValidity, GoldPaintBlueChannelUnbiased) {

@@ -1,6 +1,6 @@
 // End to end, by library calls: a synthetic session under a tinted light seen by a camera with its own
 // RGB (camera = M * linear sRGB) and a chart photo -> the chart fit -> derender -> samples in linear
-// sRGB within 1 % of the true BRDF (issue 13's colour must-show, small). Without the correction the
+// sRGB within 1 % of the true BRDF (the colour must-show, small). Without the correction the
 // samples are far off (the control that shows the check can fail).
 #include <algorithm>
 #include <cmath>

@@ -1,16 +1,13 @@
-// The derenderer's samples are byte-identical to those of the photo-by-photo loop before the speed
-// issue (commit 60d9575: every pixel of every photo linearized into a fresh buffer, photos merged
+// The derenderer's samples are byte-identical to those of the plain photo-by-photo loop
+// (commit 60d9575: every pixel of every photo linearized into a fresh buffer, photos merged
 // after a parallel loop). Small synthetic sessions, rendered by `ibrdf synth` (seeded, so their bytes
 // do not depend on the machine or the thread count), are derendered through the CLI and the .npy
 // files' FNV-1a hashes compared with the ones that commit wrote: an analytic sphere (also at stride
 // 2), a cylinder with 3-exposure brackets, the sRGB response and vignetting (flat field), and the
 // dent mesh (Embree, shadow rays on, off and auto). A deliberate change of the samples (or of synth's
-// photos) must re-record these hashes, saying why in the commit. Re-recorded for issue 13 part 8 (76-byte
-// rows with per-channel validity, the floor on the expected signal): the reliability branch alone and
-// its merge with the second speed pass (huge pages, rays only in the sample box) give these same bytes.
-// Re-recorded for issue 15's third pass: synth's sensor noise is drawn by a ziggurat on a counter-based
-// stream (synth/noise_random.h), a new realisation of the same noise model, so synth's photos changed;
-// the derenderer did not (the hashes are derender's output on the new photos, derender/ unchanged).
+// photos) must re-record these hashes, saying why in the commit. The hashes are of 76-byte rows with
+// per-channel validity and the floor on the expected signal, derendered from photos whose sensor noise
+// is drawn by a ziggurat on a counter-based stream (synth/noise_random.h).
 #include <cstdint>
 #include <filesystem>
 #include <fstream>

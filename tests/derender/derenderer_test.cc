@@ -1,4 +1,4 @@
-// The analytic derenderer against synthetic sessions with known BRDFs (the foundation issue's bounds).
+// The analytic derenderer against synthetic sessions with known BRDFs, against the derenderer's accuracy bounds.
 #include "derender/derenderer.h"
 
 #include <cstdio>
@@ -260,7 +260,7 @@ TEST(Derender, NonFinitePixelsAreRejectedNotPropagated) {
   WriteImage(session.PhotoPath(0), image, PixelFormat::kFloat);
   const DerenderResult result = DerenderAnalytic(session, DerenderOptions());
   // Only green is poisoned: the 100 pixels keep their red and blue, green flagged as not measured
-  // (per-channel validity, issue 13) with a finite value and sigma 0.
+  // (per-channel validity) with a finite value and sigma 0.
   EXPECT_EQ(result.summary.rejected.at("non_finite"), 0u);
   size_t flagged = 0;
   for (const BrdfSample& s : result.samples) {

@@ -71,7 +71,7 @@ TEST(HugePages, AdvisedRangeIsEligibleWhereTheKernelOffersThem) {
   const int eligible = ThpEligible(middle);
   if (eligible < 0) GTEST_SKIP() << "/proc/self/smaps has no THPeligible field on this kernel";
   EXPECT_EQ(eligible, 1);
-  // Issue 15: the buffer's first and last pages too (the advice is widened to whole 2 MiB pages), for
+  // The buffer's first and last pages too (the advice is widened to whole 2 MiB pages), for
   // an odd size and an element that does not divide 2 MiB.
   struct Row {
     char bytes[76];

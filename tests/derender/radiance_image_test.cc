@@ -59,7 +59,7 @@ TEST(RadianceImage, SrgbBlackLevelExposureAndGain) {
   EXPECT_TRUE(image.exposures_used.empty());
 }
 
-// Issue 13, part 8: the floor is per channel and tested on the expected signal (the ring of 16
+// The floor is per channel and tested on the expected signal (the ring of 16
 // neighbours at distance 2), not on the pixel's own value, so a reading that happens to be high under
 // the floor is not selected and a reading that happens to be low above it is kept; a clipped channel
 // leaves the others measured.
@@ -362,8 +362,8 @@ TEST(RadianceImage, BracketMergesWhereUsable) {
   EXPECT_EQ(merged.flags[bright], 0);
   EXPECT_EQ(merged.exposures_used[bright], 1);
   EXPECT_NEAR(merged.radiance[3 * bright], 4.0, 1e-5);
-  // Below the floor in its own readings but not in its neighbours' (the expected signal, issue 13 part
-  // 8): the pixel-level flag (own values) says below_signal, but every channel is measured, from both
+  // Below the floor in its own readings but not in its neighbours' (the expected signal):
+  // the pixel-level flag (own values) says below_signal, but every channel is measured, from both
   // exposures, at its true value: the floor selects on the expected signal, not on the reading.
   const size_t dark = merged.Index(2, 2);
   EXPECT_EQ(merged.flags[dark], kPixelBelowSignal);
@@ -404,7 +404,7 @@ std::vector<PhotoSpec> NoisyBracket(const ScratchDir& dir, int width, int height
   return bracket;
 }
 
-// Issue 15: the derenderer merges only the pixels it needs (RadianceReader::PrepareWindow and
+// The derenderer merges only the pixels it needs (RadianceReader::PrepareWindow and
 // RadianceWindow::At); each must read exactly what ReadWindow stores for it, for single photos and
 // brackets, in windows at the photo's edges, inside it, and too small for a ring.
 TEST(RadianceImage, WindowMergedOnDemandIsReadWindowBitForBit) {

@@ -1,4 +1,4 @@
-// The radiometry must-shows (issue 5): a session photographed with an sRGB response, a black level,
+// The radiometry must-shows: a session photographed with an sRGB response, a black level,
 // vignetting and an unknown light, once calibrated (flat field, white reference), measures the BRDF as
 // well as a linear session does and is visibly wrong without calibration; a glossy highlight that
 // clips a single exposure is recovered from a bracket of three; bad calibration input is refused.
@@ -160,8 +160,9 @@ TEST(Radiometry, BracketRecoversClippedHighlight) {
   EXPECT_GT(double(within) / total, 0.92);
   EXPECT_LT(double(within) / total, 0.98);
   // The single exposure clips the highlight in green and blue: their measured values stop well short
-  // of the peak (the bound per pixel was half the peak; per channel, green's last measured value is 57 %). Red does not clip there; with per-channel validity (issue 13)
-  // it is kept and measured, and must read the truth at the highlight.
+  // of the peak (the bound per pixel was half the peak; per channel, green's last measured value is
+  // 57 %). Red does not clip there; with per-channel validity it is kept and measured, and must read the
+  // truth at the highlight.
   EXPECT_GT(one.summary.rejected.at("saturated"), 0u);
   Eigen::Vector3d single_peak = Eigen::Vector3d::Zero(), channel_peak = Eigen::Vector3d::Zero();
   for (const BrdfSample& s : merged.samples) channel_peak = channel_peak.cwiseMax(truth_of(s));

@@ -1,4 +1,4 @@
-// End to end through the stage libraries on irregular synthetic samples (issue 5): synth a squash with a
+// End to end through the stage libraries on irregular synthetic samples: synth a squash with a
 // simulated range scan 10 km out -> scan -> align (camera poses, light, and the mesh's registration by
 // the markers the scanner saw) -> derender on the scanned mesh -> samples against the true BRDF; the
 // same on the true geometry; and a dented sphere's self-shadows with visibility off and on.

@@ -1,4 +1,4 @@
-// Honest tables (issue 14, part 1) and MERL tables as materials (part 5), on a real-style session
+// Honest tables and MERL tables as materials, on a real-style session
 // whose cameras stay within 45 degrees of the light (theta_d under 25 degrees): no cell beyond the
 // samples' theta_d is written as measured, domain.npy and the summary agree, --fill model fills the
 // unmeasured cells and says so; a MERL table reads back as a material that looks up as the MERL reader,

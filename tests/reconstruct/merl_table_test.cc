@@ -97,7 +97,7 @@ TEST(MerlTable, BadFilesAreClearErrors) {
   EXPECT_THROW(ReadMerl(dir / "missing.binary"), Error);
 }
 
-// Issue 17: a NaN in a table was read silently; now an Error naming the file and the value's index.
+// A NaN in a table must not be read silently: an Error naming the file and the value's index.
 TEST(MerlTable, NonFiniteValueIsAnError) {
   ScratchDir dir;
   MerlTable table;

@@ -327,7 +327,7 @@ TEST_F(ReportTest, ExplorerSliderChangesTheCurveAsTheTableSays) {
           << "theta_i " << theta << ", x " << x;
       ++compared;
     }
-    // Enough table cells to compare: the honest table (issue 14) leaves the unmeasured ones at -1
+    // Enough table cells to compare: the honest table leaves the unmeasured ones at -1
     // (drawn as gaps, checked above), which at theta_i 15 leaves 93 of the 179 directions.
     EXPECT_GT(compared, 80) << theta;
     EXPECT_GT(drawn.at("samples").get<int>(), 0) << theta;

@@ -243,7 +243,7 @@ TEST(PlyIo, MalformedHeadersAreErrors) {
   ExpectPlyError(dir / "f.ply", "'x' is not a number");
 }
 
-// Issue 17: a 300-byte file declaring a 100000 x 20000 range grid allocated 8 GB before reading data.
+// A 300-byte file declaring a 100000 x 20000 range grid must not allocate 8 GB before reading data.
 TEST(PlyIo, CountsAreCheckedAgainstTheFileSizeBeforeAllocating) {
   ScratchDir dir;
   WriteText(dir / "huge.ply",
@@ -259,7 +259,7 @@ TEST(PlyIo, CountsAreCheckedAgainstTheFileSizeBeforeAllocating) {
   ExpectPlyError(dir / "huge_binary.ply", "vertex entries need at least 12 bytes");
 }
 
-// Issue 17: negative range-grid indices and NaN quality were accepted silently.
+// Negative range-grid indices and NaN quality must not be accepted silently.
 TEST(PlyIo, NegativeIndicesAndNonFiniteValuesAreErrors) {
   ScratchDir dir;
   WriteText(dir / "g.ply",

@@ -186,7 +186,7 @@ TEST_F(SummaryTest, AbsentOptionalKeysAndFiles) {
   EXPECT_EQ(summary["truth"]["brdf_coverage"], 0.5);
 }
 
-// Derender's exposure advice (issue 13, part 8) reaches summary.json and the headline; a sidecar
+// Derender's exposure advice reaches summary.json and the headline; a sidecar
 // without it (older runs) gives an empty list.
 TEST_F(SummaryTest, ExposureWarningsReachTheHeadline) {
   EXPECT_TRUE(Build()["samples"]["exposure_warnings"].empty());
