@@ -126,7 +126,7 @@ TEST_F(LightSideSphere, KnownRadiusOnPixelCentreRender) {
   EXPECT_TRUE(result.sphere.radius_fixed);
   EXPECT_LT(center_error, 0.1e-3);  // the threshold edge's 0.066 mm, not worse by half
   if (center_error >= 0.05e-3) {
-    GTEST_SKIP() << "KNOWN MISS (issue 13, pixel-centre render only): centre error " << 1e3 * center_error
+    GTEST_SKIP() << "KNOWN MISS (pixel-centre render only): centre error " << 1e3 * center_error
                  << " mm with a known radius, bound 0.05 mm; the area-sampled render meets it";
   }
 }
