@@ -13,6 +13,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <memory>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
@@ -111,25 +113,26 @@ void BM_DerenderSession(benchmark::State& state) {
   SetRates(state, session, samples);
 }
 
-// The per-pixel geometry alone, on radiance images decoded and linearized beforehand, one thread.
+// The per-pixel kernel alone (the stage's DerenderSetup::DerenderPhoto, one thread), on photos decoded
+// and prepared beforehand (DerenderSetup::ReadPhoto): the geometry, the merge of the pixels that reach
+// the radiometric tests and the samples' assembly.
 void BM_DerenderDecodedPhotos(benchmark::State& state) {
   const Session& session = BenchSession(false);
-  std::vector<RadianceImage> images;
-  for (size_t i = 0; i < session.photos.size(); ++i) {
-    images.push_back(ReadRadianceImage(session, {i}, DerenderOptions().min_signal));
+  const DerenderSetup setup(session, DerenderOptions());
+  std::vector<std::unique_ptr<RadianceWindow>> images;
+  for (size_t i = 0; i < setup.NumPhotos(); ++i) {
+    images.push_back(std::make_unique<RadianceWindow>());
+    setup.ReadPhoto(i, images.back().get());
   }
-  const std::vector<Eigen::Vector2f> rays = PixelRays(session.camera);
-  const auto sample = AnalyticSample::Create(session.sample);
+  PhotoSamples photo;
   uint64_t samples = 0;
   for (auto _ : state) {
-    std::vector<BrdfSample> out;
-    out.reserve(size_t(session.camera.width) * session.camera.height * images.size());
-    RejectionCounts rejected;
+    samples = 0;
     for (size_t i = 0; i < images.size(); ++i) {
-      DerenderPhoto(session, i, images[i], rays, *sample, DerenderOptions(), &out, &rejected);
+      setup.DerenderPhoto(i, *images[i], false, &photo);
+      for (const std::vector<BrdfSample>& block : photo.blocks) samples += block.size();
+      benchmark::DoNotOptimize(photo.blocks.data());
     }
-    samples = out.size();
-    benchmark::DoNotOptimize(out.data());
   }
   SetRates(state, session, samples);
 }

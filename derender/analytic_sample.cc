@@ -1,21 +1,30 @@
 #include "derender/analytic_sample.h"
 
 #include <cmath>
+#include <type_traits>
 
 #include "core/error.h"
 
 namespace ibrdf {
 
-std::unique_ptr<AnalyticSample> AnalyticSample::Create(const SampleSpec& spec) {
+AnalyticShape MakeAnalyticShape(const SampleSpec& spec) {
   switch (spec.kind) {
     case SampleSpec::Kind::kSphere:
-      return std::make_unique<SphereSample>(spec.center, spec.radius);
+      return SphereSample(spec.center, spec.radius);
     case SampleSpec::Kind::kCylinder:
-      return std::make_unique<CylinderSample>(spec.center, spec.axis, spec.radius, spec.length);
+      return CylinderSample(spec.center, spec.axis, spec.radius, spec.length);
     case SampleSpec::Kind::kMesh:
       break;
   }
   ThrowError("sample", "a mesh sample needs the mesh derenderer; the analytic derenderer takes a sphere or a cylinder");
+}
+
+std::unique_ptr<AnalyticSample> AnalyticSample::Create(const SampleSpec& spec) {
+  return std::visit(
+      [](const auto& shape) -> std::unique_ptr<AnalyticSample> {
+        return std::make_unique<std::decay_t<decltype(shape)>>(shape);
+      },
+      MakeAnalyticShape(spec));
 }
 
 bool SphereSample::Contains(const Eigen::Vector3d& point) const {

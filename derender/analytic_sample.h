@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <memory>
+#include <variant>
 
 #include <Eigen/Core>
 
@@ -133,5 +134,12 @@ inline bool CylinderSample::Intersect(const Eigen::Vector3d& origin, const Eigen
   hit->normal = ((f_perp + t * d_perp) / radius_).normalized();
   return true;
 }
+
+// A sphere or a cylinder by value: a caller that picks the shape once and then calls its inline
+// Intersect per pixel (the derenderer's kernel, through std::visit) holds this, not a base pointer.
+using AnalyticShape = std::variant<SphereSample, CylinderSample>;
+
+// The session's sphere or cylinder; throws Error for a mesh sample.
+AnalyticShape MakeAnalyticShape(const SampleSpec& spec);
 
 }  // namespace ibrdf

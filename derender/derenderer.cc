@@ -9,6 +9,9 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <type_traits>
+#include <variant>
 
 #include <tbb/blocked_range.h>
 #include <tbb/concurrent_queue.h>
@@ -160,38 +163,10 @@ inline double HalfAngle(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo, co
   return std::acos(std::clamp(h.dot(normal), -1.0, 1.0));
 }
 
-// A photo's radiometry as the per-pixel loops read it: a radiance image merged beforehand (the public
-// DerenderPhoto), or a window whose pixels are merged on demand (the stage's pipeline), with the same
-// values either way.
-class ImagePixels {
- public:
-  explicit ImagePixels(const RadianceImage& image) : image_(image) {}
-  // Whether the photos' masks exclude pixel (x, y).
-  bool Masked(int x, int y) const { return !image_.mask.empty() && !image_.mask[image_.Index(x, y)]; }
-  // The merged reading of pixel (x, y).
-  void At(int x, int y, PixelRadiance* v) const {
-    const size_t p = image_.Index(x, y);
-    for (int c = 0; c < 3; ++c) {
-      v->radiance[c] = image_.radiance[3 * p + c];
-      v->sigma[c] = image_.sigma[3 * p + c];
-      v->channel_flags[c] = image_.channel_flags[3 * p + c];
-    }
-    v->exposures = image_.exposures_used.empty() ? 1 : image_.exposures_used[p];
-  }
-
- private:
-  const RadianceImage& image_;
-};
-
-class WindowPixels {
- public:
-  explicit WindowPixels(const RadianceWindow& window) : window_(window) {}
-  bool Masked(int x, int y) const { return !window_.mask.empty() && !window_.mask[size_t(y) * window_.width() + x]; }
-  void At(int x, int y, PixelRadiance* v) const { window_.At(x, y, v); }
-
- private:
-  const RadianceWindow& window_;
-};
+// Whether the photos' masks exclude pixel (x, y).
+inline bool Masked(const RadianceWindow& image, int x, int y) {
+  return !image.mask.empty() && !image.mask[size_t(y) * image.width() + x];
+}
 
 // f = L / E per channel, in the local frame of `normal`.
 inline BrdfSample MakeSample(const PixelRadiance& pixel, const Eigen::Vector3d& normal, const Incidence& incidence,
@@ -225,11 +200,11 @@ uint64_t PixelsPerImage(const Camera& camera, int stride) {
   return uint64_t((camera.width + stride - 1) / stride) * uint64_t((camera.height + stride - 1) / stride);
 }
 
-// One photo as the per-pixel loops see it: its pose, light and grazing limits, and the pixels traced
+// One photo as the per-pixel kernel sees it: its pose, light and grazing limits, and the pixels traced
 // (those of its sample box on the stride's grid; the others cannot see the sample).
 struct PhotoView {
   PhotoView(const Session& session, size_t photo_index, const DerenderOptions& options, const SampleSurface& sample)
-      : light(session.PhotoLight(photo_index)) {
+      : light(session.PhotoLight(photo_index)), stride(options.pixel_stride) {
     const Rigid3d& camera_from_world = *session.photos[photo_index].camera_from_world;
     const Rigid3d world_from_camera = camera_from_world.Inverse();
     world_from_camera_rotation = world_from_camera.rotation.toRotationMatrix();
@@ -237,9 +212,10 @@ struct PhotoView {
     cos_max_i = std::cos(options.max_theta_i_deg * kDegree);
     cos_max_e = std::cos(options.max_theta_e_deg * kDegree);
     box = SampleBox(session.camera, camera_from_world, sample);
-    const int stride = options.pixel_stride;
     x_start = (box.x0 + stride - 1) / stride * stride;
     y_start = (box.y0 + stride - 1) / stride * stride;
+    columns = box.x1 > x_start ? (box.x1 - x_start + stride - 1) / stride : 0;
+    rows = box.y1 > y_start && columns > 0 ? (box.y1 - y_start + stride - 1) / stride : 0;
   }
   // The unit world direction of the ray through the undistorted image-plane point `xy`.
   Eigen::Vector3d Direction(const Eigen::Vector2f& xy) const {
@@ -247,11 +223,21 @@ struct PhotoView {
   }
 
   const Light& light;
+  int stride = 1;
   Eigen::Matrix3d world_from_camera_rotation;
   Eigen::Vector3d camera_center;
   double cos_max_i = 0.0, cos_max_e = 0.0;  // cosines of the grazing limits
   PixelBox box;                             // the pixels that can see the sample
   int x_start = 0, y_start = 0;             // the box's first column and row on the stride's grid
+  int columns = 0, rows = 0;                // pixels traced per row, rows traced (0 x 0 when none)
+};
+
+// What the kernel counts per block of rows.
+struct BlockStats {
+  ReasonCounts counts{};
+  ExposureTally exposure;
+  uint64_t shadow_rays = 0;
+  uint64_t shadow_tests_skipped = 0;
 };
 
 // Everything the mesh path prepares once per session.
@@ -262,13 +248,6 @@ struct MeshPath {
   std::string visibility_reason;
   std::vector<Eigen::Vector2f> corner_rays;  // PixelCornerRays, when mixed pixels are masked
   double half_diagonal = 0.0;                // a pixel's half-diagonal, radians (image centre)
-};
-
-struct MeshPhotoStats {
-  ReasonCounts counts{};
-  uint64_t shadow_rays = 0;
-  uint64_t shadow_tests_skipped = 0;
-  ExposureTally exposure;
 };
 
 // Whether the light reaches `point` (on the surface, normal `normal`, fit residual `fit_rms_m`):
@@ -295,199 +274,203 @@ Reason ShadowTest(const MeshSample& mesh, const Light& light, const Incidence& i
   return kNumReasons;
 }
 
-// The mesh path's per-pixel work for one photo: rows of pixels in blocks across threads, each row's
-// rays handed to Embree together. `blocks` gets the samples of each block of rows in row-major order
-// (resized to the block count; the inner buffers are reused from photo to photo, so their samples are
-// copied once, into the stage's result, and their memory is touched once per run).
-template <class Pixels>
-void DerenderMeshPhoto(const Session& session, size_t photo_index, const Pixels& image,
-                       const std::vector<Eigen::Vector2f>& rays, const MeshPath& path, const DerenderOptions& options,
-                       std::vector<std::vector<BrdfSample>>* blocks_out, MeshPhotoStats* stats) {
-  const MeshSample& mesh = *path.mesh;
-  const PhotoView view(session, photo_index, options, mesh);
-  const int width = session.camera.width;
-  const bool mask_mixed = options.mask_mixed_pixels && !path.corner_rays.empty();
+// The sample geometries of the per-pixel kernel. Each is a per-photo type whose nested Tracer (made
+// once per block of rows, on the block's thread) gives the kernel, all inlined into its pixel loop:
+//   bool BeginRow(int y): prepares row y; false when no pixel of the row hits the sample;
+//   const SurfaceHit* Trace(int i, int x, Eigen::Vector3d* direction): pixel i (column x) of the row:
+//     its ray's unit world direction and its hit, or null for a miss;
+//   Reason BeforeLight(int x, const SurfaceHit&, const Eigen::Vector3d& direction): the geometry's own
+//     rejections ahead of the light's (mesh: mixed pixels, markers in front, poor normals, back faces);
+//   Reason AfterGrazing(const SurfaceHit&, const Incidence&, BlockStats*): its rejections after the
+//     grazing tests (mesh: shadows).
+// kNumReasons: none applies.
 
-  std::vector<int> xs, ys;
-  for (int x = view.x_start; x < view.box.x1; x += options.pixel_stride) xs.push_back(x);
-  for (int y = view.y_start; y < view.box.y1; y += options.pixel_stride) ys.push_back(y);
-  const uint64_t examined = PixelsPerImage(session.camera, options.pixel_stride);
-  stats->counts[kOff] += examined - uint64_t(xs.size()) * ys.size();
-  for (std::vector<BrdfSample>& block : *blocks_out) block.clear();
-  if (xs.empty() || ys.empty()) return;
-  // Corner columns used by the row's pixels: x and x + 1 of each.
-  std::vector<int> corner_xs;
-  for (int x : xs) {
-    if (corner_xs.empty() || corner_xs.back() != x) corner_xs.push_back(x);
-    corner_xs.push_back(x + 1);
-  }
-  std::vector<int> corner_index(size_t(width) + 1, -1);
-  for (size_t k = 0; k < corner_xs.size(); ++k) corner_index[corner_xs[k]] = int(k);
+// A sphere or cylinder (Shape: the concrete type, so its Intersect is inlined), one ray at a time.
+template <class Shape>
+struct AnalyticPhoto {
+  const Shape& shape;
+  const std::vector<Eigen::Vector2f>& rays;
+  int width;
 
-  // A block's first row traces its top corners anew (the rows inside a block share them), so blocks
-  // are long enough to make that cheap and many enough (tens per photo) to balance the threads.
-  constexpr int kRowsPerBlock = 16;
-  const size_t blocks = (ys.size() + kRowsPerBlock - 1) / kRowsPerBlock;
-  if (blocks_out->size() < blocks) blocks_out->resize(blocks);
-  std::vector<std::vector<BrdfSample>>& block_samples = *blocks_out;
-  std::vector<MeshPhotoStats> block_stats(blocks);
-  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
-    std::vector<BrdfSample>& out = block_samples[b];
-    MeshPhotoStats& local = block_stats[b];
-    const size_t nx = xs.size(), nc = corner_xs.size();
-    std::vector<Eigen::Vector3d> directions(nx), corner_directions(nc);
-    std::vector<SurfaceHit> hits(nx);
-    std::unique_ptr<bool[]> found(new bool[nx]);
-    // Corner distances (NaN: the corner ray misses) of the rows above and below the pixel row.
-    std::vector<double> top(nc), bottom(nc);
-    int bottom_row = -1;
-    auto trace_corners = [&](int row, std::vector<double>* depths) {
-      for (size_t k = 0; k < nc; ++k) {
-        const Eigen::Vector2f& xy = path.corner_rays[size_t(row) * (width + 1) + corner_xs[k]];
-        corner_directions[k] = view.Direction(xy);
-      }
-      mesh.DepthBatch(view.camera_center, corner_directions.data(), nc, depths->data());
-    };
-    const size_t row_end = std::min(ys.size(), (b + 1) * kRowsPerBlock);
-    // No regrowth: each copy costs more than the pixel's work.
-    ReserveWithHugePages(&out, nx * (row_end - b * kRowsPerBlock));
-    for (size_t r = b * kRowsPerBlock; r < row_end; ++r) {
-      const int y = ys[r];
-      for (size_t i = 0; i < nx; ++i) {
-        const Eigen::Vector2f& xy = rays[size_t(y) * width + xs[i]];
-        directions[i] = view.Direction(xy);
-      }
-      mesh.IntersectBatch(view.camera_center, directions.data(), nx, hits.data(), found.get());
-      bool any_hit = false;
-      for (size_t i = 0; i < nx; ++i) any_hit |= found[i];
-      if (!any_hit) {
-        local.counts[kOff] += nx;
-        continue;
-      }
-      if (mask_mixed) {
-        if (bottom_row == y) {
-          top.swap(bottom);
-        } else {
-          trace_corners(y, &top);
-        }
-        trace_corners(y + 1, &bottom);
-        bottom_row = y + 1;
-      }
-      for (size_t i = 0; i < nx; ++i) {
-        const int x = xs[i];
-        if (!found[i]) {
-          ++local.counts[kOff];
-          continue;
-        }
-        if (image.Masked(x, y)) {
-          ++local.counts[kMasked];
-          continue;
-        }
-        const SurfaceHit& hit = hits[i];
-        const Eigen::Vector3d& direction = directions[i];
-        if (mask_mixed) {
-          const double tolerance = options.mixed_pixel_depth_factor * hit.t * path.half_diagonal;
-          const int k0 = corner_index[x], k1 = corner_index[x + 1];
-          const double corners[4] = {top[k0], top[k1], bottom[k0], bottom[k1]};
-          bool mixed = false;
-          for (double t : corners) mixed |= !(std::abs(t - hit.t) <= tolerance);  // NaN (a miss) is mixed
-          if (mixed) {
-            ++local.counts[kMixed];
-            continue;
-          }
-        }
-        if (path.occluders && path.occluders->Blocks(view.camera_center, direction, hit.t)) {
-          ++local.counts[kTarget];
-          continue;
-        }
-        const bool no_fit = hit.fit_neighbours >= 0 && hit.fit_neighbours < options.min_fit_neighbours;
-        const bool poor_fit = options.max_normal_fit_rms_m > 0.0 && hit.fit_rms_m > options.max_normal_fit_rms_m;
-        if (hit.normal.isZero(0.0) || no_fit || poor_fit) {
-          ++local.counts[kLowQuality];
-          continue;
-        }
-        const Eigen::Vector3d wo_world = -direction;
-        const double cos_e = wo_world.dot(hit.normal);
-        if (!(cos_e > 0.0) || !(wo_world.dot(hit.geometric_normal) > 0.0)) {
-          ++local.counts[kBackfacing];
-          continue;
-        }
-        const Incidence incidence = IncidenceAt(view.light, hit.point, hit.normal);
-        if (!incidence.lit) {
-          ++local.counts[kUnlit];
-          continue;
-        }
-        if (!(cos_e >= view.cos_max_e)) {
-          ++local.counts[kGrazingE];
-          continue;
-        }
-        if (!(incidence.cos_theta >= view.cos_max_i)) {
-          ++local.counts[kGrazingI];
-          continue;
-        }
-        if (path.shadow_rays) {
-          const Reason shadow = ShadowTest(mesh, view.light, incidence, hit.point, hit.normal, hit.fit_rms_m, options,
-                                           &local.shadow_rays);
-          if (shadow != kNumReasons) {
-            ++local.counts[shadow];
-            continue;
-          }
-        } else {
-          ++local.shadow_tests_skipped;
-        }
-        PixelRadiance pixel;
-        image.At(x, y, &pixel);
-        local.exposure.Add(HalfAngle(incidence.wi, wo_world, hit.normal), pixel.channel_flags);
-        const Reason radiometric = RadiometricReason(pixel.channel_flags);
-        if (radiometric != kNumReasons) {
-          ++local.counts[radiometric];
-          continue;
-        }
-        out.push_back(MakeSample(pixel, hit.normal, incidence, wo_world, photo_index, x, y));
-      }
+  class Tracer {
+   public:
+    Tracer(const AnalyticPhoto& photo, const PhotoView& view) : photo_(photo), view_(view) {}
+    bool BeginRow(int y) {
+      y_ = y;
+      return true;
     }
-  });
-  for (size_t b = 0; b < blocks; ++b) {
-    for (int r = 0; r < kNumReasons; ++r) stats->counts[r] += block_stats[b].counts[r];
-    stats->shadow_rays += block_stats[b].shadow_rays;
-    stats->shadow_tests_skipped += block_stats[b].shadow_tests_skipped;
-    stats->exposure.Merge(block_stats[b].exposure);
-  }
-}
+    const SurfaceHit* Trace(int, int x, Eigen::Vector3d* direction) {
+      *direction = view_.Direction(photo_.rays[size_t(y_) * photo_.width + x]);
+      return photo_.shape.Intersect(view_.camera_center, *direction, &hit_) ? &hit_ : nullptr;
+    }
+    Reason BeforeLight(int, const SurfaceHit&, const Eigen::Vector3d&) const { return kNumReasons; }
+    Reason AfterGrazing(const SurfaceHit&, const Incidence&, BlockStats*) const { return kNumReasons; }
 
-// The analytic path's per-pixel work on the traced rows y_begin, y_begin + stride, ... below y_end of
-// one photo (`view`), for a surface of type Surface (a concrete analytic shape: its Intersect is inlined
-// into the pixel loop) and either kind of radiometry (ImagePixels, WindowPixels): appends the accepted
-// samples in row-major order, counts the rejections and (when `exposure` is given) tallies the pixels
-// that reach the radiometric tests. Returns the number of pixels traced.
-template <class Pixels, class Surface>
-uint64_t DerenderAnalyticRows(const Session& session, size_t photo_index, const PhotoView& photo_view,
-                              const Pixels& image, const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
-                              int stride, int y_begin, int y_end, std::vector<BrdfSample>* samples,
-                              ReasonCounts* reason_counts, ExposureTally* exposure) {
+   private:
+    const AnalyticPhoto& photo_;
+    const PhotoView& view_;
+    int y_ = 0;
+    SurfaceHit hit_;  // reused: Intersect sets every field it reports
+  };
+};
+
+// The scanned mesh: each row's rays handed to Embree together, the mixed-pixel test on the depths of
+// the pixel corners (the rows inside a block share them), the marker, normal-quality and back-face
+// masks, and (visibility on) shadow rays.
+class MeshPhoto {
+ public:
+  MeshPhoto(const MeshPath& path, const PhotoView& view, const std::vector<Eigen::Vector2f>& rays, int width,
+            const DerenderOptions& options)
+      : path_(path), rays_(rays), width_(width), options_(options),
+        mask_mixed_(options.mask_mixed_pixels && !path.corner_rays.empty()) {
+    // Corner columns used by the row's pixels: x and x + 1 of each.
+    for (int i = 0; i < view.columns; ++i) {
+      const int x = view.x_start + i * view.stride;
+      if (corner_xs_.empty() || corner_xs_.back() != x) corner_xs_.push_back(x);
+      corner_xs_.push_back(x + 1);
+    }
+    corner_index_.assign(size_t(width) + 1, -1);
+    for (size_t k = 0; k < corner_xs_.size(); ++k) corner_index_[corner_xs_[k]] = int(k);
+  }
+
+  class Tracer {
+   public:
+    Tracer(const MeshPhoto& photo, const PhotoView& view)
+        : photo_(photo), view_(view), mesh_(*photo.path_.mesh), nx_(size_t(view.columns)),
+          directions_(nx_), hits_(nx_), found_(new bool[nx_]), corner_directions_(photo.corner_xs_.size()),
+          top_(photo.corner_xs_.size()), bottom_(photo.corner_xs_.size()) {}
+
+    bool BeginRow(int y) {
+      for (size_t i = 0; i < nx_; ++i) {
+        const Eigen::Vector2f& xy = photo_.rays_[size_t(y) * photo_.width_ + view_.x_start + int(i) * view_.stride];
+        directions_[i] = view_.Direction(xy);
+      }
+      mesh_.IntersectBatch(view_.camera_center, directions_.data(), nx_, hits_.data(), found_.get());
+      bool any_hit = false;
+      for (size_t i = 0; i < nx_; ++i) any_hit |= found_[i];
+      if (!any_hit) return false;
+      if (photo_.mask_mixed_) {
+        if (bottom_row_ == y) {
+          top_.swap(bottom_);
+        } else {
+          TraceCorners(y, &top_);
+        }
+        TraceCorners(y + 1, &bottom_);
+        bottom_row_ = y + 1;
+      }
+      return true;
+    }
+
+    const SurfaceHit* Trace(int i, int, Eigen::Vector3d* direction) const {
+      *direction = directions_[i];
+      return found_[i] ? &hits_[i] : nullptr;
+    }
+
+    Reason BeforeLight(int x, const SurfaceHit& hit, const Eigen::Vector3d& direction) const {
+      const DerenderOptions& options = photo_.options_;
+      if (photo_.mask_mixed_) {
+        const double tolerance = options.mixed_pixel_depth_factor * hit.t * photo_.path_.half_diagonal;
+        const int k0 = photo_.corner_index_[x], k1 = photo_.corner_index_[x + 1];
+        const double corners[4] = {top_[k0], top_[k1], bottom_[k0], bottom_[k1]};
+        bool mixed = false;
+        for (double t : corners) mixed |= !(std::abs(t - hit.t) <= tolerance);  // NaN (a miss) is mixed
+        if (mixed) return kMixed;
+      }
+      if (photo_.path_.occluders && photo_.path_.occluders->Blocks(view_.camera_center, direction, hit.t)) {
+        return kTarget;
+      }
+      const bool no_fit = hit.fit_neighbours >= 0 && hit.fit_neighbours < options.min_fit_neighbours;
+      const bool poor_fit = options.max_normal_fit_rms_m > 0.0 && hit.fit_rms_m > options.max_normal_fit_rms_m;
+      if (hit.normal.isZero(0.0) || no_fit || poor_fit) return kLowQuality;
+      const Eigen::Vector3d wo_world = -direction;
+      if (!(wo_world.dot(hit.normal) > 0.0) || !(wo_world.dot(hit.geometric_normal) > 0.0)) return kBackfacing;
+      return kNumReasons;
+    }
+
+    Reason AfterGrazing(const SurfaceHit& hit, const Incidence& incidence, BlockStats* stats) const {
+      if (!photo_.path_.shadow_rays) {
+        ++stats->shadow_tests_skipped;
+        return kNumReasons;
+      }
+      return ShadowTest(mesh_, view_.light, incidence, hit.point, hit.normal, hit.fit_rms_m, photo_.options_,
+                        &stats->shadow_rays);
+    }
+
+   private:
+    // The corner distances (NaN: the corner ray misses) of corner row `row`.
+    void TraceCorners(int row, std::vector<double>* depths) {
+      const size_t nc = photo_.corner_xs_.size();
+      for (size_t k = 0; k < nc; ++k) {
+        const Eigen::Vector2f& xy = photo_.path_.corner_rays[size_t(row) * (photo_.width_ + 1) + photo_.corner_xs_[k]];
+        corner_directions_[k] = view_.Direction(xy);
+      }
+      mesh_.DepthBatch(view_.camera_center, corner_directions_.data(), nc, depths->data());
+    }
+
+    const MeshPhoto& photo_;
+    const PhotoView& view_;
+    const MeshSample& mesh_;
+    const size_t nx_;
+    std::vector<Eigen::Vector3d> directions_;
+    std::vector<SurfaceHit> hits_;
+    std::unique_ptr<bool[]> found_;
+    std::vector<Eigen::Vector3d> corner_directions_;
+    // Corner distances of the rows above and below the pixel row.
+    std::vector<double> top_, bottom_;
+    int bottom_row_ = -1;
+  };
+
+ private:
+  const MeshPath& path_;
+  const std::vector<Eigen::Vector2f>& rays_;
+  const int width_;
+  const DerenderOptions& options_;
+  const bool mask_mixed_;
+  std::vector<int> corner_xs_;
+  std::vector<int> corner_index_;  // per corner column of the image: its index in corner_xs_, or -1
+};
+
+// The per-pixel kernel, for every geometry (Geometry: AnalyticPhoto or MeshPhoto), on rows
+// [row_begin, row_end) of the photo's traced rows: appends the accepted samples in row-major order to
+// `samples`, counts the rejections, under the first reason in RejectionReasons() order that applies,
+// and tallies the pixels that reach the radiometric tests. The hot loop of the stage.
+template <class Geometry>
+void DerenderRows(const Geometry& geometry, const PhotoView& photo_view, const RadianceWindow& image,
+                  size_t photo_index, int row_begin, int row_end, std::vector<BrdfSample>* samples,
+                  BlockStats* stats) {
   const PhotoView view = photo_view;  // a local copy: its fields stay in registers across the stores below
+  typename Geometry::Tracer tracer(geometry, view);
   ReasonCounts counts{};
-  uint64_t traced = 0;
-  SurfaceHit hit;  // reused: Intersect sets every field it reports
-  for (int y = y_begin; y < y_end; y += stride) {
-    for (int x = view.x_start; x < view.box.x1; x += stride) {
-      ++traced;
-      const Eigen::Vector3d direction = view.Direction(rays[size_t(y) * session.camera.width + x]);
-      if (!sample.Intersect(view.camera_center, direction, &hit)) {
+  for (int r = row_begin; r < row_end; ++r) {
+    const int y = view.y_start + r * view.stride;
+    if (!tracer.BeginRow(y)) {
+      counts[kOff] += view.columns;
+      continue;
+    }
+    for (int i = 0; i < view.columns; ++i) {
+      const int x = view.x_start + i * view.stride;
+      Eigen::Vector3d direction;
+      const SurfaceHit* hit = tracer.Trace(i, x, &direction);
+      if (!hit) {
         ++counts[kOff];
         continue;
       }
-      if (image.Masked(x, y)) {
+      if (Masked(image, x, y)) {
         ++counts[kMasked];
         continue;
       }
-      const Incidence incidence = IncidenceAt(view.light, hit.point, hit.normal);
+      const Reason surface = tracer.BeforeLight(x, *hit, direction);
+      if (surface != kNumReasons) {
+        ++counts[surface];
+        continue;
+      }
+      const Incidence incidence = IncidenceAt(view.light, hit->point, hit->normal);
       if (!incidence.lit) {
         ++counts[kUnlit];
         continue;
       }
       const Eigen::Vector3d wo_world = -direction;
-      const double cos_e = wo_world.dot(hit.normal);
+      const double cos_e = wo_world.dot(hit->normal);
       if (!(cos_e >= view.cos_max_e)) {
         ++counts[kGrazingE];
         continue;
@@ -496,74 +479,63 @@ uint64_t DerenderAnalyticRows(const Session& session, size_t photo_index, const 
         ++counts[kGrazingI];
         continue;
       }
+      const Reason light = tracer.AfterGrazing(*hit, incidence, stats);
+      if (light != kNumReasons) {
+        ++counts[light];
+        continue;
+      }
       PixelRadiance pixel;
       image.At(x, y, &pixel);
-      if (exposure) exposure->Add(HalfAngle(incidence.wi, wo_world, hit.normal), pixel.channel_flags);
+      stats->exposure.Add(HalfAngle(incidence.wi, wo_world, hit->normal), pixel.channel_flags);
       const Reason radiometric = RadiometricReason(pixel.channel_flags);
       if (radiometric != kNumReasons) {
         ++counts[radiometric];
         continue;
       }
-      samples->push_back(MakeSample(pixel, hit.normal, incidence, wo_world, photo_index, x, y));
+      samples->push_back(MakeSample(pixel, hit->normal, incidence, wo_world, photo_index, x, y));
     }
   }
-  for (int r = 0; r < kNumReasons; ++r) (*reason_counts)[r] += counts[r];
-  return traced;
+  for (int r = 0; r < kNumReasons; ++r) stats->counts[r] += counts[r];
 }
 
-// DerenderPhoto (derenderer.h) on either kind of radiometry, one thread.
-template <class Pixels, class Surface>
-void DerenderAnalyticPhoto(const Session& session, size_t photo_index, const Pixels& image,
-                           const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
-                           const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
-                           ExposureTally* exposure) {
-  const PhotoView view(session, photo_index, options, sample);
-  const int stride = options.pixel_stride;
+// One photo's traced rows in blocks (each into its own buffer of `out`, across threads when
+// `parallel`), the blocks' counts merged into `out`. The mesh's first row of a block traces its top
+// corners anew (the rows inside a block share them), so blocks are long enough to make that cheap and
+// many enough (tens per photo) to balance the threads.
+template <class Geometry>
+void DerenderBlocks(const Geometry& geometry, const PhotoView& view, const RadianceWindow& image, size_t photo_index,
+                    uint64_t examined, bool parallel, PhotoSamples* out) {
+  constexpr int kRowsPerBlock = 16;
+  const size_t blocks = size_t(view.rows + kRowsPerBlock - 1) / kRowsPerBlock;
+  for (std::vector<BrdfSample>& block : out->blocks) block.clear();
+  if (out->blocks.size() < blocks) out->blocks.resize(blocks);
+  std::vector<BlockStats> block_stats(blocks);
+  const auto derender_block = [&](size_t b) {
+    const int first = int(b) * kRowsPerBlock, last = std::min(view.rows, first + kRowsPerBlock);
+    std::vector<BrdfSample>& samples = out->blocks[b];
+    // Room for every traced pixel: no regrowth copies (each costs more than the pixels' work).
+    ReserveWithHugePages(&samples, size_t(view.columns) * size_t(last - first));
+    DerenderRows(geometry, view, image, photo_index, first, last, &samples, &block_stats[b]);
+  };
+  if (parallel) {
+    tbb::parallel_for(size_t(0), blocks, derender_block);
+  } else {
+    for (size_t b = 0; b < blocks; ++b) derender_block(b);
+  }
   // Only the pixels that can see the sample are traced; the others are off the sample by construction.
   ReasonCounts counts{};
-  const uint64_t traced = DerenderAnalyticRows(session, photo_index, view, image, rays, sample, stride, view.y_start,
-                                               view.box.y1, samples, &counts, exposure);
-  counts[kOff] += PixelsPerImage(session.camera, stride) - traced;
-  AddCounts(counts, rejected);
-}
-
-// The same in blocks of rows across threads (the stage's pipeline: the last photos in flight use every
-// thread): `blocks` gets each block's samples in row-major order (resized to the block count; the
-// inner buffers are reused from photo to photo), the counts and the tally are summed over the blocks.
-template <class Pixels, class Surface>
-void DerenderAnalyticPhotoBlocks(const Session& session, size_t photo_index, const Pixels& image,
-                                 const std::vector<Eigen::Vector2f>& rays, const Surface& sample,
-                                 const DerenderOptions& options, std::vector<std::vector<BrdfSample>>* blocks_out,
-                                 RejectionCounts* rejected, ExposureTally* exposure) {
-  const PhotoView view(session, photo_index, options, sample);
-  const int stride = options.pixel_stride;
-  for (std::vector<BrdfSample>& block : *blocks_out) block.clear();
-  const int rows = view.box.y1 > view.y_start ? (view.box.y1 - view.y_start + stride - 1) / stride : 0;
-  const size_t columns = view.box.x1 > view.x_start ? size_t(view.box.x1 - view.x_start + stride - 1) / stride : 0;
-  constexpr int kRowsPerBlock = 16;
-  const size_t blocks = size_t(rows + kRowsPerBlock - 1) / kRowsPerBlock;
-  if (blocks_out->size() < blocks) blocks_out->resize(blocks);
-  std::vector<ReasonCounts> block_counts(blocks, ReasonCounts{});
-  std::vector<ExposureTally> block_tallies(exposure ? blocks : 0);
-  std::vector<uint64_t> block_traced(blocks, 0);
-  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
-    const int first = int(b) * kRowsPerBlock, last = std::min(rows, first + kRowsPerBlock);
-    std::vector<BrdfSample>& out = (*blocks_out)[b];
-    // Room for every traced pixel: no regrowth copies.
-    ReserveWithHugePages(&out, columns * size_t(last - first));
-    block_traced[b] = DerenderAnalyticRows(session, photo_index, view, image, rays, sample, stride,
-                                           view.y_start + first * stride, view.y_start + last * stride, &out,
-                                           &block_counts[b], exposure ? &block_tallies[b] : nullptr);
-  });
-  ReasonCounts counts{};
-  uint64_t traced = 0;
-  for (size_t b = 0; b < blocks; ++b) {
-    for (int r = 0; r < kNumReasons; ++r) counts[r] += block_counts[b][r];
-    traced += block_traced[b];
-    if (exposure) exposure->Merge(block_tallies[b]);
+  counts[kOff] = examined - uint64_t(view.rows) * uint64_t(view.columns);
+  out->rejected.clear();
+  out->exposure = ExposureTally();
+  out->shadow_rays = 0;
+  out->shadow_tests_skipped = 0;
+  for (const BlockStats& stats : block_stats) {
+    for (int r = 0; r < kNumReasons; ++r) counts[r] += stats.counts[r];
+    out->exposure.Merge(stats.exposure);
+    out->shadow_rays += stats.shadow_rays;
+    out->shadow_tests_skipped += stats.shadow_tests_skipped;
   }
-  counts[kOff] += PixelsPerImage(session.camera, stride) - traced;
-  AddCounts(counts, rejected);
+  AddCounts(counts, &out->rejected);
 }
 
 // Whether the scan's convexity report asks for shadow rays: from the scan stage's sidecar
@@ -665,13 +637,33 @@ MeshPath PrepareMeshPath(const Session& session, const DerenderOptions& options)
   return path;
 }
 
-// The stage for either path: checks, decoding across photos (exposure groups), per-pixel work, merge.
-DerenderResult RunDerender(const Session& session, const DerenderOptions& options, const SampleSurface& sample,
-                           const MeshPath* mesh_path) {
-  Timer timer;
-  DerenderResult result;
-  result.summary.sample = SampleKindName(session.sample.kind);
-  // Everything that can be checked before decoding is checked first, so a bad session fails at once.
+// The stage's set-up of one session (DerenderSetup), made before the first photo is decoded, in the
+// order its errors are reported: options, the sample's geometry, the photos' poses and lights, the
+// sample boxes, the photo files, the radiometric chain, the shared masks.
+struct Stage {
+  Stage(const Session& session, const DerenderOptions& options);
+  // The sample's surface (for the checks and the sample boxes; the kernel takes the concrete type).
+  const SampleSurface& Surface() const;
+
+  const Session& session;
+  const DerenderOptions options;
+  Timer timer;  // the stage's wall clock (the summary's total_s), from the end of the mesh's set-up
+  std::optional<AnalyticShape> analytic;  // a sphere or a cylinder
+  std::unique_ptr<MeshPath> mesh;         // a scanned mesh
+  double mesh_setup_s = 0.0;              // mesh: reading it, the ray-tracing scene, the convexity verdict
+  std::vector<std::vector<size_t>> groups;  // the photos derendered (ExposureGroups)
+  std::vector<PixelBox> boxes;              // per group: the pixels that can see the sample
+  // The rays of the pixels some group's box holds (the kernel reads no others): undistorting every
+  // pixel of the camera costs more than the geometry of the sample's pixels.
+  std::vector<Eigen::Vector2f> rays;
+  std::unique_ptr<RadianceReader> reader;
+  // Per group, a mask that several groups use (the session's default mask, usually), decoded once;
+  // null: the group's masks are read as it is worked on.
+  std::vector<std::shared_ptr<const std::vector<uint8_t>>> shared_masks;
+};
+
+// Everything about the photos that can be checked before decoding, so a bad session fails at once.
+void CheckPhotoPoses(const Session& session, const SampleSurface& sample) {
   for (size_t i = 0; i < session.photos.size(); ++i) {
     const PhotoSpec& photo = session.photos[i];
     const std::string where = session.manifest_path + ": /photos/" + std::to_string(i);
@@ -687,23 +679,62 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
                             "\"intensity\", or white-reference photos under it)");
     }
   }
-  const std::vector<std::vector<size_t>> groups = ExposureGroups(session);
+}
+
+// The masks that more than one group uses, decoded once (per group; null where none is shared).
+std::vector<std::shared_ptr<const std::vector<uint8_t>>> SharedMasks(const Session& session,
+                                                                     const std::vector<std::vector<size_t>>& groups) {
+  std::vector<std::shared_ptr<const std::vector<uint8_t>>> shared(groups.size());
+  std::map<std::vector<std::string>, std::vector<size_t>> groups_by_masks;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    std::vector<std::string> paths;
+    for (size_t i : groups[g]) paths.push_back(session.PhotoMaskPath(i));
+    groups_by_masks[paths].push_back(g);
+  }
+  for (const auto& [paths, users] : groups_by_masks) {
+    bool any_mask = false;
+    for (const std::string& path : paths) any_mask = any_mask || !path.empty();
+    if (!any_mask || users.size() < 2) continue;
+    const auto mask = std::make_shared<const std::vector<uint8_t>>(ReadGroupMask(session, groups[users.front()]));
+    for (size_t g : users) shared[g] = mask;
+  }
+  return shared;
+}
+
+Stage::Stage(const Session& session_in, const DerenderOptions& options_in)
+    : session(session_in), options(options_in) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("derender options", why);
+  switch (session.sample.kind) {
+    case SampleSpec::Kind::kSphere:
+    case SampleSpec::Kind::kCylinder:
+      analytic = MakeAnalyticShape(session.sample);
+      break;
+    case SampleSpec::Kind::kMesh: {
+      const Timer setup;
+      mesh = std::make_unique<MeshPath>(PrepareMeshPath(session, options));
+      mesh_setup_s = setup.ElapsedSeconds();
+      char seconds[32];
+      std::snprintf(seconds, sizeof(seconds), "%.2f s", mesh_setup_s);
+      Log(1, std::string("mesh set-up (read, ray-tracing scene, convexity): ") + seconds);
+      timer.Restart();
+      break;
+    }
+  }
+  CheckPhotoPoses(session, Surface());
+  groups = ExposureGroups(session);
   bool any_sees = groups.empty();
-  std::vector<PixelBox> boxes;  // per group: the pixels that can see the sample
   for (const auto& group : groups) {
-    boxes.push_back(SampleBox(session.camera, *session.photos[group.front()].camera_from_world, sample));
+    boxes.push_back(SampleBox(session.camera, *session.photos[group.front()].camera_from_world, Surface()));
     any_sees |= !boxes.back().Empty();
   }
   if (!any_sees) {
     ThrowError(session.manifest_path,
                "no photo sees the sample: its bounding sphere projects outside every "
                "measurement photo (check the sample's position" +
-                   std::string(mesh_path ? " and world_from_mesh" : "") + " and the poses)");
+                   std::string(mesh ? " and world_from_mesh" : "") + " and the poses)");
   }
   session.CheckPhotos();
-
-  // The rays of the pixels some photo's box holds (the per-pixel loops read no others): undistorting
-  // every pixel of the camera costs more than the geometry of the sample's pixels.
   PixelBox ray_box{session.camera.width, session.camera.height, 0, 0};
   for (const PixelBox& box : boxes) {
     if (box.Empty()) continue;
@@ -712,39 +743,96 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     ray_box.x1 = std::max(ray_box.x1, box.x1);
     ray_box.y1 = std::max(ray_box.y1, box.y1);
   }
-  const std::vector<Eigen::Vector2f> rays = PixelRaysInBox(session.camera, ray_box);
-  const RadianceReader reader(session);
-  // A mask that several groups use (the session's default mask, usually) is decoded once, here;
-  // masks of one group only are read as their group is worked on.
-  std::vector<std::shared_ptr<const std::vector<uint8_t>>> shared_masks(groups.size());
-  {
-    std::map<std::vector<std::string>, std::vector<size_t>> groups_by_masks;
-    for (size_t g = 0; g < groups.size(); ++g) {
-      std::vector<std::string> paths;
-      for (size_t i : groups[g]) paths.push_back(session.PhotoMaskPath(i));
-      groups_by_masks[paths].push_back(g);
-    }
-    for (const auto& [paths, users] : groups_by_masks) {
-      bool any_mask = false;
-      for (const std::string& path : paths) any_mask = any_mask || !path.empty();
-      if (!any_mask || users.size() < 2) continue;
-      const auto mask = std::make_shared<const std::vector<uint8_t>>(ReadGroupMask(session, groups[users.front()]));
-      for (size_t g : users) shared_masks[g] = mask;
+  rays = PixelRaysInBox(session.camera, ray_box);
+  reader = std::make_unique<RadianceReader>(session);
+  shared_masks = SharedMasks(session, groups);
+}
+
+const SampleSurface& Stage::Surface() const {
+  if (mesh) return *mesh->mesh;
+  return std::visit([](const auto& shape) -> const SampleSurface& { return shape; }, *analytic);
+}
+
+// DerenderSetup::ReadPhoto: each photo (exposure group) is linearized only inside the pixel box that
+// can see the sample (the kernel traces nothing outside it).
+void ReadStagePhoto(const Stage& stage, size_t group, RadianceWindow* image, double* decode_s) {
+  const PixelBox& box = stage.boxes[group];
+  std::vector<PhotoSpec> exposures;
+  for (size_t i : stage.groups[group]) exposures.push_back(stage.session.photos[i]);
+  stage.reader->PrepareWindow(exposures, stage.options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1}, image,
+                              decode_s);
+  if (stage.shared_masks[group]) {
+    image->mask = *stage.shared_masks[group];
+  } else {
+    image->mask = ReadGroupMask(stage.session, stage.groups[group]);
+  }
+}
+
+// DerenderSetup::DerenderPhoto: the kernel on the concrete geometry (a sphere's or a cylinder's
+// Intersect inlined into the pixel loop, or the mesh's batches of rays).
+void DerenderStagePhoto(const Stage& stage, size_t group, const RadianceWindow& image, bool parallel,
+                        PhotoSamples* out) {
+  const size_t photo_index = stage.groups[group].front();
+  const PhotoView view(stage.session, photo_index, stage.options, stage.Surface());
+  const uint64_t examined = PixelsPerImage(stage.session.camera, stage.options.pixel_stride);
+  const int width = stage.session.camera.width;
+  if (stage.mesh) {
+    const MeshPhoto mesh(*stage.mesh, view, stage.rays, width, stage.options);
+    DerenderBlocks(mesh, view, image, photo_index, examined, parallel, out);
+    return;
+  }
+  std::visit(
+      [&](const auto& shape) {
+        const AnalyticPhoto<std::decay_t<decltype(shape)>> analytic{shape, stage.rays, width};
+        DerenderBlocks(analytic, view, image, photo_index, examined, parallel, out);
+      },
+      *stage.analytic);
+}
+
+// The stage's summary after the last photo: totals, exposure advice, the mesh's figures and the
+// check that some pixel saw the sample.
+void FinishSummary(const Stage& stage, DerenderResult* result) {
+  DerenderSummary& summary = result->summary;
+  const size_t measured = stage.groups.size();
+  summary.photos = measured;
+  summary.pixels_examined = PixelsPerImage(stage.session.camera, stage.options.pixel_stride) * measured;
+  summary.accepted = result->samples.size();
+  bool bracketed = false;
+  for (const auto& group : stage.groups) bracketed = bracketed || group.size() > 1;
+  summary.exposure_warnings = AdviseExposure(summary.exposure, stage.options.exposure_advice, bracketed);
+  if (measured > 0 && summary.rejected["off_sample"] == summary.pixels_examined) {
+    ThrowError(stage.session.manifest_path,
+               "no photo sees the sample: every pixel's ray misses it (check the sample's "
+               "position" +
+                   std::string(stage.mesh ? " and world_from_mesh" : "") + " and the poses)");
+  }
+  if (stage.mesh) {
+    summary.mesh_faces = stage.mesh->mesh->NumFaces();
+    summary.shadow_rays_on = stage.mesh->shadow_rays;
+    summary.visibility_reason = stage.mesh->visibility_reason;
+    summary.mesh_setup_s = stage.mesh_setup_s;
+    if (!stage.mesh->shadow_rays) {
+      Log(1, "shadow rays skipped for " + std::to_string(summary.shadow_tests_skipped) + " pixels (visibility " +
+                 stage.mesh->visibility_reason + ")");
+    } else {
+      Log(1, std::to_string(summary.shadow_rays) + " shadow rays traced");
     }
   }
-  // Each photo (exposure group) is linearized only inside the pixel box that can see the sample (the
-  // per-pixel loops below trace nothing outside it). A TBB pipeline keeps a few photos in flight, so
-  // one is decoded while another's pixels are worked on; each token's buffers (decoded files,
-  // radiance image, samples) are reused from photo to photo, and the samples are appended in photo
-  // order, byte-identical to a photo-by-photo loop.
+  summary.total_s = stage.timer.ElapsedSeconds();
+}
+
+// DerenderSetup::DerenderAll. A TBB pipeline keeps a few photos in flight, so one is decoded while
+// another's pixels are worked on; each token's buffers (decoded files, radiance window, samples) are
+// reused from photo to photo, and the samples are appended in photo order, byte-identical to a
+// photo-by-photo loop.
+DerenderResult RunStage(const Stage& stage) {
+  DerenderResult result;
+  result.summary.sample = SampleKindName(stage.session.sample.kind);
+  const size_t photos = stage.groups.size();
   struct PhotoWork {
     size_t group = 0;
     RadianceWindow image;  // the decoded exposures, merged pixel by pixel on demand
-    // The photo's samples in order: one part (analytic path) or one per block of rows (mesh path).
-    std::vector<std::vector<BrdfSample>> parts;
-    RejectionCounts rejected;
-    MeshPhotoStats mesh_stats;
-    ExposureTally exposure;  // analytic path
+    PhotoSamples samples;
     double decode_s = 0.0;
     std::array<uint64_t, 3> channels_not_measured{};
   };
@@ -758,20 +846,20 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
     idle.push(w.get());
   }
   // Room for every pixel of every box: the samples never regrow, and only the pages written are touched.
-  const int stride = options.pixel_stride;
+  const int stride = stage.options.pixel_stride;
   uint64_t box_pixels = 0;
-  for (const PixelBox& box : boxes) {
+  for (const PixelBox& box : stage.boxes) {
     if (!box.Empty())
       box_pixels += uint64_t((box.x1 - box.x0 + stride - 1) / stride) * ((box.y1 - box.y0 + stride - 1) / stride);
   }
   ReserveWithHugePages(&result.samples, box_pixels);
-  ProgressBar progress("photos", groups.size());
+  ProgressBar progress("photos", photos);
   size_t next_group = 0;
   tbb::parallel_pipeline(
       tokens,
       tbb::make_filter<void,
                        PhotoWork*>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& control) -> PhotoWork* {
-        if (next_group == groups.size()) {
+        if (next_group == photos) {
           control.stop();
           return nullptr;
         }
@@ -780,105 +868,63 @@ DerenderResult RunDerender(const Session& session, const DerenderOptions& option
         w->group = next_group++;
         return w;
       }) & tbb::make_filter<PhotoWork*, PhotoWork*>(tbb::filter_mode::parallel, [&](PhotoWork* w) {
-        const size_t g = w->group;
-        const PixelBox& box = boxes[g];
-        std::vector<PhotoSpec> exposures;
-        for (size_t i : groups[g]) exposures.push_back(session.photos[i]);
-        w->rejected.clear();
-        w->mesh_stats = MeshPhotoStats();
-        w->exposure = ExposureTally();
         w->decode_s = 0.0;
-        reader.PrepareWindow(exposures, options.min_signal, PixelWindow{box.x0, box.y0, box.x1, box.y1}, &w->image,
-                             &w->decode_s);
-        if (shared_masks[g]) {
-          w->image.mask = *shared_masks[g];
-        } else {
-          w->image.mask = ReadGroupMask(session, groups[g]);
-        }
-        if (mesh_path) {
-          DerenderMeshPhoto(session, groups[g].front(), WindowPixels(w->image), rays, *mesh_path, options, &w->parts,
-                            &w->mesh_stats);
-          AddCounts(w->mesh_stats.counts, &w->rejected);
-        } else {
-          const WindowPixels pixels(w->image);
-          // The last two photos in rows blocks across threads (a thread done with its photo then
-          // takes blocks of the other's, instead of waiting; a one-photo session uses every
-          // thread); the others one per thread into one reused buffer (fewer, larger pages).
-          const bool split = g + 2 >= groups.size();
-          if (w->parts.empty()) w->parts.resize(1);
-          for (std::vector<BrdfSample>& part : w->parts) part.clear();
-          if (!split) {
-            ReserveWithHugePages(&w->parts.front(), PixelsPerImage(session.camera, options.pixel_stride));
-          }
-          const auto derender = [&](const auto& surface) {
-            if (split) {
-              DerenderAnalyticPhotoBlocks(session, groups[g].front(), pixels, rays, surface, options, &w->parts,
-                                          &w->rejected, &w->exposure);
-            } else {
-              DerenderAnalyticPhoto(session, groups[g].front(), pixels, rays, surface, options, &w->parts.front(),
-                                    &w->rejected, &w->exposure);
-            }
-          };
-          if (const auto* sphere = dynamic_cast<const SphereSample*>(&sample)) {
-            derender(*sphere);
-          } else if (const auto* cylinder = dynamic_cast<const CylinderSample*>(&sample)) {
-            derender(*cylinder);
-          } else {
-            derender(sample);
-          }
-        }
+        ReadStagePhoto(stage, w->group, &w->image, &w->decode_s);
+        // A mesh photo's blocks, and those of the last two analytic photos, across threads (a thread
+        // done with its photo then takes blocks of the other's, instead of waiting; a one-photo session
+        // uses every thread); the other analytic photos one per thread.
+        const bool parallel = stage.mesh || w->group + 2 >= photos;
+        DerenderStagePhoto(stage, w->group, w->image, parallel, &w->samples);
         // Counted here, while the photo's samples are in cache, not over the whole result afterwards.
         w->channels_not_measured = {};
-        for (const std::vector<BrdfSample>& part : w->parts) {
-          for (const BrdfSample& s : part) {
+        for (const std::vector<BrdfSample>& block : w->samples.blocks) {
+          for (const BrdfSample& s : block) {
             for (int c = 0; c < 3; ++c) w->channels_not_measured[c] += s.valid[c] == 0;
           }
         }
         return w;
       }) & tbb::make_filter<PhotoWork*, void>(tbb::filter_mode::serial_in_order, [&](PhotoWork* w) {
-        for (const std::vector<BrdfSample>& part : w->parts) {
-          result.samples.insert(result.samples.end(), part.begin(), part.end());
+        for (const std::vector<BrdfSample>& block : w->samples.blocks) {
+          result.samples.insert(result.samples.end(), block.begin(), block.end());
         }
-        for (const auto& [reason, count] : w->rejected) result.summary.rejected[reason] += count;
+        for (const auto& [reason, count] : w->samples.rejected) result.summary.rejected[reason] += count;
         result.summary.decode_s += w->decode_s;
         for (int c = 0; c < 3; ++c) result.summary.channels_not_measured[c] += w->channels_not_measured[c];
-        result.summary.shadow_rays += w->mesh_stats.shadow_rays;
-        result.summary.shadow_tests_skipped += w->mesh_stats.shadow_tests_skipped;
-        result.summary.exposure.Merge(w->exposure);
-        result.summary.exposure.Merge(w->mesh_stats.exposure);
+        result.summary.shadow_rays += w->samples.shadow_rays;
+        result.summary.shadow_tests_skipped += w->samples.shadow_tests_skipped;
+        result.summary.exposure.Merge(w->samples.exposure);
         idle.push(w);
         progress.Add(1);
       }));
   progress.Finish();
-  const size_t measured = groups.size();
-  result.summary.photos = measured;
-  result.summary.pixels_examined = PixelsPerImage(session.camera, options.pixel_stride) * measured;
-  result.summary.accepted = result.samples.size();
-  bool bracketed = false;
-  for (const auto& group : groups) bracketed = bracketed || group.size() > 1;
-  result.summary.exposure_warnings = AdviseExposure(result.summary.exposure, options.exposure_advice, bracketed);
-  if (measured > 0 && result.summary.rejected["off_sample"] == result.summary.pixels_examined) {
-    ThrowError(session.manifest_path,
-               "no photo sees the sample: every pixel's ray misses it (check the sample's "
-               "position" +
-                   std::string(mesh_path ? " and world_from_mesh" : "") + " and the poses)");
-  }
-  if (mesh_path) {
-    result.summary.mesh_faces = mesh_path->mesh->NumFaces();
-    result.summary.shadow_rays_on = mesh_path->shadow_rays;
-    result.summary.visibility_reason = mesh_path->visibility_reason;
-    if (!mesh_path->shadow_rays) {
-      Log(1, "shadow rays skipped for " + std::to_string(result.summary.shadow_tests_skipped) + " pixels (visibility " +
-                 mesh_path->visibility_reason + ")");
-    } else {
-      Log(1, std::to_string(result.summary.shadow_rays) + " shadow rays traced");
-    }
-  }
-  result.summary.total_s = timer.ElapsedSeconds();
+  FinishSummary(stage, &result);
   return result;
 }
 
 }  // namespace
+
+struct DerenderSetup::Impl : Stage {
+  using Stage::Stage;
+};
+
+DerenderSetup::DerenderSetup(const Session& session, const DerenderOptions& options)
+    : impl_(std::make_unique<Impl>(session, options)) {}
+
+DerenderSetup::~DerenderSetup() = default;
+
+size_t DerenderSetup::NumPhotos() const { return impl_->groups.size(); }
+
+void DerenderSetup::ReadPhoto(size_t photo, RadianceWindow* image, double* decode_s) const {
+  IBRDF_CHECK(photo < impl_->groups.size()) << "photo " << photo << " of " << impl_->groups.size();
+  ReadStagePhoto(*impl_, photo, image, decode_s);
+}
+
+void DerenderSetup::DerenderPhoto(size_t photo, const RadianceWindow& image, bool parallel, PhotoSamples* out) const {
+  IBRDF_CHECK(photo < impl_->groups.size()) << "photo " << photo << " of " << impl_->groups.size();
+  DerenderStagePhoto(*impl_, photo, image, parallel, out);
+}
+
+DerenderResult DerenderSetup::DerenderAll() const { return RunStage(*impl_); }
 
 bool DerenderOptions::Check(std::string* why) const {
   // Grazing limits in (0, 90] degrees.
@@ -941,18 +987,12 @@ std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera) {
   return PixelCornerRaysInBox(camera, PixelBox{0, 0, camera.width + 1, camera.height + 1});
 }
 
-void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
-                   const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
-                   const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
-                   ExposureTally* exposure) {
-  DerenderAnalyticPhoto(session, photo_index, ImagePixels(image), rays, sample, options, samples, rejected, exposure);
-}
-
 DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& options) {
-  std::string why;
-  if (!options.Check(&why)) ThrowError("derender options", why);
-  const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
-  return RunDerender(session, options, *sample, nullptr);
+  if (session.sample.kind == SampleSpec::Kind::kMesh) {
+    ThrowError("sample", "a mesh sample needs the mesh derenderer (Derender); DerenderAnalytic takes a sphere or a "
+                         "cylinder");
+  }
+  return DerenderSetup(session, options).DerenderAll();
 }
 
 DerenderResult Derender(const Session& measured_session, const DerenderOptions& options) {
@@ -964,19 +1004,7 @@ DerenderResult Derender(const Session& measured_session, const DerenderOptions& 
   calibration_options.min_signal = options.min_signal;
   const Session session = ApplyLightCalibration(measured_session, &calibration, calibration_options);
   if (calibration.calibrated) Log(1, calibration.BriefReport());
-  DerenderResult result;
-  if (session.sample.kind != SampleSpec::Kind::kMesh) {
-    result = DerenderAnalytic(session, options);
-  } else {
-    const Timer setup;
-    const MeshPath path = PrepareMeshPath(session, options);
-    const double setup_s = setup.ElapsedSeconds();
-    char seconds[32];
-    std::snprintf(seconds, sizeof(seconds), "%.2f s", setup_s);
-    Log(1, std::string("mesh set-up (read, ray-tracing scene, convexity): ") + seconds);
-    result = RunDerender(session, options, *path.mesh, &path);
-    result.summary.mesh_setup_s = setup_s;
-  }
+  DerenderResult result = DerenderSetup(session, options).DerenderAll();
   // The colour chart's matrix, per sample by its photo's light (colour_chart.h), after the light's calibration.
   size_t colour_dropped = 0;
   result.summary.colour_matrices = ApplyColourCorrection(session, &result.samples, &colour_dropped);

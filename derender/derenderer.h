@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -111,17 +112,49 @@ DerenderResult Derender(const Session& session, const DerenderOptions& options);
 // The analytic path alone, the session's light taken as stated (throws Error for a mesh sample).
 DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& options);
 
-// The per-pixel core of the analytic path, for one photo's radiance image (radiance_image.h;
-// photo_index gives the pose): appends accepted samples and counts rejections (and, when `exposure`
-// is given, tallies the pixels that reach the radiometric tests by theta_h band). `rays` holds the
-// undistorted image-plane point (x, y) of every pixel centre, row-major. Any SampleSurface works;
-// a mesh gets none of the mesh path's masks here.
-class SampleSurface;
-struct RadianceImage;
-void DerenderPhoto(const Session& session, size_t photo_index, const RadianceImage& image,
-                   const std::vector<Eigen::Vector2f>& rays, const SampleSurface& sample,
-                   const DerenderOptions& options, std::vector<BrdfSample>* samples, RejectionCounts* rejected,
-                   ExposureTally* exposure = nullptr);
+// One photo's (exposure group's) part of the stage's result, as DerenderSetup::DerenderPhoto fills it.
+struct PhotoSamples {
+  // The accepted samples in row-major order, one buffer per block of rows (their concatenation is the
+  // photo's samples); the buffers are kept from photo to photo, so their memory is touched once.
+  std::vector<std::vector<BrdfSample>> blocks;
+  RejectionCounts rejected;  // every pixel of the photo (after the stride) not accepted, by reason
+  ExposureTally exposure;    // the pixels that reach the radiometric tests, by theta_h band
+  uint64_t shadow_rays = 0;           // mesh: shadow rays traced (shadow-edge rays included)
+  uint64_t shadow_tests_skipped = 0;  // mesh: pixels that would have had shadow rays, with visibility off
+};
+
+class RadianceWindow;  // radiance_image.h
+
+// The derender stage's set-up of one session, shared by all its photos: the checks that need no photo
+// decoded, the exposure groups (the photos derendered, radiance_image.h), the sample's geometry (the
+// analytic shape, or the mesh's ray-tracing scene, marker occluders and shadow-ray verdict), the rays
+// of the pixels that can see the sample, the radiometric chain and the masks several photos share.
+// Derender and DerenderAnalytic run the stage through it; tests and benchmarks may call its per-photo
+// steps directly. `session` must outlive it.
+class DerenderSetup {
+ public:
+  // Throws Error as Derender does for bad options, a missing or corrupt mesh, a photo without a pose,
+  // a camera inside the sample, a measurement light without intensity and a sample no photo sees.
+  DerenderSetup(const Session& session, const DerenderOptions& options);
+  ~DerenderSetup();
+  DerenderSetup(const DerenderSetup&) = delete;
+  DerenderSetup& operator=(const DerenderSetup&) = delete;
+
+  // The photos (exposure groups) to derender, in ExposureGroups order.
+  size_t NumPhotos() const;
+  // Decodes photo `photo`'s exposures inside the pixels that can see the sample, with its mask, into
+  // `image` (buffers reused from photo to photo); `decode_s` gets the seconds spent decoding added.
+  void ReadPhoto(size_t photo, RadianceWindow* image, double* decode_s = nullptr) const;
+  // The per-pixel kernel on photo `photo` as ReadPhoto prepared it: fills `out` (its buffers reused).
+  // `parallel`: the blocks of rows across threads; else all on the calling thread.
+  void DerenderPhoto(size_t photo, const RadianceWindow& image, bool parallel, PhotoSamples* out) const;
+  // Every photo, decoded and derendered in a pipeline, the samples in photo order.
+  DerenderResult DerenderAll() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // Undistorted image-plane points of every pixel centre of the session's camera, row-major.
 std::vector<Eigen::Vector2f> PixelRays(const Camera& camera);

@@ -1,10 +1,12 @@
 // The mesh path of the derenderer on synthetic sessions: a UV-sphere mesh against the analytic
 // sphere, the same 10 km from the origin, self-shadowing with shadow rays on and off, markers in
-// front of the sample, and the errors (missing mesh, no normals, a sample no photo sees).
+// front of the sample, the errors (missing mesh, no normals, a sample no photo sees), and the stage's
+// per-photo steps (DerenderSetup) on either geometry.
 #include "derender/derenderer.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -17,6 +19,7 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "derender/analytic_sample.h"
+#include "derender/radiance_image.h"
 #include "scan/ply_io.h"
 #include "scan/synthetic_scan.h"
 #include "tests/test_util.h"
@@ -109,6 +112,40 @@ TEST(MeshDerender, UvSphereMatchesTheAnalyticSphere) {
   EXPECT_LT(worst, 0.01);   // measured 5.3e-3
   std::printf("mesh vs analytic sphere: %zu matched of %zu; |f_mesh / f_exact - 1| median %.2e, max %.2e\n", matched,
               exact.samples.size(), median, worst);
+}
+
+// The stage's per-photo steps (DerenderSetup::ReadPhoto and DerenderPhoto, what tests and benchmarks
+// call) give, photo after photo, the bytes and counts of the whole stage, with the blocks of rows on
+// one thread or across threads, for the analytic sphere and for the mesh (mixed pixels, back faces
+// and, visibility on, shadow rays included).
+TEST(MeshDerender, PerPhotoStepsGiveTheStagesSamples) {
+  ScratchDir dir;
+  const Session analytic = LambertianSession(dir / "s", SmallSphere());
+  WritePly(dir / "s/sphere.ply", MakeUvEllipsoid(Eigen::Vector3d::Constant(0.04), 90, 180));
+  for (const Session& session : {analytic, WithMesh(analytic, "sphere.ply", Sim3d(), Visibility::kOn)}) {
+    const DerenderSetup setup(session, DerenderOptions());
+    const DerenderResult whole = setup.DerenderAll();
+    ASSERT_EQ(setup.NumPhotos(), session.photos.size());
+    ASSERT_GT(whole.samples.size(), 10000u);
+    for (const bool parallel : {false, true}) {
+      std::vector<BrdfSample> samples;
+      RejectionCounts rejected;
+      uint64_t shadow_rays = 0;
+      RadianceWindow image;
+      PhotoSamples photo;
+      for (size_t i = 0; i < setup.NumPhotos(); ++i) {
+        setup.ReadPhoto(i, &image);
+        setup.DerenderPhoto(i, image, parallel, &photo);
+        for (const std::vector<BrdfSample>& block : photo.blocks) samples.insert(samples.end(), block.begin(), block.end());
+        for (const auto& [reason, count] : photo.rejected) rejected[reason] += count;
+        shadow_rays += photo.shadow_rays;
+      }
+      ASSERT_EQ(samples.size(), whole.samples.size()) << session.sample.mesh_file << " parallel " << parallel;
+      EXPECT_EQ(std::memcmp(samples.data(), whole.samples.data(), samples.size() * sizeof(BrdfSample)), 0);
+      EXPECT_EQ(rejected, whole.summary.rejected);
+      EXPECT_EQ(shadow_rays, whole.summary.shadow_rays);
+    }
+  }
 }
 
 // 10 km from the origin (scanner coordinates often are), the mesh placed by world_from_mesh or
