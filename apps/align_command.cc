@@ -1,7 +1,6 @@
 // ibrdf align: a session's geometry from its own photos (align/align_stage.h) behind flags.
 #include "align/align_stage.h"
 #include "apps/commands.h"
-#include "core/logging.h"
 #include "core/session.h"
 
 namespace ibrdf {

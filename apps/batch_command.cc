@@ -25,12 +25,13 @@ IBRDF_COMMAND(85, Batch) {
   auto args = std::make_shared<Args>();
   c->add_option("config", args->config, "Batch config (JSON, format ibrdf-batch)")->required();
   c->add_option("--cores", args->run.cores, "Local cores Snakemake may use (default: all)");
-  auto* slurm = c->add_flag_callback("--slurm", [args] { args->run.profile = "slurm"; },
-                                     "Submit the jobs to Slurm through the shipped profile");
+  auto* slurm = c->add_flag_callback(
+      "--slurm", [args] { args->run.profile = "slurm"; }, "Submit the jobs to Slurm through the shipped profile");
   c->add_option("--profile", args->run.profile, "A Snakemake profile folder of your own")->excludes(slurm);
   c->add_flag("-n,--dry-run", args->run.dry_run, "List the jobs and their commands; run nothing");
-  c->add_flag("--plan", args->plan, "Print the plan (JSON: each session, its `ibrdf run` command, what it has left "
-              "to do)\nand exit; the Snakefile reads it");
+  c->add_flag("--plan", args->plan,
+              "Print the plan (JSON: each session, its `ibrdf run` command, what it has left to do)\n"
+              "and exit; the Snakefile reads it");
   c->add_option("--snakemake-args", args->run.extra, "More snakemake arguments (after --snakemake-args)")
       ->allow_extra_args();
   c->callback([args] {

@@ -1,7 +1,6 @@
 // ibrdf check: consistency of measured samples (reconstruct/consistency.h) behind flags.
 #include "apps/commands.h"
 #include "core/json_reader.h"
-#include "core/logging.h"
 #include "core/sample_file.h"
 #include "reconstruct/consistency.h"
 #include "reconstruct/prediction_check.h"

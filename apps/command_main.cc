@@ -2,8 +2,12 @@
 // front end (apps/main.cc) execs it with the whole command line. It parses the global flags wherever
 // they are (the subcommand falls through to them), runs the one subcommand linked in, and maps
 // failures to exit codes: 2 for a usage error, 1 for an error in the input, 70 for a bug.
+// Also the subcommand registry and the flag helpers of apps/commands.h.
+#include <algorithm>
 #include <iostream>
 #include <memory>
+#include <set>
+#include <utility>
 
 #include <tbb/global_control.h>
 #include <CLI/CLI.hpp>
@@ -11,7 +15,50 @@
 #include "apps/commands.h"
 #include "apps/global_flags.h"
 #include "core/error.h"
-#include "core/logging.h"
+
+namespace ibrdf {
+namespace {
+std::vector<std::pair<int, AddCommandFunction>>& Registry() {
+  static std::vector<std::pair<int, AddCommandFunction>> registry;
+  return registry;
+}
+}  // namespace
+
+CommandRegistrar::CommandRegistrar(int order, AddCommandFunction add) { Registry().emplace_back(order, add); }
+
+std::vector<AddCommandFunction> RegisteredCommands() {
+  std::vector<std::pair<int, AddCommandFunction>> sorted = Registry();
+  std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<AddCommandFunction> out;
+  for (const auto& entry : sorted) out.push_back(entry.second);
+  return out;
+}
+
+void AddOutputFlags(CLI::App& app, std::string& out, bool& overwrite, const std::string& out_help,
+                    const std::string& overwrite_help) {
+  app.add_option("--out", out, out_help)->required();
+  app.add_flag("--overwrite", overwrite, overwrite_help);
+}
+
+CLI::Option* AddClearingFlag(CLI::App& app, const std::string& name, bool& value, const std::string& help) {
+  return app.add_flag_callback(
+      name, [&value] { value = false; }, help);
+}
+
+CLI::Option* AddMillimetres(CLI::App& app, const std::string& name, double& metres, const std::string& help) {
+  return app
+      .add_option_function<double>(
+          name, [&metres](double mm) { metres = 1e-3 * mm; }, help)
+      ->default_str(CLI::detail::to_string(1e3 * metres));
+}
+
+void WarnDeprecatedOption(const std::string& old_name, const std::string& new_name) {
+  static std::set<std::string> warned;
+  if (!warned.insert(old_name).second) return;
+  Log(1, "warning: " + old_name + " is deprecated; use " + new_name + " (the old name goes in the next release)");
+}
+
+}  // namespace ibrdf
 
 int main(int argc, char** argv) {
   CLI::App app{"", "ibrdf"};

@@ -1,5 +1,5 @@
 // The subcommands of the ibrdf tool. Each subcommand lives in its own apps/<name>_command.cc,
-// registers itself with IBRDF_REGISTER_COMMAND and is built into its own binary `ibrdf-<name>` by one
+// defines and registers itself with IBRDF_COMMAND and is built into its own binary `ibrdf-<name>` by one
 // line of apps/CMakeLists.txt (ibrdf_add_command; apps/main.cc, the front end, says how to add one).
 // Library code never sees argv. The helpers below bind the flags several subcommands share.
 #pragma once
@@ -9,11 +9,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/logging.h"       // Log, StageLog: what every command prints
 #include "core/output_guard.h"  // RequireWritableOutput: every command's output guard
 
 namespace ibrdf {
-
-struct Session;
 
 using AddCommandFunction = void (*)(CLI::App& app);
 
@@ -47,8 +46,15 @@ CLI::Option* AddClearingFlag(CLI::App& app, const std::string& name, bool& value
 // A length kept in metres and given in millimetres (--marker-mm); --help shows its default in millimetres.
 CLI::Option* AddMillimetres(CLI::App& app, const std::string& name, double& metres, const std::string& help);
 
-// The inputs of a command that reads a session: its files, its manifest and its folder.
-std::vector<std::string> SessionInputs(const Session& session);
+// The inputs of a command that reads a session (core/session.h): its files, its manifest and its folder.
+// A template, so that a binary whose command reads no session does not link the session code.
+template <typename SessionType>
+std::vector<std::string> SessionInputs(const SessionType& session) {
+  std::vector<std::string> inputs = session.InputFiles();
+  inputs.push_back(session.manifest_path);
+  inputs.push_back(session.directory);
+  return inputs;
+}
 
 // Prints once that `old_name` is deprecated in favour of `new_name` (a warning on standard error).
 void WarnDeprecatedOption(const std::string& old_name, const std::string& new_name);
@@ -102,7 +108,7 @@ void RequireValidOptions(const Options& options, const std::string& flags) {
   static const ::ibrdf::CommandRegistrar function##_registrar(order, &function)
 
 // Defines the subcommand function `Add<Name>Command(CLI::App& app)` (its body follows) and registers it.
-#define IBRDF_COMMAND(order, Name)                 \
-  static void Add##Name##Command(CLI::App& app);   \
+#define IBRDF_COMMAND(order, Name)                   \
+  static void Add##Name##Command(CLI::App& app);     \
   IBRDF_REGISTER_COMMAND(order, Add##Name##Command); \
   static void Add##Name##Command(CLI::App& app)

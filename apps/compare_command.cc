@@ -5,7 +5,6 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/json_reader.h"
-#include "core/logging.h"
 #include "core/merl_brdf.h"
 #include "reconstruct/truth_comparison.h"
 

@@ -1,6 +1,5 @@
 // ibrdf derender: a session's photos to a BRDF sample file (derender/derenderer.h) behind flags.
 #include "apps/commands.h"
-#include "core/logging.h"
 #include "core/session.h"
 #include "derender/derenderer.h"
 
@@ -27,8 +26,8 @@ IBRDF_COMMAND(40, Derender) {
   AddOption(*c, "--min-signal", o.min_signal, "Signal floor (linear, normalized units)");
   AddOption(*c, "--stride", o.pixel_stride, "Use every n-th pixel in x and y");
   const auto visibility = [&o](const std::string& name) { VisibilityFromName(name, &o.visibility.emplace()); };
-  c->add_option_function<std::string>("--visibility", visibility, "Mesh samples: shadow rays auto (as the scan's "
-                                      "convexity report asks), on or off (over sample.visibility)")
+  c->add_option_function<std::string>("--visibility", visibility,
+                                      "Mesh samples: shadow rays auto (as the scan's convexity report asks), on or off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   AddClearingFlag(*c, "--no-mixed-pixel-mask", o.mask_mixed_pixels,
                   "Mesh samples: keep pixels that straddle the silhouette (corner rays miss or jump in depth)");

@@ -19,7 +19,8 @@ inline void AddGlobalFlags(CLI::App& app, int& verbosity, int& threads) {
   app.set_version_flag("--version", "ibrdf " IBRDF_VERSION);
   app.add_flag_callback(
       "-q,--quiet", [&verbosity] { verbosity = 1; }, "Stage lines and summaries only, no progress bars");
-  app.add_flag_callback("--silent", [&verbosity] { verbosity = 0; }, "Errors only");
+  app.add_flag_callback(
+      "--silent", [&verbosity] { verbosity = 0; }, "Errors only");
   app.add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
 }
 

@@ -3,7 +3,6 @@
 // and an index.html gallery. Docs: docs/workflow.md, "The material library".
 #include "apps/commands.h"
 #include "core/error.h"
-#include "core/logging.h"
 #include "report/material_library.h"
 #include "workflow/batch_config.h"
 

@@ -1,7 +1,6 @@
 // ibrdf reconstruct: samples to a smooth isotropic BRDF (reconstruct/reconstruction_stage.h) behind flags.
 #include "apps/commands.h"
 #include "core/error.h"
-#include "core/logging.h"
 #include "core/sample_file.h"
 #include "reconstruct/reconstruction_stage.h"
 #include "reconstruct/sample_domain.h"
@@ -32,8 +31,8 @@ IBRDF_COMMAND(50, Reconstruct) {
     o.select_bandwidth = name != "given";
     if (o.select_bandwidth) ParseBandwidthCriterion(name, &o.selection.criterion);
   };
-  c->add_option_function<std::string>("--bandwidth", bandwidth, "Kernel radii: given, or selected by loo "
-                                      "(leave-one-out) or gcv among the radii times --bandwidth-scales")
+  c->add_option_function<std::string>("--bandwidth", bandwidth,
+                                      "Kernel radii: given, or selected by loo or gcv among them x --bandwidth-scales")
       ->check(CLI::IsMember({"given", "loo", "gcv"}))
       ->default_str("given");
   AddOption(*c, "--bandwidth-scales", o.selection.scales, "Factors on both radii tried by --bandwidth loo|gcv")
@@ -41,8 +40,9 @@ IBRDF_COMMAND(50, Reconstruct) {
   AddOption(*c, "--bandwidth-samples", o.selection.samples, "Samples each candidate is scored at");
   AddOption(*c, "--bin-h", r.bin_fraction_h, "Bin edge along the sheets, fraction of --radius-h-deg (0: no binning)");
   AddOption(*c, "--bin-d", r.bin_fraction_d, "Bin edge across the sheets, fraction of --radius-d-deg (0: no binning)");
-  c->add_flag_callback("--no-fold", [&r] { r.fold_reciprocity = r.fold_bilateral = false; },
-                       "Do not assume reciprocity and bilateral symmetry");
+  c->add_flag_callback(
+      "--no-fold", [&r] { r.fold_reciprocity = r.fold_bilateral = false; },
+      "Do not assume reciprocity and bilateral symmetry");
   AddClearingFlag(*c, "--linear-values", r.log_space, "Fit f rather than log f");
   AddOption(*c, "--max-theta-deg", o.tabulate.max_theta_deg, "Tabulate cells up to this theta_i, theta_e");
   AddOption(*c, "--min-effective-samples", o.tabulate.min_effective_samples, "Fewer: the cell is unmeasured (-1)");
@@ -55,8 +55,8 @@ IBRDF_COMMAND(50, Reconstruct) {
   c->add_option("--eval", o.eval_file, "Also evaluate at these points: .npy float64 (N, 3), radians");
   c->add_option("--material", args->material, "With --eval and no samples: evaluate this material at the points");
   const auto fill = [&o](const std::string& name) { ParseFillMode(name, &o.tabulate.fill); };
-  c->add_option_function<std::string>("--fill", fill, "Unmeasured cells and points: none (-1, MERL's no data), "
-                                      "model (the chosen fit) or extrapolate (the regression's)")
+  c->add_option_function<std::string>("--fill", fill,
+                                      "Unmeasured cells and points: none (-1), model (the fit) or extrapolate")
       ->check(CLI::IsMember({"none", "model", "extrapolate"}))
       ->default_str("none");
   c->add_option("--name", o.name, "Name of the fitted materials (default: the samples' session folder)");

@@ -2,7 +2,6 @@
 #include <filesystem>
 
 #include "apps/commands.h"
-#include "core/logging.h"
 #include "report/report_stage.h"
 
 namespace ibrdf {

@@ -6,7 +6,6 @@
 #include <tbb/global_control.h>
 
 #include "apps/commands.h"
-#include "core/logging.h"
 #include "workflow/run_folder.h"
 
 namespace ibrdf {
@@ -17,16 +16,10 @@ IBRDF_COMMAND(80, Run) {
       "The whole workflow into one folder: (synth, for a recipe) -> scan -> align -> derender -> check -> compare ->\n"
       "reconstruct -> report, each stage a child `ibrdf` process, skipped when its outputs are newer than its inputs\n"
       "and its options unchanged (DIR/stamps/): interrupted, it resumes. Writes DIR/summary.json (docs/workflow.md).");
-  using StageArgs = std::vector<std::string> MeasurementOptions::*;  // the arguments of one stage
-  struct PassThrough {
-    StageArgs target;
-    std::string value;  // one value (the named options, after their flag) or words split at spaces
-  };
   struct Args {
     std::string input, out;
     MeasurementOptions o;
     bool overwrite = false;
-    std::vector<PassThrough> words, named;  // --derender-args etc.; the named pass-through options
   };
   auto args = std::make_shared<Args>();
   MeasurementOptions& o = args->o;
@@ -45,52 +38,52 @@ IBRDF_COMMAND(80, Run) {
   c->add_flag("--force", o.force, "Re-run every stage, up to date or not");
   AddClearingFlag(*c, "--sequential", o.concurrent_sample_stages,
                   "Run check and compare after reconstruct, not beside it (the outputs are the same)");
+  // Arguments passed to a stage: in the order of these options (CLI11 runs their callbacks so), the
+  // --STAGE-args words before the named options.
+  using StageArgs = std::vector<std::string> MeasurementOptions::*;
   const StageArgs derender = &MeasurementOptions::derender_args, check = &MeasurementOptions::check_args,
                   reconstruct = &MeasurementOptions::reconstruct_args, report = &MeasurementOptions::report_args;
   const struct {
     const char* flag;
     StageArgs target;
     const char *stage, *help;
-  } named[] = {{"--lobes", reconstruct, "reconstruct", "Lafortune lobes (1 to 3)"},
+  } more[] = {{"--derender-args", derender, "derender", "--shadow-edge-deg 2"},
+              {"--check-args", check, "check", "--theta-bin-deg 5 --phi-bin-deg 10"},
+              {"--reconstruct-args", reconstruct, "reconstruct", "--degree 1 --no-fold"},
+              {"--report-args", report, "report", "--angles-deg 20,40,60"}},
+    named[] = {{"--lobes", reconstruct, "reconstruct", "Lafortune lobes (1 to 3)"},
                {"--bandwidth", reconstruct, "reconstruct", "Kernel radii: given, loo or gcv"},
                {"--max-theta-deg", reconstruct, "reconstruct", "Tabulate up to this theta"},
                {"--visibility", derender, "derender", "Mesh samples' shadow rays: auto, on or off"},
                {"--max-theta-i-deg", derender, "derender", "Reject samples beyond this incidence angle"},
                {"--max-theta-e-deg", derender, "derender", "Reject samples beyond this exitance angle"},
                {"--min-signal", derender, "derender", "Reject pixels below this linear signal"},
-               {"--held-out", report, "report", "Photos shown held out (a fit without each)"}},
-    more[] = {{"--derender-args", derender, "derender", "--shadow-edge-deg 2"},
-              {"--check-args", check, "check", "--theta-bin-deg 5 --phi-bin-deg 10"},
-              {"--reconstruct-args", reconstruct, "reconstruct", "--degree 1 --no-fold"},
-              {"--report-args", report, "report", "--angles-deg 20,40,60"}};
-  for (const auto& n : named) {
-    const std::string flag = n.flag;
-    const StageArgs target = n.target;
-    const auto add = [args, flag, target](const std::string& value) {
-      args->named.push_back({target, flag});
-      args->named.push_back({target, value});
-    };
-    c->add_option_function<std::string>(flag, add, std::string(n.stage) + ": " + n.help + " (passed to `ibrdf " +
-                                                        n.stage + " " + flag + "`)")
-        ->type_name("VALUE");
-  }
+               {"--held-out", report, "report", "Photos shown held out (a fit without each)"}};
   for (const auto& m : more) {
-    const StageArgs target = m.target;
-    const auto add = [args, target](const std::string& text) { args->words.push_back({target, text}); };
-    c->add_option_function<std::string>(m.flag, add, std::string("More arguments for `ibrdf ") + m.stage +
-                                                          "`, one string split at spaces, e.g. \"" + m.help + "\"")
+    std::vector<std::string>& target = o.*m.target;
+    const auto add = [&target](const std::string& text) {
+      std::istringstream words(text);
+      for (std::string word; words >> word;) target.push_back(word);
+    };
+    c->add_option_function<std::string>(
+         m.flag, add,
+         std::string("More arguments for `ibrdf ") + m.stage + "`, one string split at spaces, e.g. \"" + m.help + "\"")
         ->type_name("\"ARGS\"");
   }
-  c->add_option("--stop-after", o.stop_after, "Stop after this stage (synth, scan, align, colour, derender, check, "
-                "compare,\nreconstruct, report); later stages are left as they are");
+  for (const auto& n : named) {
+    const std::string flag = n.flag;
+    std::vector<std::string>& target = o.*n.target;
+    const auto add = [&target, flag](const std::string& value) { target.insert(target.end(), {flag, value}); };
+    c->add_option_function<std::string>(
+         flag, add, std::string(n.stage) + ": " + n.help + " (passed to `ibrdf " + n.stage + " " + flag + "`)")
+        ->type_name("VALUE");
+  }
+  c->add_option("--stop-after", o.stop_after,
+                "Stop after this stage (synth, scan, align, colour, derender, check, compare,\n"
+                "reconstruct, report); later stages are left as they are");
   c->callback([args] {
     Timer wall;
     RequireValidOptions(args->o, "ibrdf run");
-    for (const auto& [target, text] : args->words) {
-      std::istringstream words(text);
-      for (std::string word; words >> word;) (args->o.*target).push_back(word);
-    }
-    for (const auto& [target, value] : args->named) (args->o.*target).push_back(value);
     const int threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     const nlohmann::json summary =
         RunInFolder(args->input, args->out, args->o, args->overwrite, ChildStageLauncher(threads), "ibrdf 0.1.0", wall);

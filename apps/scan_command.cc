@@ -2,7 +2,6 @@
 #include <iostream>
 
 #include "apps/commands.h"
-#include "core/logging.h"
 #include "scan/scan_pipeline.h"
 
 namespace ibrdf {

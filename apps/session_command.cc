@@ -3,7 +3,6 @@
 
 #include "apps/commands.h"
 #include "capture/session_init.h"
-#include "core/logging.h"
 
 namespace ibrdf {
 namespace {
@@ -32,7 +31,7 @@ IBRDF_COMMAND(15, Session) {
   };
   auto args = std::make_shared<Args>();
   SessionInitOptions& o = args->o;
-  const auto files = [c](const char* name, std::vector<std::string>& paths, const char* help) {
+  const auto files = [c](const char* name, auto& paths, const char* help) {  // one file or several
     c->add_option(name, paths, help)->check(CLI::ExistingFile);
   };
   const auto vector = [c](const char* name, std::vector<double>& values, int n, const char* help) {
@@ -47,10 +46,8 @@ IBRDF_COMMAND(15, Session) {
   vector("--white-reflectance", args->white_reflectance, 3, "The white reference's albedo R G B (default 0.99)");
   files("--chart-photos", o.chart_photos, "Photos of a ColorChecker Classic 24 under the session's light");
   vector("--chart-corners", args->chart_corners, 8, "Pixel centres X Y of the chart's patches 1, 6, 24 and 19");
-  c->add_option("--targets", o.targets_file, "The markers' layout: targets.json from `ibrdf targets`")
-      ->check(CLI::ExistingFile);
-  c->add_option("--camera", o.camera_file, "A JSON file with a calibrated \"camera\" block (e.g. a session.json)")
-      ->check(CLI::ExistingFile);
+  files("--targets", o.targets_file, "The markers' layout: targets.json from `ibrdf targets`");
+  files("--camera", o.camera_file, "A JSON file with a calibrated \"camera\" block (e.g. a session.json)");
   c->add_option("--sensor-width-mm", o.sensor_width_mm, "Sensor width, when EXIF has no focal-plane resolution");
   c->add_option("--base-iso", o.base_iso, "The ISO of gain 1 (default: the lowest ISO of the photos)");
   AddOption(*c, "--bracket-size", o.bracket_size, "Exposures per bracket (0: by capture time and steps; 1: none)");
@@ -61,8 +58,9 @@ IBRDF_COMMAND(15, Session) {
   AddDeprecatedAlias(*c, c->add_option("--sample-radius-m", args->sample_radius, "The sphere's radius"),
                      "--sample-radius", args->sample_radius);
   c->add_flag("--radius-known", o.radius_known, "The radius is measured: `ibrdf align` fits only the centre");
-  AddDeprecatedAlias(*c, vector("--sample-center-m", args->sample_center, 3, "The sphere's centre X Y Z (default with "
-                                "--targets: on the platform's centre)"),
+  AddDeprecatedAlias(*c,
+                     vector("--sample-center-m", args->sample_center, 3,
+                            "The sphere's centre X Y Z (default with --targets: on the platform's centre)"),
                      "--sample-center", args->sample_center);
   c->add_option("--response", o.response, "\"linear\" or \"srgb\" (default: from the file format)");
   c->add_option("--name", o.name, "The session's name (default: the output folder's)");

@@ -1,6 +1,5 @@
 // ibrdf synth: writes a synthetic session with known truth; the flags fill a SynthRequest (synth/synth_request.h).
 #include "apps/commands.h"
-#include "core/logging.h"
 #include "synth/synth_request.h"
 #include "synth/synthetic.h"
 
@@ -108,7 +107,7 @@ IBRDF_COMMAND(10, Synth) {
   c.add_flag("--targets", r.targets, "Sample on an ArUco marker platform (for `ibrdf align`; cameras at 45 deg)");
   AddOption(c, "--target-dictionary", o.targets.dictionary, "ArUco dictionary of the markers");
   args->light_photos = c.add_option("--light-photos", o.targets.light_photos,
-                                   "With --targets: photos of the light's marker card (default 3; 0: none)");
+                                    "With --targets: photos of the light's marker card (default 3; 0: none)");
   c.add_flag("--white-card", o.targets.white_card, "With --targets --light-unknown: the white reference on a card");
   AddOption(c, "--charuco-photos", r.charuco_photos, "ChArUco board photos into OUT/calibration (align --calibrate)");
   c.add_option("--shape", r.shape, "squash, pot or dent: a mesh sample with simulated range scans (with --targets)")

@@ -3,7 +3,6 @@
 
 #include "align/targets.h"
 #include "apps/commands.h"
-#include "core/logging.h"
 
 namespace ibrdf {
 

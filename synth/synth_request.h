@@ -31,9 +31,9 @@ struct SynthRequest {
   bool targets = false;
   bool camera_elevation_given = false, light_photos_given = false;
   std::vector<double> origin, light_intensity;  // 3 values each when given
-  int charuco_photos = 0;  // ChArUco board photos to write beside the session (WriteSessionCharucoPhotos)
-  std::vector<double> camera_matrix;         // 9 values row by row when given: camera RGB = M * linear sRGB
-  bool colour_chart_detect = false;          // leave the chart's corners out (`ibrdf colour` detects it)
+  int charuco_photos = 0;             // ChArUco board photos to write beside the session (WriteSessionCharucoPhotos)
+  std::vector<double> camera_matrix;  // 9 values row by row when given: camera RGB = M * linear sRGB
+  bool colour_chart_detect = false;   // leave the chart's corners out (`ibrdf colour` detects it)
   std::string colour_space = "linear_srgb";  // the colour_chart block's target space (ColourSpaceFromName)
   std::string no_data = "skip";              // a MERL table's cells without data (SynthNoDataFromName)
   // A MERL table's lookups (MerlLookupFromName), applied only when given: other materials have none.

@@ -56,8 +56,7 @@ void ClaimRunFolder(const std::string& out, const std::string& input, bool overw
 }
 
 nlohmann::json RunInFolder(const std::string& input, const std::string& out, const MeasurementOptions& options,
-                           bool overwrite, const StageLauncher& launch, const std::string& version,
-                           const Timer& wall) {
+                           bool overwrite, const StageLauncher& launch, const std::string& version, const Timer& wall) {
   // The output guard: the run folder is resumed, not replaced, but it must not be (or hold) the input.
   RequireOutputOutsideInputs(out, {input});
   // The input: a recipe folder, or a session (validated here, so a bad one is one clear line).

@@ -30,8 +30,7 @@ void ClaimRunFolder(const std::string& out, const std::string& input, bool overw
 // claims the run folder, runs the measurement's stages through `launch` as `version` (the stamps' tool
 // version), writes DIR/summary.json and returns it (BuildRunSummary; `wall`: the run's stopwatch).
 nlohmann::json RunInFolder(const std::string& input, const std::string& out, const MeasurementOptions& options,
-                           bool overwrite, const StageLauncher& launch, const std::string& version,
-                           const Timer& wall);
+                           bool overwrite, const StageLauncher& launch, const std::string& version, const Timer& wall);
 
 // What `ibrdf run` prints at the end: RunHeadline(summary), the timings, the summary's and the report's paths.
 std::vector<std::string> RunFolderReport(const nlohmann::json& summary, const std::string& out, double wall_s);

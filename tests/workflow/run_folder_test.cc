@@ -38,8 +38,8 @@ TEST(RunFolder, ClaimedForOneInput) {
 TEST(RunFolder, RefusesAnOutputThatHoldsTheInput) {
   testing::ScratchDir dir;
   fs::create_directories(dir / "session");
-  EXPECT_THROW(RunInFolder(dir / "session", dir.str(), MeasurementOptions(), false, ChildStageLauncher(1),
-                           "ibrdf test", Timer()),
+  EXPECT_THROW(RunInFolder(dir / "session", dir.str(), MeasurementOptions(), false, ChildStageLauncher(1), "ibrdf test",
+                           Timer()),
                Error);
 }
 
