@@ -3,11 +3,10 @@
 // they are (the subcommand falls through to them), runs the one subcommand linked in, and maps
 // failures to exit codes: 2 for a usage error, 1 for an error in the input, 70 for a bug.
 // Also the subcommand registry and the flag helpers of apps/commands.h.
-#include <algorithm>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <set>
-#include <utility>
 
 #include <tbb/global_control.h>
 #include <CLI/CLI.hpp>
@@ -18,19 +17,18 @@
 
 namespace ibrdf {
 namespace {
-std::vector<std::pair<int, AddCommandFunction>>& Registry() {
-  static std::vector<std::pair<int, AddCommandFunction>> registry;
+// By order; a multimap keeps the registration order of equal orders.
+std::multimap<int, AddCommandFunction>& Registry() {
+  static std::multimap<int, AddCommandFunction> registry;
   return registry;
 }
 }  // namespace
 
-CommandRegistrar::CommandRegistrar(int order, AddCommandFunction add) { Registry().emplace_back(order, add); }
+CommandRegistrar::CommandRegistrar(int order, AddCommandFunction add) { Registry().emplace(order, add); }
 
 std::vector<AddCommandFunction> RegisteredCommands() {
-  std::vector<std::pair<int, AddCommandFunction>> sorted = Registry();
-  std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<AddCommandFunction> out;
-  for (const auto& entry : sorted) out.push_back(entry.second);
+  for (const auto& [order, add] : Registry()) out.push_back(add);
   return out;
 }
 

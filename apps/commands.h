@@ -1,6 +1,6 @@
 // The subcommands of the ibrdf tool. Each subcommand lives in its own apps/<name>_command.cc,
 // defines and registers itself with IBRDF_COMMAND and is built into its own binary `ibrdf-<name>` by one
-// line of apps/CMakeLists.txt (ibrdf_add_command; apps/main.cc, the front end, says how to add one).
+// line of apps/CMakeLists.txt (ibrdf_add_command; IBRDF_COMMAND below says how to add one).
 // Library code never sees argv. The helpers below bind the flags several subcommands share.
 #pragma once
 
@@ -108,6 +108,9 @@ void RequireValidOptions(const Options& options, const std::string& flags) {
   static const ::ibrdf::CommandRegistrar function##_registrar(order, &function)
 
 // Defines the subcommand function `Add<Name>Command(CLI::App& app)` (its body follows) and registers it.
+// A new subcommand `foo`: apps/foo_command.cc holds `IBRDF_COMMAND(95, Foo) { app.add_subcommand("foo", ...) ...
+// }`, and apps/CMakeLists.txt `ibrdf_add_command(foo 95 "one-line summary" ibrdf_x ...)` naming the
+// libraries it calls (95: its place in `ibrdf --help`); configuring fails without that line.
 #define IBRDF_COMMAND(order, Name)                   \
   static void Add##Name##Command(CLI::App& app);     \
   IBRDF_REGISTER_COMMAND(order, Add##Name##Command); \

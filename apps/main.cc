@@ -3,14 +3,8 @@
 // This is the front end, a small binary that links no library: it reads the global flags
 // (apps/global_flags.h), answers --version and --help, and execs the subcommand's own binary
 // `ibrdf-<name>` beside it with the whole command line. Each `ibrdf-<name>` links only the libraries its
-// subcommand uses, so `ibrdf check` never loads PCL, VTK or OpenCV, and `ibrdf --version` nothing but
-// the C++ runtime (docs/decisions.md, "Speed"). A subcommand that launches others runs this front end
-// (IBRDF_TOOL, set here; workflow/build_id.h ExecutablePath()), never its own binary.
-//
-// Adding a subcommand `foo` is two steps: apps/foo_command.cc defines it with `IBRDF_COMMAND(95, Foo) {
-// app.add_subcommand("foo", ...) ... }` (apps/commands.h), and apps/CMakeLists.txt gets
-// `ibrdf_add_command(foo 95 "one-line summary" ibrdf_x ...)` naming the libraries it calls; configuring
-// fails without that line.
+// subcommand uses (docs/decisions.md, "Speed"); one that launches others runs this front end (IBRDF_TOOL,
+// set here; workflow/build_id.h ExecutablePath()). Adding a subcommand: apps/commands.h, IBRDF_COMMAND.
 #include <unistd.h>
 
 #include <cerrno>
