@@ -2,32 +2,66 @@
 // front end (apps/main.cc) execs it with the whole command line. It parses the global flags wherever
 // they are (the subcommand falls through to them), runs the one subcommand linked in, and maps
 // failures to exit codes: 2 for a usage error, 1 for an error in the input, 70 for a bug.
-#include <cstdlib>
+// Also the subcommand registry and the flag helpers of apps/commands.h.
 #include <iostream>
+#include <map>
 #include <memory>
+#include <set>
 
 #include <tbb/global_control.h>
 #include <CLI/CLI.hpp>
 
 #include "apps/commands.h"
+#include "apps/global_flags.h"
 #include "core/error.h"
-#include "core/logging.h"
+
+namespace ibrdf {
+namespace {
+// By order; a multimap keeps the registration order of equal orders.
+std::multimap<int, AddCommandFunction>& Registry() {
+  static std::multimap<int, AddCommandFunction> registry;
+  return registry;
+}
+}  // namespace
+
+CommandRegistrar::CommandRegistrar(int order, AddCommandFunction add) { Registry().emplace(order, add); }
+
+std::vector<AddCommandFunction> RegisteredCommands() {
+  std::vector<AddCommandFunction> out;
+  for (const auto& [order, add] : Registry()) out.push_back(add);
+  return out;
+}
+
+void AddOutputFlags(CLI::App& app, std::string& out, bool& overwrite, const std::string& out_help,
+                    const std::string& overwrite_help) {
+  app.add_option("--out", out, out_help)->required();
+  app.add_flag("--overwrite", overwrite, overwrite_help);
+}
+
+CLI::Option* AddClearingFlag(CLI::App& app, const std::string& name, bool& value, const std::string& help) {
+  return app.add_flag_callback(
+      name, [&value] { value = false; }, help);
+}
+
+CLI::Option* AddMillimetres(CLI::App& app, const std::string& name, double& metres, const std::string& help) {
+  return app
+      .add_option_function<double>(
+          name, [&metres](double mm) { metres = 1e-3 * mm; }, help)
+      ->default_str(CLI::detail::to_string(1e3 * metres));
+}
+
+void WarnDeprecatedOption(const std::string& old_name, const std::string& new_name) {
+  static std::set<std::string> warned;
+  if (!warned.insert(old_name).second) return;
+  Log(1, "warning: " + old_name + " is deprecated; use " + new_name + " (the old name goes in the next release)");
+}
+
+}  // namespace ibrdf
 
 int main(int argc, char** argv) {
-  CLI::App app{
-      "ibrdf: image-based BRDF measurement (after Marschner et al. 1999).\n"
-      "Photograph a curved sample under one small light from many positions; every pixel is a BRDF sample.",
-      "ibrdf"};
-  app.require_subcommand(1);
-  app.set_version_flag("--version", "ibrdf " IBRDF_VERSION);
-  int verbosity = 2;
-  int threads = 0;
-  app.add_flag_callback(
-      "-q,--quiet", [&] { verbosity = 1; }, "Stage lines and summaries only, no progress bars");
-  app.add_flag_callback(
-      "--silent", [&] { verbosity = 0; }, "Errors only");
-  app.add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
-
+  CLI::App app{"", "ibrdf"};
+  int verbosity = 2, threads = 0;
+  ibrdf::AddGlobalFlags(app, verbosity, threads);
   for (ibrdf::AddCommandFunction add : ibrdf::RegisteredCommands()) add(app);
   // Global flags after the subcommand's own arguments (`ibrdf derender S --out x.npy -q`).
   for (CLI::App* command : app.get_subcommands({})) command->fallthrough();
@@ -42,22 +76,13 @@ int main(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);  // prints the message and a pointer to --help
-    return ibrdf::kUsageErrorExitCode;
-  } catch (const ibrdf::Error& e) {
-    std::cerr << "ibrdf: error: " << e.what() << std::endl;
-    return 1;
+    // Prints the help, the version, or the message and a pointer to --help; only the first two succeed.
+    return app.exit(e) == 0 ? 0 : ibrdf::kUsageErrorExitCode;
   } catch (const ibrdf::InternalError& e) {
     std::cerr << "ibrdf: bug: " << e.what() << " (please report it)" << std::endl;
     return 70;
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // ibrdf::Error (bad input) and every other failure
     std::cerr << "ibrdf: error: " << e.what() << std::endl;
     return 1;
   }

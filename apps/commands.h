@@ -1,13 +1,16 @@
 // The subcommands of the ibrdf tool. Each subcommand lives in its own apps/<name>_command.cc,
-// registers itself with IBRDF_REGISTER_COMMAND and is built into its own binary `ibrdf-<name>` by one
-// line of apps/CMakeLists.txt (ibrdf_add_command; apps/main.cc, the front end, says how to add one).
-// Library code never sees argv.
+// defines and registers itself with IBRDF_COMMAND and is built into its own binary `ibrdf-<name>` by one
+// line of apps/CMakeLists.txt (ibrdf_add_command; IBRDF_COMMAND below says how to add one).
+// Library code never sees argv. The helpers below bind the flags several subcommands share.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+
+#include "core/logging.h"       // Log, StageLog: what every command prints
+#include "core/output_guard.h"  // RequireWritableOutput: every command's output guard
 
 namespace ibrdf {
 
@@ -26,20 +29,32 @@ struct CommandRegistrar {
 // The registered subcommands, sorted by order.
 std::vector<AddCommandFunction> RegisteredCommands();
 
-// The output guard of every subcommand: throws Error unless `output` (a file or a folder the command
-// writes or replaces) may be written. It must not be one of the command's inputs, nor a folder that
-// holds one (symlinks resolved), --overwrite or not; an existing output is replaced only with
-// --overwrite; its parent folder must exist. `inputs`: every file the command reads (missing ones and
-// "" are ignored), and every input folder.
-void RequireWritableOutput(const std::string& output, bool overwrite, const std::vector<std::string>& inputs);
+// An option whose default --help shows.
+template <typename T>
+CLI::Option* AddOption(CLI::App& app, const std::string& name, T& value, const std::string& help) {
+  return app.add_option(name, value, help)->capture_default_str();
+}
 
-// The first half of RequireWritableOutput: `output` is no input and holds none (for `run`, whose folder
-// is resumed rather than replaced).
-void RequireOutputOutsideInputs(const std::string& output, const std::vector<std::string>& inputs);
+// --out (required) and --overwrite, the flags of a command that writes one output.
+void AddOutputFlags(CLI::App& app, std::string& out, bool& overwrite, const std::string& out_help,
+                    const std::string& overwrite_help);
 
-// Every regular file under `folder`, recursively (none if it is not a folder): the inputs of a command
-// that reads a whole folder (a run folder, a COLMAP model, a calibration folder).
-std::vector<std::string> FilesUnder(const std::string& folder);
+// A flag that sets `value` to false (--no-fits clears `fits`). Not CLI11's negated flag ("!--no-fits"),
+// which --help shows as "--no-fits{false}".
+CLI::Option* AddClearingFlag(CLI::App& app, const std::string& name, bool& value, const std::string& help);
+
+// A length kept in metres and given in millimetres (--marker-mm); --help shows its default in millimetres.
+CLI::Option* AddMillimetres(CLI::App& app, const std::string& name, double& metres, const std::string& help);
+
+// The inputs of a command that reads a session (core/session.h): its files, its manifest and its folder.
+// A template, so that a binary whose command reads no session does not link the session code.
+template <typename SessionType>
+std::vector<std::string> SessionInputs(const SessionType& session) {
+  std::vector<std::string> inputs = session.InputFiles();
+  inputs.push_back(session.manifest_path);
+  inputs.push_back(session.directory);
+  return inputs;
+}
 
 // Prints once that `old_name` is deprecated in favour of `new_name` (a warning on standard error).
 void WarnDeprecatedOption(const std::string& old_name, const std::string& new_name);
@@ -62,6 +77,15 @@ CLI::Option* AddDeprecatedAlias(CLI::App& app, CLI::Option* option, const std::s
       });
 }
 
+// An option with a default shown (AddOption) and its deprecated former name (AddDeprecatedAlias).
+template <typename T>
+CLI::Option* AddRenamedOption(CLI::App& app, const std::string& name, const std::string& old_name, T& value,
+                              const std::string& help) {
+  CLI::Option* option = AddOption(app, name, value, help);
+  AddDeprecatedAlias(app, option, old_name, value);
+  return option;
+}
+
 // The error of an option value that a library's options Check() rejected: a usage error (exit 2), its
 // message naming the flags and the failed constraint.
 class OptionValueError : public CLI::ValidationError {
@@ -82,3 +106,12 @@ void RequireValidOptions(const Options& options, const std::string& flags) {
 
 #define IBRDF_REGISTER_COMMAND(order, function) \
   static const ::ibrdf::CommandRegistrar function##_registrar(order, &function)
+
+// Defines the subcommand function `Add<Name>Command(CLI::App& app)` (its body follows) and registers it.
+// A new subcommand `foo`: apps/foo_command.cc holds `IBRDF_COMMAND(95, Foo) { app.add_subcommand("foo", ...) ...
+// }`, and apps/CMakeLists.txt `ibrdf_add_command(foo 95 "one-line summary" ibrdf_x ...)` naming the
+// libraries it calls (95: its place in `ibrdf --help`); configuring fails without that line.
+#define IBRDF_COMMAND(order, Name)                   \
+  static void Add##Name##Command(CLI::App& app);     \
+  IBRDF_REGISTER_COMMAND(order, Add##Name##Command); \
+  static void Add##Name##Command(CLI::App& app)

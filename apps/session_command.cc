@@ -1,24 +1,24 @@
 // ibrdf session init: a draft session.json from a camera's photos (capture/session_init.h) behind flags.
 #include <iostream>
-#include <memory>
 
 #include "apps/commands.h"
 #include "capture/session_init.h"
-#include "core/error.h"
-#include "core/logging.h"
 
 namespace ibrdf {
 namespace {
 
-std::optional<Eigen::Vector3d> Vector(const std::vector<double>& values) {
-  if (values.empty()) return std::nullopt;
-  return Eigen::Vector3d(values[0], values[1], values[2]);
+// Three values as a vector (none when not given).
+std::optional<Eigen::Vector3d> Vector3(const std::vector<double>& v) {
+  if (v.empty()) return std::nullopt;
+  return Eigen::Vector3d(v[0], v[1], v[2]);
 }
 
-void AddSessionCommand(CLI::App& app) {
+}  // namespace
+
+IBRDF_COMMAND(15, Session) {
   auto* session = app.add_subcommand("session", "Session files: `session init` drafts one from a camera's photos");
   session->require_subcommand(1);
-  auto* init = session->add_subcommand(
+  auto* c = session->add_subcommand(
       "init",
       "Draft OUT/session.json from the photos' EXIF: exposure time, ISO (as gain), focal length and size;\n"
       "exposure brackets grouped; the camera from --camera or guessed from EXIF. Prints what was assumed and\n"
@@ -26,75 +26,55 @@ void AddSessionCommand(CLI::App& app) {
   struct Args {
     SessionInitOptions o;
     std::string out;
-    std::vector<double> light_position, light_intensity, sample_center;
+    std::vector<double> light_position, light_intensity, sample_center, white_reflectance, chart_corners;
     double sample_radius = 0.0, white_size = 0.0;
-    std::vector<double> white_reflectance;
-    std::vector<double> chart_corners;
   };
   auto args = std::make_shared<Args>();
   SessionInitOptions& o = args->o;
-  init->add_option("photos", o.photos, "Measurement photos, in capture order")->required()->check(CLI::ExistingFile);
-  init->add_option("--out", args->out, "Folder for session.json (the photos stay where they are)")->required();
-  init->add_option("--target-photos", o.target_photos, "Photos for the alignment only (e.g. of the light's markers)")
-      ->check(CLI::ExistingFile);
-  init->add_option("--white-photos", o.white_photos,
-                   "Photos of the white reference (its card's markers pose it in `ibrdf align`); it measures the "
-                   "light's intensity")
-      ->check(CLI::ExistingFile);
-  init->add_option("--white-size-m", args->white_size, "The white reference's size (metres, the patch's side)");
-  init->add_option("--white-reflectance", args->white_reflectance,
-                   "The white reference's albedo R G B (default 0.99: Spectralon)")
-      ->expected(3);
-  init->add_option("--chart-photos", o.chart_photos,
-                   "Photos of a ColorChecker Classic 24 under the session's light (one view; `ibrdf colour` fits the "
-                   "matrix to linear sRGB)")
-      ->check(CLI::ExistingFile);
-  init->add_option("--chart-corners", args->chart_corners,
-                   "Pixel centres X Y of the chart's patches 1, 6, 24 and 19 (top-left, top-right, bottom-right, "
-                   "bottom-left); without them `ibrdf colour` detects the chart (OpenCV mcc)")
-      ->expected(8);
-  init->add_option("--targets", o.targets_file, "The markers' layout: targets.json from `ibrdf targets`")
-      ->check(CLI::ExistingFile);
-  init->add_option("--camera", o.camera_file, "A JSON file with a calibrated \"camera\" block (e.g. a session.json)")
-      ->check(CLI::ExistingFile);
-  init->add_option("--sensor-width-mm", o.sensor_width_mm, "Sensor width, when EXIF has no focal-plane resolution");
-  init->add_option("--base-iso", o.base_iso, "The ISO of gain 1 (default: the lowest ISO of the photos)");
-  init->add_option("--bracket-size", o.bracket_size,
-                   "Exposures per bracket (0: group by capture time and exposure steps; 1: no brackets)")
-      ->capture_default_str();
-  init->add_option("--bracket-gap-s", o.bracket_gap_s, "Longest time between two exposures of one bracket")
-      ->capture_default_str();
-  AddDeprecatedAlias(
-      *init,
-      init->add_option("--light-position-m", args->light_position, "The light's position X Y Z (targets' frame)")
-          ->expected(3),
-      "--light-position", args->light_position);
-  init->add_option("--light-intensity", args->light_intensity, "The light's RGB intensity (session radiance unit)")
-      ->expected(3);
-  AddDeprecatedAlias(*init, init->add_option("--sample-radius-m", args->sample_radius, "The sphere's radius"),
+  const auto files = [c](const char* name, auto& paths, const char* help) {  // one file or several
+    c->add_option(name, paths, help)->check(CLI::ExistingFile);
+  };
+  const auto vector = [c](const char* name, std::vector<double>& values, int n, const char* help) {
+    return c->add_option(name, values, help)->expected(n);
+  };
+  c->add_option("photos", o.photos, "Measurement photos, in capture order")->required()->check(CLI::ExistingFile);
+  c->add_option("--out", args->out, "Folder for session.json (the photos stay where they are)")->required();
+  c->add_flag("--overwrite", o.overwrite, "Replace session.json / session.draft.json in OUT");
+  files("--target-photos", o.target_photos, "Photos for the alignment only (e.g. of the light's markers)");
+  files("--white-photos", o.white_photos, "Photos of the white reference (measures the light's intensity)");
+  c->add_option("--white-size-m", args->white_size, "The white reference's size (metres, the patch's side)");
+  vector("--white-reflectance", args->white_reflectance, 3, "The white reference's albedo R G B (default 0.99)");
+  files("--chart-photos", o.chart_photos, "Photos of a ColorChecker Classic 24 under the session's light");
+  vector("--chart-corners", args->chart_corners, 8, "Pixel centres X Y of the chart's patches 1, 6, 24 and 19");
+  files("--targets", o.targets_file, "The markers' layout: targets.json from `ibrdf targets`");
+  files("--camera", o.camera_file, "A JSON file with a calibrated \"camera\" block (e.g. a session.json)");
+  c->add_option("--sensor-width-mm", o.sensor_width_mm, "Sensor width, when EXIF has no focal-plane resolution");
+  c->add_option("--base-iso", o.base_iso, "The ISO of gain 1 (default: the lowest ISO of the photos)");
+  AddOption(*c, "--bracket-size", o.bracket_size, "Exposures per bracket (0: by capture time and steps; 1: none)");
+  AddOption(*c, "--bracket-gap-s", o.bracket_gap_s, "Longest time between two exposures of one bracket");
+  AddDeprecatedAlias(*c, vector("--light-position-m", args->light_position, 3, "The light's X Y Z (targets' frame)"),
+                     "--light-position", args->light_position);
+  vector("--light-intensity", args->light_intensity, 3, "The light's RGB intensity (session radiance unit)");
+  AddDeprecatedAlias(*c, c->add_option("--sample-radius-m", args->sample_radius, "The sphere's radius"),
                      "--sample-radius", args->sample_radius);
-  init->add_flag("--radius-known", o.radius_known, "The radius is measured: `ibrdf align` fits only the centre");
-  AddDeprecatedAlias(*init,
-                     init->add_option("--sample-center-m", args->sample_center,
-                                      "The sphere's centre X Y Z (default with --targets: on the platform's centre)")
-                         ->expected(3),
+  c->add_flag("--radius-known", o.radius_known, "The radius is measured: `ibrdf align` fits only the centre");
+  AddDeprecatedAlias(*c,
+                     vector("--sample-center-m", args->sample_center, 3,
+                            "The sphere's centre X Y Z (default with --targets: on the platform's centre)"),
                      "--sample-center", args->sample_center);
-  init->add_option("--response", o.response, "\"linear\" or \"srgb\" (default: from the file format)");
-  init->add_option("--name", o.name, "The session's name (default: the output folder's)");
-  init->add_flag("--overwrite", o.overwrite, "Replace session.json / session.draft.json in OUT");
-  init->callback([args] {
+  c->add_option("--response", o.response, "\"linear\" or \"srgb\" (default: from the file format)");
+  c->add_option("--name", o.name, "The session's name (default: the output folder's)");
+  c->callback([args] {
     SessionInitOptions& options = args->o;
-    options.light_position = Vector(args->light_position);
-    options.light_intensity = Vector(args->light_intensity);
-    options.sample_center = Vector(args->sample_center);
+    options.light_position = Vector3(args->light_position);
+    options.light_intensity = Vector3(args->light_intensity);
+    options.sample_center = Vector3(args->sample_center);
+    options.white_reflectance = Vector3(args->white_reflectance);
     if (args->sample_radius > 0.0) options.sample_radius = args->sample_radius;
     if (args->white_size != 0.0) options.white_size = args->white_size;
-    options.white_reflectance = Vector(args->white_reflectance);
     if (args->chart_corners.size() == 8) {
-      std::array<Eigen::Vector2d, 4> corners;
-      for (int k = 0; k < 4; ++k)
-        corners[k] = Eigen::Vector2d(args->chart_corners[2 * k], args->chart_corners[2 * k + 1]);
-      options.chart_corners = corners;
+      const std::vector<double>& x = args->chart_corners;
+      options.chart_corners = {{{x[0], x[1]}, {x[2], x[3]}, {x[4], x[5]}, {x[6], x[7]}}};
     }
     RequireValidOptions(options, "ibrdf session init");
     const SessionInitResult result = InitSession(options, args->out);
@@ -108,9 +88,5 @@ void AddSessionCommand(CLI::App& app) {
     std::cout << "session: " << result.path << "\n";
   });
 }
-
-}  // namespace
-
-IBRDF_REGISTER_COMMAND(15, AddSessionCommand);
 
 }  // namespace ibrdf

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <nlohmann/json_fwd.hpp>
+#include <nlohmann/json.hpp>
 
 #include "core/brdf_model.h"
 #include "core/sample_file.h"
@@ -54,5 +54,16 @@ std::string TruthPathFromSidecar(const std::string& samples_path);
 // The comparison as the table `ibrdf compare` prints: median and 95th-percentile relative error per
 // channel (percent) for each non-empty band and overall, one line each.
 std::string ComparisonTable(const TruthComparison& comparison);
+
+// What `ibrdf compare` finds for `input`: a sample file against the truth (CompareWithTruth), or a MERL
+// table's lookups at `lookups` random direction pairs (CheckMerlLookups).
+struct CompareOutcome {
+  nlohmann::json json;  // the figures, with "samples" (or "table") and "truth": the paths compared
+  std::string text;     // what the command prints: the comparison table, or the lookup check's line
+  std::string brief;    // the comparison's BriefReport ("" for a table)
+};
+
+// `truth_path`: truth.json, a material file or a MERL table (LoadTruthFile).
+CompareOutcome CompareFileWithTruth(const std::string& input, const std::string& truth_path, size_t lookups);
 
 }  // namespace ibrdf

@@ -473,6 +473,15 @@ nlohmann::json LibraryRecord(const LibraryEntry& entry) {
   return record;
 }
 
+std::vector<LibraryEntry> LibraryEntriesOfRuns(const std::vector<std::string>& run_dirs) {
+  std::vector<LibraryEntry> entries;
+  for (const std::string& run : run_dirs) {
+    if (!fs::is_directory(run)) ThrowError(run, "is not a folder (expected an `ibrdf run` folder)");
+    entries.push_back({fs::absolute(run).lexically_normal().filename().string(), run, "", ""});
+  }
+  return entries;
+}
+
 LibraryResult BuildLibrary(const std::vector<LibraryEntry>& entries, const LibraryOptions& options) {
   Timer timer;
   std::string why;

@@ -50,6 +50,10 @@ struct LibraryResult {
 // invalid options, two entries with one name, or an out_dir inside a run folder or holding one.
 LibraryResult BuildLibrary(const std::vector<LibraryEntry>& entries, const LibraryOptions& options);
 
+// The entries of `ibrdf run` folders, each material named after its folder. Throws Error naming a run
+// that is not a folder.
+std::vector<LibraryEntry> LibraryEntriesOfRuns(const std::vector<std::string>& run_dirs);
+
 // The entry's state as the index records it: {"name", "status": "ok" | "failed" | "incomplete",
 // "error", "log", "run_dir", "source", ...figures}. Exposed for the tests.
 nlohmann::json LibraryRecord(const LibraryEntry& entry);

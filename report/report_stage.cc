@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <future>
 #include <map>
@@ -21,6 +22,7 @@
 #include "core/linear_image.h"
 #include "core/logging.h"
 #include "core/npy.h"
+#include "core/output_guard.h"
 #include "core/sample_file.h"
 #include "core/session.h"
 #include "core/statistics.h"
@@ -542,6 +544,30 @@ std::string ReportResult::BriefReport() const {
         << " % (the reconstruction that saw it: " << 100.0 * h.in_sample_median_abs_difference << " %)";
   }
   return out.str();
+}
+
+std::vector<std::string> ReportResult::SummaryLines() const {
+  std::vector<std::string> lines = {BriefReport()};
+  for (const BandAgreement& band : bands) {
+    char line[200];
+    std::snprintf(line, sizeof(line),
+                  "incidence plane %g deg: median sample / reconstruction R G B %.3f %.3f %.3f over %zu samples",
+                  band.theta0_deg, band.ratio[0], band.ratio[1], band.ratio[2], band.samples);
+    lines.push_back(line);
+  }
+  if (!explorer_html.empty()) lines.push_back("explorer: " + explorer_html);
+  return lines;
+}
+
+std::vector<std::string> ReportInputs(const std::string& run_dir, const ReportOptions& options) {
+  const fs::path own_report = fs::path(run_dir) / "report";
+  std::vector<std::string> inputs = {run_dir};
+  if (!options.reconstruction.empty()) inputs.push_back(options.reconstruction);
+  for (const std::string& file : FilesUnder(run_dir)) {
+    if (fs::path(file).lexically_relative(own_report).string().rfind("..", 0) != 0) continue;
+    inputs.push_back(file);
+  }
+  return inputs;
 }
 
 ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& options, const std::string& out_dir) {

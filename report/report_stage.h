@@ -68,7 +68,13 @@ struct ReportResult {
   std::vector<HeldOutRender> held_out;  // the held-out photos shown
   // One line: where, which photo, what was rendered.
   std::string BriefReport() const;
+  // What `ibrdf report` prints: BriefReport(), a line per incidence-plane band, the explorer's path.
+  std::vector<std::string> SummaryLines() const;
 };
+
+// The inputs of the report of `run_dir` (for the output guard): the run folder, every file in it but
+// those of its default report folder RUN_DIR/report, and the reconstruction the options name.
+std::vector<std::string> ReportInputs(const std::string& run_dir, const ReportOptions& options);
 
 // Writes the report of `run_dir` (samples.npy; optionally its sidecar, summary.json, consistency.json,
 // the reconstruction and truth-comparison.json) into `out_dir` (empty: RUN_DIR/report), atomically.

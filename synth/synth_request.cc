@@ -1,6 +1,8 @@
 #include "synth/synth_request.h"
 
+#include "core/colour.h"
 #include "core/error.h"
+#include "core/merl_brdf.h"
 #include "core/session.h"
 
 namespace ibrdf {
@@ -40,7 +42,26 @@ SynthOptions SynthOptionsFromRequest(const SynthRequest& request) {
   const std::vector<double>& i = request.light_intensity;
   if (!i.empty() && i.size() != 3) ThrowError("--light-intensity", "expected 3 values (R G B)");
   if (!i.empty()) options.scene.light_intensity = Eigen::Vector3d(i[0], i[1], i[2]);
+  const std::vector<double>& m = request.camera_matrix;
+  if (!m.empty() && m.size() != 9) ThrowError("--camera-matrix", "expected 9 values (row by row)");
+  if (!m.empty()) {
+    options.colour.camera_matrix = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m.data());
+  }
+  options.colour.chart_corners = !request.colour_chart_detect;
+  if (!ColourSpaceFromName(request.colour_space, &options.colour.space)) {
+    ThrowError("--colour-space", "unknown space \"" + request.colour_space + "\" (expected linear_srgb or xyz)");
+  }
+  options.no_data = SynthNoDataFromName(request.no_data);
   return options;
+}
+
+std::unique_ptr<BrdfModel> LoadRequestedMaterial(const SynthRequest& request, const std::string& path) {
+  std::unique_ptr<BrdfModel> material = LoadMaterial(path);
+  if (!request.merl_lookup_given) return material;
+  const auto* table = dynamic_cast<const MerlBrdf*>(material.get());
+  if (!table) ThrowError(path, "--merl-lookup applies to MERL tables (.binary) only");
+  return std::make_unique<MerlBrdf>(table->table(), table->path(),
+                                    MerlLookupFromName(request.merl_lookup, "synth --merl-lookup"));
 }
 
 CharucoPhotosSummary WriteSessionCharucoPhotos(const std::string& session_dir, int num_photos, uint64_t session_seed) {

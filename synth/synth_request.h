@@ -4,9 +4,11 @@
 // a SynthRequest; the logic that turns it into options lives here, where it can be tested.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "core/brdf_model.h"
 #include "synth/synth_options.h"
 #include "synth/synthetic_charuco.h"
 
@@ -29,12 +31,23 @@ struct SynthRequest {
   bool targets = false;
   bool camera_elevation_given = false, light_photos_given = false;
   std::vector<double> origin, light_intensity;  // 3 values each when given
-  int charuco_photos = 0;  // ChArUco board photos to write beside the session (WriteSessionCharucoPhotos)
+  int charuco_photos = 0;             // ChArUco board photos to write beside the session (WriteSessionCharucoPhotos)
+  std::vector<double> camera_matrix;  // 9 values row by row when given: camera RGB = M * linear sRGB
+  bool colour_chart_detect = false;   // leave the chart's corners out (`ibrdf colour` detects it)
+  std::string colour_space = "linear_srgb";  // the colour_chart block's target space (ColourSpaceFromName)
+  std::string no_data = "skip";              // a MERL table's cells without data (SynthNoDataFromName)
+  // A MERL table's lookups (MerlLookupFromName), applied only when given: other materials have none.
+  std::string merl_lookup = "nearest";
+  bool merl_lookup_given = false;
 };
 
 // The options a request describes. Throws Error naming the flag for contradictory choices (--no-clip
-// without float output) or an unknown shape.
+// without float output), an unknown shape or no-data policy, or a vector of the wrong size.
 SynthOptions SynthOptionsFromRequest(const SynthRequest& request);
+
+// The material at `path` (LoadMaterial), a MERL table with the request's lookup when one was given.
+// Throws Error naming the file when a lookup is given for a material that is not a MERL table.
+std::unique_ptr<BrdfModel> LoadRequestedMaterial(const SynthRequest& request, const std::string& path);
 
 // Writes `num_photos` photos of the default ChArUco board (CharucoPhotoOptions) taken with the camera
 // of the session in `session_dir` into `session_dir`/calibration (for `ibrdf align --calibrate`),

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "core/error.h"
 #include "tests/error_of.h"
 #include "tests/scratch_dir.h"
 
@@ -31,6 +32,16 @@ const char* kSummary = R"({"format": "ibrdf-run", "version": 1, "input": "/data/
   "reconstruction": {"table": {"cells_measured": 900, "cells_unsupported": 100},
                      "fits": {"ggx": {"rel_rms_vs_samples": 0.07}}},
   "timings_s": {"stages_total": 12.5}})";
+
+TEST(MaterialLibrary, RunFoldersAreNamedAfterTheirFolder) {
+  testing::ScratchDir dir;
+  fs::create_directories(dir / "runs/felt");
+  const std::vector<LibraryEntry> entries = LibraryEntriesOfRuns({dir / "runs/felt"});
+  ASSERT_EQ(entries.size(), 1u);
+  EXPECT_EQ(entries[0].name, "felt");
+  EXPECT_EQ(entries[0].run_dir, dir / "runs/felt");
+  EXPECT_THROW(LibraryEntriesOfRuns({dir / "runs/none"}), Error);
+}
 
 TEST(MaterialLibrary, AFinishedRunsFiguresComeFromItsSummary) {
   ScratchDir dir;

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/colour.h"
 #include "core/error.h"
 
 namespace ibrdf {
@@ -73,6 +74,44 @@ TEST(SynthRequest, EffectsPresetAndOverrides) {
   EXPECT_EQ(options.scene.light_intensity, Eigen::Vector3d(2.0, 2.0, 1.0));
   request.origin = {1.0};
   EXPECT_THROW(SynthOptionsFromRequest(request), Error);
+}
+
+TEST(SynthRequest, ColourAndNoDataByName) {
+  SynthRequest request;
+  request.camera_matrix = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+  request.colour_chart_detect = true;
+  request.colour_space = "xyz";
+  request.no_data = "zero";
+  const SynthOptions options = SynthOptionsFromRequest(request);
+  EXPECT_EQ(options.colour.camera_matrix(0, 1), 2.0);  // row by row
+  EXPECT_EQ(options.colour.camera_matrix(1, 0), 4.0);
+  EXPECT_FALSE(options.colour.chart_corners);
+  EXPECT_EQ(options.colour.space, ColourSpace::kXyz);
+  EXPECT_EQ(options.no_data, SynthNoData::kZero);
+  EXPECT_TRUE(SynthOptionsFromRequest(SynthRequest()).colour.chart_corners);
+  SynthRequest bad;
+  bad.camera_matrix = {1, 2};
+  EXPECT_THROW(SynthOptionsFromRequest(bad), Error);
+  bad = SynthRequest();
+  bad.colour_space = "lab";
+  EXPECT_THROW(SynthOptionsFromRequest(bad), Error);
+  bad = SynthRequest();
+  bad.no_data = "maybe";
+  EXPECT_THROW(SynthOptionsFromRequest(bad), Error);
+}
+
+TEST(SynthRequest, MerlLookupOnlyForTables) {
+  SynthRequest request;
+  const std::string material = std::string(IBRDF_SAMPLES_DIR) + "/materials/lambertian50.json";
+  EXPECT_NE(LoadRequestedMaterial(request, material), nullptr);
+  request.merl_lookup_given = true;
+  try {
+    LoadRequestedMaterial(request, material);
+    FAIL() << "a lookup for a material that is no MERL table";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--merl-lookup"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(material), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

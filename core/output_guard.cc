@@ -1,32 +1,13 @@
-#include <algorithm>
-#include <filesystem>
-#include <set>
-#include <utility>
+#include "core/output_guard.h"
 
-#include "apps/commands.h"
+#include <filesystem>
+
 #include "core/error.h"
 #include "core/file_util.h"
-#include "core/logging.h"
 
 namespace ibrdf {
 namespace {
-std::vector<std::pair<int, AddCommandFunction>>& Registry() {
-  static std::vector<std::pair<int, AddCommandFunction>> registry;
-  return registry;
-}
-}  // namespace
 
-CommandRegistrar::CommandRegistrar(int order, AddCommandFunction add) { Registry().emplace_back(order, add); }
-
-std::vector<AddCommandFunction> RegisteredCommands() {
-  std::vector<std::pair<int, AddCommandFunction>> sorted = Registry();
-  std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<AddCommandFunction> out;
-  for (const auto& entry : sorted) out.push_back(entry.second);
-  return out;
-}
-
-namespace {
 // The absolute, symlink-resolved form of `path` (its existing part resolved, the rest appended).
 std::filesystem::path Resolved(const std::string& path) {
   std::error_code error;
@@ -46,6 +27,7 @@ bool IsWithin(const std::filesystem::path& inner, const std::filesystem::path& o
   }
   return true;
 }
+
 }  // namespace
 
 void RequireOutputOutsideInputs(const std::string& output, const std::vector<std::string>& inputs) {
@@ -72,12 +54,6 @@ void RequireWritableOutput(const std::string& output, bool overwrite, const std:
   if (!parent.empty() && !std::filesystem::is_directory(parent)) {
     ThrowError(output, "output folder " + parent.string() + " does not exist");
   }
-}
-
-void WarnDeprecatedOption(const std::string& old_name, const std::string& new_name) {
-  static std::set<std::string> warned;
-  if (!warned.insert(old_name).second) return;
-  Log(1, "warning: " + old_name + " is deprecated; use " + new_name + " (the old name goes in the next release)");
 }
 
 std::vector<std::string> FilesUnder(const std::string& folder) {

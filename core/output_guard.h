@@ -1,0 +1,26 @@
+// The output guard of every stage's command: a file or folder a command writes is never one of its
+// inputs (nor a folder holding one, symlinks resolved), and an existing one is replaced only when the
+// user said so. The commands call it before they read or write anything, so a refused command leaves
+// nothing behind.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace ibrdf {
+
+// Throws Error unless `output` (a file or a folder the command writes or replaces) may be written. It
+// must not be one of the command's inputs, nor a folder that holds one, overwrite or not; an existing
+// output is replaced only with `overwrite` (--overwrite); its parent folder must exist. `inputs`: every
+// file the command reads (missing ones and "" are ignored), and every input folder.
+void RequireWritableOutput(const std::string& output, bool overwrite, const std::vector<std::string>& inputs);
+
+// The first half of RequireWritableOutput: `output` is no input and holds none (for `run`, whose folder
+// is resumed rather than replaced).
+void RequireOutputOutsideInputs(const std::string& output, const std::vector<std::string>& inputs);
+
+// Every regular file under `folder`, recursively (none if it is not a folder): the inputs of a command
+// that reads a whole folder (a run folder, a COLMAP model, a calibration folder).
+std::vector<std::string> FilesUnder(const std::string& folder);
+
+}  // namespace ibrdf
