@@ -18,7 +18,7 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "core/light.h"
-#include "core/linear_image.h"
+#include "radiometry/linear_image.h"
 #include "core/logging.h"
 
 namespace ibrdf {

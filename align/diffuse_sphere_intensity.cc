@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
-#include "core/linear_image.h"
+#include "radiometry/linear_image.h"
 #include "core/logging.h"
 
 namespace ibrdf {
@@ -174,6 +174,7 @@ DiffuseSphereIntensities MeasureDiffuseSphereIntensities(const Session& diffuse,
     const Image raw = ReadImage(photo_path);
     Image radiance = raw;
     LinearizeImage(diffuse, i, &radiance, /*divide_by_exposure=*/true);
+    const std::vector<uint8_t> saturated = SaturatedPixels(diffuse.radiometry, raw);
     const double to_signal = photo.exposure_s * photo.gain;
     Samples& samples = by_light[id];
     const int channels = std::min(raw.channels, 3);
@@ -196,10 +197,7 @@ DiffuseSphereIntensities MeasureDiffuseSphereIntensities(const Session& diffuse,
         const double unit = UnitIrradiance(*light, p_world, n_world, &cos_i);
         const double unit_nominal = UnitIrradiance(nominal, p_world, n_world, &cos_nominal);
         if (cos_i < cos_i_min) continue;
-        bool clipped = false;
-        for (int c = 0; c < raw.channels; ++c)
-          clipped = clipped || raw.at(x, y, c) >= diffuse.radiometry.saturation_level;
-        if (clipped) {
+        if (saturated[size_t(y) * raw.width + x]) {
           ++samples.saturated;
           continue;
         }

@@ -9,7 +9,7 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
-#include "core/linear_image.h"
+#include "radiometry/linear_image.h"
 #include "core/logging.h"
 #include "core/statistics.h"
 

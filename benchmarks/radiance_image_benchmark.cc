@@ -1,4 +1,4 @@
-// Speed of the radiometric chain (derender/radiance_image.h) against decoding the same photos: it
+// Speed of the radiometric chain (radiometry/radiance_image.h) against decoding the same photos: it
 // runs for every pixel of every photo, so it should cost little beside the decode.
 //
 //   build/benchmarks/radiance_image_benchmark [--benchmark_filter=...]
@@ -20,7 +20,7 @@
 #include "core/logging.h"
 #include "core/session.h"
 #include "derender/light_calibration.h"
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 #include "synth/synthetic.h"
 
 namespace ibrdf {

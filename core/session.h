@@ -148,7 +148,7 @@ struct PhotoSpec {
   std::optional<Rigid3d> camera_from_world;  // known pose, if any
   PhotoRole role = PhotoRole::kMeasurement;
   // Exposure bracket: measurement photos with the same bracket id are exposures of one pose under one
-  // light, merged into one high-dynamic-range radiance image (derender/radiance_image.h). Absent:
+  // light, merged into one high-dynamic-range radiance image (radiometry/radiance_image.h). Absent:
   // photos with identical poses and the same light still form one bracket.
   std::optional<int> bracket;
   // The light the photo was taken under: an index into Session::lights (the manifest names it by id).

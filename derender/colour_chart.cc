@@ -15,7 +15,7 @@
 #include "core/json_reader.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 
 namespace ibrdf {
 namespace {

@@ -19,7 +19,7 @@
 #include "core/logging.h"
 #include "core/sample_file.h"
 #include "core/session.h"
-#include "derender/exposure_advice.h"
+#include "radiometry/exposure_advice.h"
 
 namespace ibrdf {
 

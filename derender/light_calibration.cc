@@ -8,7 +8,7 @@
 #include "core/file_util.h"
 #include "core/light.h"
 #include "core/statistics.h"
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 
 namespace ibrdf {
 namespace {

@@ -12,7 +12,7 @@
 #include "core/file_util.h"
 #include "core/image_io.h"
 #include "core/json_reader.h"
-#include "core/linear_image.h"
+#include "radiometry/linear_image.h"
 #include "core/sample_file.h"
 #include "core/session.h"
 #include "core/statistics.h"

@@ -18,7 +18,7 @@
 #include "core/file_util.h"
 #include "core/image_io.h"
 #include "core/json_reader.h"
-#include "core/linear_image.h"
+#include "radiometry/linear_image.h"
 #include "core/logging.h"
 #include "core/npy.h"
 #include "core/sample_file.h"

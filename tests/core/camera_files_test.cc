@@ -11,7 +11,7 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
-#include "core/linear_image.h"
+#include "radiometry/linear_image.h"
 #include "core/session.h"
 #include "tests/core/test_dng.h"
 #include "tests/scratch_dir.h"

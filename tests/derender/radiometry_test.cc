@@ -14,7 +14,7 @@
 #include "core/logging.h"
 #include "derender/derenderer.h"
 #include "derender/light_calibration.h"
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 #include "reconstruct/truth_comparison.h"
 #include "tests/test_util.h"
 

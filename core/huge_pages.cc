@@ -1,4 +1,4 @@
-#include "derender/huge_pages.h"
+#include "core/huge_pages.h"
 
 #include <sys/mman.h>
 

@@ -1,4 +1,4 @@
-#include "derender/exposure_advice.h"
+#include "radiometry/exposure_advice.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 
 namespace ibrdf {
 namespace {

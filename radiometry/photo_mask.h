@@ -11,7 +11,7 @@
 
 namespace ibrdf {
 
-// The usable pixels of one exposure group (session.photos indices; derender/radiance_image.h): one
+// The usable pixels of one exposure group (session.photos indices; radiometry/radiance_image.h): one
 // byte per pixel, row-major, 1 where every photo of the group that has a mask (its own, or the
 // session's default) marks the pixel usable, 0 elsewhere. Empty when no photo of the group has a mask.
 // Throws Error naming the mask for an unreadable file, and naming both the mask and the photo for a

@@ -1,7 +1,7 @@
 // Huge-page advice for the derenderer's buffers: contents and capacity as reserve() gives them, any
 // range accepted, and (where the kernel offers transparent huge pages) the advised range marked
 // eligible in /proc/self/smaps.
-#include "derender/huge_pages.h"
+#include "core/huge_pages.h"
 
 #include <cstdint>
 #include <fstream>

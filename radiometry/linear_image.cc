@@ -1,4 +1,4 @@
-#include "core/linear_image.h"
+#include "radiometry/linear_image.h"
 
 #include <algorithm>
 #include <cmath>
@@ -102,6 +102,19 @@ void LinearizeImage(const Session& session, size_t photo, Image* image, bool div
 double SaturationLevel(const RadiometrySpec& radiometry, const Image& image) {
   if (radiometry.saturation_stated) return radiometry.saturation_level;
   return image.floating_point ? std::numeric_limits<double>::infinity() : 1.0;
+}
+
+std::vector<uint8_t> SaturatedPixels(const RadiometrySpec& radiometry, const Image& image) {
+  const double level = SaturationLevel(radiometry, image);
+  const size_t n = size_t(image.width) * image.height;
+  std::vector<uint8_t> saturated(n, 0);
+  for (size_t p = 0; p < n; ++p) {
+    const float* values = &image.pixels[p * image.channels];
+    for (int c = 0; c < 3; ++c) {
+      if (values[image.channels == 1 ? 0 : c] >= level) saturated[p] = 1;
+    }
+  }
+  return saturated;
 }
 
 }  // namespace ibrdf

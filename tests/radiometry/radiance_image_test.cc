@@ -1,6 +1,6 @@
 // The radiometric chain on hand-made images: response, black level, exposure, flat field, flags, the
 // noise model's sigma, exposure groups and the HDR merge of a bracket.
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 
 #include <cmath>
 #include <cstring>
@@ -114,7 +114,7 @@ TEST(RadianceImage, LookupTableMatchesTheResponse) {
 TEST(RadianceImage, FlagsSaturatedBelowSignalAndNonFinite) {
   ScratchDir dir;
   Session session = SmallSession(dir);
-  // Float files clip only where the session says so (core/linear_image.h SaturationLevel).
+  // Float files clip only where the session says so (radiometry/linear_image.h SaturationLevel).
   session.radiometry.saturation_stated = true;
   session.radiometry.saturation_level = 1.0;
   Image image(kWidth, kHeight, 3);

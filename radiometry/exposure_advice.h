@@ -38,7 +38,7 @@ struct ExposureTally {
   std::array<std::array<uint64_t, 3>, kBands> non_finite{};
 
   // Counts one pixel at half-vector angle theta_h (radians) with per-channel PixelFlag bits
-  // (derender/radiance_image.h; 0 = the channel is measured).
+  // (radiometry/radiance_image.h; 0 = the channel is measured).
   void Add(double theta_h, const uint8_t channel_flags[3]);
   void Merge(const ExposureTally& other);
   // Pixels of all bands.

@@ -1,4 +1,4 @@
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,9 +12,9 @@
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
-#include "core/linear_image.h"
+#include "radiometry/linear_image.h"
 #include "core/logging.h"
-#include "derender/huge_pages.h"
+#include "core/huge_pages.h"
 
 namespace fs = std::filesystem;
 

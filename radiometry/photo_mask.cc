@@ -1,4 +1,4 @@
-#include "derender/photo_mask.h"
+#include "radiometry/photo_mask.h"
 
 #include <string>
 

@@ -1,10 +1,11 @@
 // A photo's file values to linear signal, the one way every stage does it outside the derenderer's
-// own per-pixel loop (derender/radiance_image.h, which reads the same flat field): the session's
+// own per-pixel loop (radiometry/radiance_image.h, which reads the same flat field): the session's
 // response inverted, the black level subtracted (clamped at 0), divided by the flat field, and
 // optionally by the photo's exposure time and gain (then in the session's radiance unit).
 // docs/radiometry.md states the chain.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -29,6 +30,11 @@ std::shared_ptr<const FlatField> LoadFlatField(const Session& session);
 // floating-point files (an HDR render or merged EXR has no full scale: clipping it at 1.0 would throw
 // away every highlight).
 double SaturationLevel(const RadiometrySpec& radiometry, const Image& image);
+
+// Per pixel of `image` (its file values, before LinearizeImage), 1 where one of its colour channels (the
+// first three; a grey image's one) reaches SaturationLevel, 0 elsewhere: the clipping test of the
+// derenderer's chain (radiance_image.h, kPixelSaturated) for a stage that reads a photo whole.
+std::vector<uint8_t> SaturatedPixels(const RadiometrySpec& radiometry, const Image& image);
 
 // Linearizes `image` (photo `photo` of the session, as ReadImage decoded it) in place by the chain
 // above. Grey images use the mean of the flat field's channels; channels past the third (alpha) are
