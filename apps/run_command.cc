@@ -149,8 +149,8 @@ void AddRunCommand(CLI::App& app) {
         ->type_name("\"ARGS\"");
   }
   command->add_option("--stop-after", o.stop_after,
-                      "Stop after this stage (synth, scan, align, colour, derender, check, compare,\n"
-                      "reconstruct, report); later stages are left as they are");
+                      "Stop after this stage (synth, scan, align, lights, colour, derender, check,\n"
+                      "compare, reconstruct, report); later stages are left as they are");
   command->callback([args] {
     Timer wall;
     RequireValidOptions(args->options, "ibrdf run");

@@ -15,11 +15,11 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include "calibrate/white_reference_intensity.h"
 #include "core/brdf_model.h"
 #include "core/image_io.h"
 #include "core/logging.h"
 #include "core/session.h"
-#include "derender/light_calibration.h"
 #include "radiometry/radiance_image.h"
 #include "synth/synthetic.h"
 

@@ -11,10 +11,10 @@
 
 #include "core/error.h"
 #include "core/file_util.h"
-#include "core/image_io.h"
-#include "radiometry/linear_image.h"
-#include "core/logging.h"
 #include "core/huge_pages.h"
+#include "core/image_io.h"
+#include "core/logging.h"
+#include "radiometry/linear_image.h"
 
 namespace fs = std::filesystem;
 
@@ -322,9 +322,43 @@ void RadianceReader::Exposures::Merge(int x, int y, PixelRadiance* out, uint8_t*
   out->exposures = m > 1 ? static_cast<uint8_t>(used) : uint8_t(1);
 }
 
-void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
-                             std::vector<Image>* decoded, std::vector<float>* scratch_buffer, Exposures* state,
-                             double* decode_s) const {
+namespace {
+
+// The pixels of the floor's ring (kFloorRing*) in one dimension around index k of `size`.
+int RingSpan(int k, int half, int size) { return std::min(k + half, size - 1) - std::max(k - half, 0) + 1; }
+
+// The ring's pixel counts by column of a window `width` wide (outer and inner span), and of each value
+// of a row at least kFloorRingOuter rows from the window's top and bottom; the columns whose ring lies
+// inside the window.
+struct RingColumns {
+  explicit RingColumns(int width) : span_outer_x(width), span_inner_x(width), interior_row_count(3 * size_t(width)) {
+    constexpr int kOuter = kFloorRingOuter, kInner = kFloorRingInner;
+    for (int i = 0; i < width; ++i) {
+      span_outer_x[i] = RingSpan(i, kOuter, width);
+      span_inner_x[i] = RingSpan(i, kInner, width);
+    }
+    interior_begin = std::min(kOuter, width);
+    interior_end = std::max(width - kOuter, interior_begin);
+    for (int i = 0; i < width; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        interior_row_count[3 * i + c] = span_outer_x[i] * (2 * kOuter + 1) - span_inner_x[i] * (2 * kInner + 1);
+      }
+    }
+  }
+  std::vector<int> span_outer_x, span_inner_x, interior_row_count;
+  int interior_begin = 0, interior_end = 0;
+};
+
+// The linear signal and the horizontal sums of a block of rows and its kFloorRingOuter rows above and
+// below, small enough to stay in cache (the blocks' halo rows are computed twice).
+struct RingRowBuffers {
+  std::vector<float> linear, outer, inner;
+};
+
+}  // namespace
+
+void RadianceReader::Decode(const std::vector<PhotoSpec>& exposures, const PixelWindow& window,
+                            std::vector<Image>* decoded, Exposures* state, double* decode_s) const {
   IBRDF_CHECK(!exposures.empty());
   IBRDF_CHECK(exposures.size() < 256) << exposures.size() << " exposures";
   const Impl& impl = *impl_;
@@ -338,7 +372,6 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
   st.images = images.data();
   st.m = m;
   st.window = window;
-  st.min_signal = min_signal;
   st.noise = radiometry.noise.has_value();
   st.inverse_flat = impl.flat ? impl.flat->inverse.data() : nullptr;
   st.saturation.assign(m, 0.0);
@@ -361,6 +394,18 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
     st.scale[e] = exposures[e].exposure_s * exposures[e].gain;
     st.saturation[e] = SaturationLevel(radiometry, images[e]);
   }
+}
+
+void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
+                             std::vector<Image>* decoded, std::vector<float>* scratch_buffer, Exposures* state,
+                             double* decode_s) const {
+  const Impl& impl = *impl_;
+  const RadiometrySpec& radiometry = impl.radiometry;
+  const size_t m = exposures.size();
+  Decode(exposures, window, decoded, state, decode_s);
+  const std::vector<Image>& images = *decoded;
+  Exposures& st = *state;
+  st.min_signal = min_signal;
 
   // The expected signal of every channel in every exposure: the mean linear signal over the ring of
   // neighbours (kFloorRing*), by separable box sums over the window (5x5 minus 3x3). The sums run in
@@ -384,30 +429,15 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
   constexpr int kOuter = kFloorRingOuter, kInner = kFloorRingInner;
   // Neighbours on one side: the loops below spell the ring's sums out for these half-widths.
   static_assert(kOuter == 2 && kInner == 1, "the ring's sums are written for a 5x5 square without its 3x3");
-  const auto span = [](int k, int half, int size) { return std::min(k + half, size - 1) - std::max(k - half, 0) + 1; };
-  // Ring pixel counts by column (outer and inner span); rows are done per row.
-  std::vector<int> span_outer_x(width), span_inner_x(width);
-  for (int i = 0; i < width; ++i) {
-    span_outer_x[i] = span(i, kOuter, width);
-    span_inner_x[i] = span(i, kInner, width);
-  }
-  const int interior_begin = std::min(kOuter, width), interior_end = std::max(width - kOuter, interior_begin);
+  // Ring pixel counts by column; rows are done per row.
+  const RingColumns columns(width);
+  const std::vector<int>&span_outer_x = columns.span_outer_x, &span_inner_x = columns.span_inner_x;
+  const std::vector<int>& interior_row_count = columns.interior_row_count;
+  const int interior_begin = columns.interior_begin, interior_end = columns.interior_end;
   const size_t row_values = 3 * size_t(width);
-  // Ring pixel counts of each value of a row at least kOuter rows from the window's top and bottom.
-  std::vector<int> interior_row_count(row_values);
-  for (int i = 0; i < width; ++i) {
-    for (int c = 0; c < 3; ++c) {
-      interior_row_count[3 * i + c] = span_outer_x[i] * (2 * kOuter + 1) - span_inner_x[i] * (2 * kInner + 1);
-    }
-  }
-  // Per thread: the linear signal and the horizontal sums of a block of rows and its kOuter rows above
-  // and below, small enough to stay in cache (the blocks' halo rows are computed twice).
-  // They are per thread and kept for the process (sized for a whole block at once): fresh buffers for
-  // every photo were a third of the stage's page faults.
-  struct RowBuffers {
-    std::vector<float> linear, outer, inner;
-  };
-  static thread_local RowBuffers thread_buffers;
+  // Per thread and kept for the process (sized for a whole block at once): fresh buffers for every
+  // photo were a third of the stage's page faults.
+  static thread_local RingRowBuffers thread_buffers;
   constexpr int kBlockRows = 32;
   const size_t block_values = row_values * size_t(kBlockRows + 2 * kOuter);
   for (size_t e = 0; e < m; ++e) {
@@ -415,7 +445,7 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
     float* exp = &expected[3 * area * e];
     tbb::parallel_for(tbb::blocked_range<int>(0, height, kBlockRows), [&](const tbb::blocked_range<int>& rows) {
       const int first = std::max(rows.begin() - kOuter, 0), last = std::min(rows.end() + kOuter, height);
-      RowBuffers& local = thread_buffers;
+      RingRowBuffers& local = thread_buffers;
       if (local.linear.size() < block_values) {
         local.linear.resize(block_values);
         local.outer.resize(block_values);
@@ -477,7 +507,7 @@ void RadianceReader::Prepare(const std::vector<PhotoSpec>& exposures, double min
       const auto outer_at = [&](int j) { return &local.outer[row_values * (j - first)]; };
       const auto inner_at = [&](int j) { return &local.inner[row_values * (j - first)]; };
       for (int j = rows.begin(); j < rows.end(); ++j) {
-        const int span_outer_y = span(j, kOuter, height), span_inner_y = span(j, kInner, height);
+        const int span_outer_y = RingSpan(j, kOuter, height), span_inner_y = RingSpan(j, kInner, height);
         float* row_exp = &exp[row_values * j];
         const float* row_lin = &local.linear[row_values * (j - first)];
         if (j >= kOuter && j + kOuter < height) {

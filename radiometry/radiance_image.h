@@ -127,6 +127,10 @@ class RadianceReader {
   friend class RadianceWindow;
   struct Impl;
   struct Exposures;
+  // Decodes and checks the exposures into `decoded` and fills `state`'s per-exposure scale and
+  // saturation level.
+  void Decode(const std::vector<PhotoSpec>& exposures, const PixelWindow& window, std::vector<Image>* decoded,
+              Exposures* state, double* decode_s) const;
   // Decodes and checks the exposures and fills `state` (the expected signal inside `window`).
   void Prepare(const std::vector<PhotoSpec>& exposures, double min_signal, const PixelWindow& window,
                std::vector<Image>* decoded, std::vector<float>* scratch, Exposures* state, double* decode_s) const;

@@ -1,12 +1,13 @@
-// Tests of derender/colour_chart.h: the patch layout from the corner patches, the light-balanced
+// Tests of calibrate/colour_chart.h: the patch layout from the corner patches, the light-balanced
 // sample matrix, and the chart fit on synthetic chart photos (synth/synthetic_colour_chart.h) with a
 // known camera matrix and light tint: residuals, clipped patches left out and said, too few patches.
-#include "derender/colour_chart.h"
+#include "calibrate/colour_chart.h"
 
 #include <gtest/gtest.h>
 
 #include "core/brdf_model.h"
 #include "core/error.h"
+#include "derender/colour_correction.h"
 #include "tests/error_of.h"
 #include "tests/test_util.h"
 

@@ -1,4 +1,4 @@
-#include "align/mirror_sphere.h"
+#include "calibrate/mirror_sphere.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,11 +1,16 @@
-#include "derender/light_calibration.h"
+#include "calibrate/white_reference_intensity.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
+#include <nlohmann/json.hpp>
+
+#include "calibrate/lambertian.h"
 #include "core/error.h"
 #include "core/file_util.h"
+#include "core/json_reader.h"
 #include "core/light.h"
 #include "core/statistics.h"
 #include "radiometry/radiance_image.h"
@@ -78,6 +83,22 @@ std::string LightCalibrationReport::BriefReport() const {
     text += buffer + FormatCounts(light.rejected);
   }
   return text;
+}
+
+nlohmann::json LightCalibrationReport::ToJson() const {
+  nlohmann::json per_light = nlohmann::json::array();
+  for (const LightIntensityReport& light : lights) {
+    nlohmann::json entry = {{"light", light.light},
+                            {"photos", light.photos},
+                            {"calibrated_intensity", ibrdf::ToJson(light.calibrated_intensity)},
+                            {"interior_pixels", light.interior_pixels},
+                            {"pixels_used", light.pixels_used},
+                            {"rejected", light.rejected},
+                            {"spread", ibrdf::ToJson(light.spread)}};
+    entry["stated_intensity"] = light.stated ? ibrdf::ToJson(light.stated_intensity) : nlohmann::json(nullptr);
+    per_light.push_back(entry);
+  }
+  return {{"summary", BriefReport()}, {"photos", photos}, {"lights", per_light}, {"total_s", total_s}};
 }
 
 namespace {
@@ -157,8 +178,8 @@ void CalibrateLight(const Session& session, size_t light_index, const std::vecto
         }
         ++report->pixels_used;
         for (int c = 0; c < 3; ++c) {
-          // L = rho / pi * I * e, with e the irradiance per unit intensity.
-          estimates[c].push_back(M_PI * image.radiance[3 * p + c] / (white.reflectance[c] * incidence.irradiance[c]));
+          estimates[c].push_back(
+              LambertianIntensity(image.radiance[3 * p + c], white.reflectance[c], incidence.irradiance[c]));
         }
       }
     }
@@ -232,6 +253,22 @@ Session ApplyLightCalibration(const Session& session, LightCalibrationReport* re
   report->total_s = timer.ElapsedSeconds();
   report->success = true;
   return calibrated;
+}
+
+LightCalibrationReport WriteLightCalibrationStage(const Session& session, const LightCalibrationOptions& options,
+                                                  const std::string& out_dir, bool overwrite) {
+  if (!session.calibration || !session.calibration->white_reference) {
+    ThrowError(session.manifest_path, "has no white reference (calibration.white_reference): nothing to calibrate");
+  }
+  LightCalibrationReport report;
+  Session calibrated = ApplyLightCalibration(session, &report, options);
+  calibrated.calibration.reset();  // the white reference is its only step, now applied
+  AtomicDirectory directory(out_dir, overwrite);
+  const std::filesystem::path folder = directory.temporary_path();
+  calibrated.Rebased(out_dir).Save((folder / "session.json").string());
+  WriteJsonFile((folder / "white-reference.json").string(), report.ToJson());
+  directory.Commit();
+  return report;
 }
 
 }  // namespace ibrdf

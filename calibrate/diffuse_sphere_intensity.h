@@ -8,7 +8,7 @@
 // response: on a Lambertian sphere the linear signal falls off as cos(theta_i), so the fitted exponent
 // of signal ~ cos(theta_i)^k is 1 for a linear response (about 1 / 2.2 for an sRGB-encoded one), and
 // the per-pixel spread compares the calibrated directions with the session's nominal ones.
-// (derender/light_calibration.h is the flat white reference for the single light of version-1 sessions.)
+// (calibrate/white_reference_intensity.h is the flat white reference for the single light of version-1 sessions.)
 #pragma once
 
 #include <optional>
@@ -18,7 +18,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
-#include "align/mirror_sphere.h"
+#include "calibrate/mirror_sphere.h"
 #include "core/light.h"
 #include "core/session.h"
 

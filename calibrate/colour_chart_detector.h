@@ -1,6 +1,6 @@
 // Finding a ColorChecker Classic in a photo with OpenCV contrib's mcc detector
 // (cv::mcc::CCheckerDetector), for `ibrdf colour` when the session gives no corner patches. OpenCV's
-// types stay in the .cc file. The fit itself is derender/colour_chart.h.
+// types stay in the .cc file. The fit itself is calibrate/colour_chart.h.
 #pragma once
 
 #include <array>

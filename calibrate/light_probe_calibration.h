@@ -2,10 +2,10 @@
 // the light probe (`ibrdf lights calibrate`, docs/align.md "Light calibration"). The input is a session
 // (version 2) whose sample is the chrome sphere and whose photos each name their light: the lights'
 // stated directions or positions are taken as nominal (a rig's design values) and only compared with
-// what the calibration finds. Per light: the highlight in its photo (align/mirror_sphere.h), the law of
+// what the calibration finds. Per light: the highlight in its photo (calibrate/mirror_sphere.h), the law of
 // reflection gives its direction; a directional light keeps it, a point light needs two sphere
 // placements (two sessions, the rays from both highlights triangulated) or a known distance from the
-// sphere's centre. Intensities come from a diffuse reference (align/diffuse_sphere_intensity.h) or
+// sphere's centre. Intensities come from a diffuse reference (calibrate/diffuse_sphere_intensity.h) or
 // stay relative (1); the sidecar says which.
 #pragma once
 
@@ -16,7 +16,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
-#include "align/mirror_sphere.h"
+#include "calibrate/mirror_sphere.h"
 #include "core/light.h"
 #include "core/session.h"
 

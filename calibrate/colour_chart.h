@@ -1,9 +1,10 @@
 // Colour correction from a colour-chart photo (docs/radiometry.md, "Colour"): the chart's 24 patches
 // read through the session's radiometric chain (response, black level, exposure, gain, flat field:
 // radiance_image.h), a 3x3 matrix from camera RGB to linear sRGB (or XYZ) fitted by least squares to
-// the ColorChecker's published reference values (core/colour.h), and the form of that matrix the
-// derenderer applies to every sample. Locating the chart in the photo from the user's corner patches
-// is here; detecting it (OpenCV mcc) is align/colour_chart_detector.h.
+// the ColorChecker's published reference values (core/colour.h), written into the session's
+// colour_chart block (`ibrdf colour`); the derenderer applies it (derender/colour_correction.h).
+// Locating the chart from the user's corner patches, or by trying every orientation of a detected one
+// (OpenCV mcc, colour_chart_detector.h), is here.
 #pragma once
 
 #include <array>
@@ -15,7 +16,6 @@
 
 #include "core/camera.h"
 #include "core/image_io.h"
-#include "core/sample_file.h"
 #include "core/session.h"
 
 namespace ibrdf {
@@ -85,7 +85,14 @@ std::array<Eigen::Vector2d, kColorCheckerPatches> ColourPatchCenters(const Camer
 ColourChartFit FitColourChart(const Session& session, const std::array<Eigen::Vector2d, 4>& corners,
                               const ColourChartOptions& options, const std::string& located_by);
 
-// The chart photo for eyes and for the detector (align/colour_chart_detector.h): its radiance scaled so
+// The fit as `ibrdf colour` runs it: at the session's corner patches (colour_chart.corners) unless
+// there are none or `detect` is set; otherwise at the chart OpenCV's mcc finds (colour_chart_detector.h),
+// trying each of the 8 ways its box can lie on the chart and keeping the fit of least RMS residual.
+// Throws Error naming the manifest for a session without colour_chart, naming the chart's photo when
+// no chart is found, and naming the manifest when no orientation gives a usable fit.
+ColourChartFit LocateAndFitColourChart(const Session& session, const ColourChartOptions& options, bool detect);
+
+// The chart photo for eyes and for the detector (calibrate/colour_chart_detector.h): its radiance scaled so
 // that the 99th percentile of the brightest channel is 0.9, sRGB-encoded, clamped to [0, 1].
 Image ColourChartDisplayImage(const Session& session);
 
@@ -97,32 +104,5 @@ void WriteColourStage(const Session& session, const ColourChartFit& fit, const s
 
 // Writes the fit into a colour_chart block (matrix and per-patch residuals or exclusions).
 void StoreColourFit(const ColourChartFit& fit, ColourChartSpec* chart);
-
-// The matrix the derenderer applies to a sample's camera-RGB BRDF under a light of camera-RGB
-// intensity `light_intensity` (the session's, after any white-reference calibration):
-//   C = diag(w / (A I)) A diag(I),  A = linear-sRGB-from-camera, w = (1, 1, 1);  XYZ: XyzFromLinearSrgb C.
-// f_camera is L / (I cos / r^2) per channel; A diag(I) f_camera is then the BRDF in linear sRGB up to
-// the light's brightness, which dividing by A I (the light's own colour in sRGB: grey for a light whose
-// colour the chart saw, whatever its tint) removes: a white diffuser reads 1/pi in every channel.
-Eigen::Matrix3d SampleColourMatrix(const ColourChartSpec& chart, const Eigen::Vector3d& light_intensity);
-
-// Applies SampleColourMatrix of each sample's photo's light to its brdf and (propagated, channels
-// taken as independent) sigma; returns the matrices used, one per light. Nothing without a fitted
-// colour_chart. A corrected channel is valid only when every camera channel it mixes is; samples left
-// with no valid channel are removed, their count in `dropped`. Throws Error naming the manifest for a
-// colour_chart without a matrix (run `ibrdf colour`).
-std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples,
-                                                   size_t* dropped = nullptr);
-
-// The sidecar's "colour" entry: space, reference source, the chart's matrix and per-patch fit, and the
-// matrices applied per light. Null without a colour_chart.
-nlohmann::json ColourSidecar(const Session& session, const std::vector<Eigen::Matrix3d>& applied);
-
-// For the log: the space, the chart's matrix, each patch's residual (or why it was left out) and the
-// matrices applied per light, over several lines.
-std::string ColourCorrectionReport(const Session& session, const std::vector<Eigen::Matrix3d>& applied);
-
-// The sidecar's "colour_space" line for a session (camera RGB, or the chart's space).
-std::string ColourSpaceDescription(const Session& session);
 
 }  // namespace ibrdf

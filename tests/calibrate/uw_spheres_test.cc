@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "align/mirror_sphere.h"
+#include "calibrate/mirror_sphere.h"
 #include "core/image_io.h"
 
 namespace ibrdf {

@@ -1,4 +1,4 @@
-#include "align/colour_chart_detector.h"
+#include "calibrate/colour_chart_detector.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
-// Tests of align/mirror_sphere.h: the silhouette cone fit, the highlight, the law of reflection and its
+// Tests of calibrate/mirror_sphere.h: the silhouette cone fit, the highlight, the law of reflection and its
 // uncertainty, triangulation; end to end on synthetic mirror-sphere photos (synth/synthetic_mirror_sphere.h).
-#include "align/mirror_sphere.h"
+#include "calibrate/mirror_sphere.h"
 
 #include <cmath>
 #include <cstdio>

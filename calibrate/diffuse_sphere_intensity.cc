@@ -1,14 +1,16 @@
-#include "align/diffuse_sphere_intensity.h"
+#include "calibrate/diffuse_sphere_intensity.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
 
+#include "calibrate/lambertian.h"
+#include "calibrate/sphere_silhouettes.h"
 #include "core/error.h"
 #include "core/json_reader.h"
-#include "radiometry/linear_image.h"
 #include "core/logging.h"
+#include "radiometry/linear_image.h"
 
 namespace ibrdf {
 namespace {
@@ -38,21 +40,6 @@ double RelativeSpread(const std::vector<double>& values) {
 }
 
 std::string LightName(const Light& light) { return light.id.empty() ? std::string("light") : light.id; }
-
-// Irradiance per unit intensity at `point` with `normal`, and the cosine: E / I.
-double UnitIrradiance(const Light& light, const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double* cos_i) {
-  Eigen::Vector3d wi;
-  double falloff = 1.0;
-  if (light.kind == Light::Kind::kDirectional) {
-    wi = light.direction.normalized();
-  } else {
-    const Eigen::Vector3d d = light.position - point;
-    falloff = 1.0 / d.squaredNorm();
-    wi = d.normalized();
-  }
-  *cos_i = wi.dot(normal);
-  return *cos_i * falloff;
-}
 
 }  // namespace
 
@@ -105,6 +92,120 @@ nlohmann::json DiffuseSphereIntensities::ToJson() const {
           {"lights", per_light}};
 }
 
+namespace {
+
+// The per-pixel estimates of one light's intensity over the diffuse sphere's photos.
+struct Samples {
+  std::vector<double> estimate[3], nominal[3];
+  std::vector<double> log_cos, log_signal;
+  int saturated = 0;
+};
+
+// Adds the usable pixels of photo `i` (under `light`, calibrated, and `nominal`, the session's) to
+// `samples`: on the sphere inside `silhouette` less the rim margin and inside `mask`, lit and seen
+// within the options' angles, not clipped, above the signal floor.
+void SamplePhoto(const Session& diffuse, size_t i, const Light* light, const SphereSilhouette& silhouette,
+                 const PixelMask& mask, const std::optional<Eigen::Vector3d>& albedo,
+                 const DiffuseSphereOptions& options, Samples* out) {
+  const PhotoSpec& photo = diffuse.photos[i];
+  const std::string photo_path = diffuse.PhotoPath(i);
+  const Light& nominal = diffuse.PhotoLight(i);
+  const Rigid3d& camera_from_world = *photo.camera_from_world;
+  const double radius = diffuse.sample.radius;
+  const double cos_i_min = std::cos(options.max_theta_i_deg * kPi / 180.0);
+  const double cos_e_min = std::cos(options.max_theta_e_deg * kPi / 180.0);
+  const Eigen::Vector3d center_in_camera = silhouette.CenterInCamera(radius);
+  const Eigen::Matrix3d world_from_camera = camera_from_world.rotation.inverse().toRotationMatrix();
+  // The lights at unit intensity: their irradiance is the irradiance per unit of intensity.
+  Light unit_light = *light, unit_nominal = nominal;
+  unit_light.intensity = unit_nominal.intensity = Eigen::Vector3d::Ones();
+  Samples& samples = *out;
+
+  const Image raw = ReadImage(photo_path);
+  Image radiance = raw;
+  LinearizeImage(diffuse, i, &radiance, /*divide_by_exposure=*/true);
+  const std::vector<uint8_t> saturated = SaturatedPixels(diffuse.radiometry, raw);
+  const double to_signal = photo.exposure_s * photo.gain;
+  const int channels = std::min(raw.channels, 3);
+  for (int y = 0; y < raw.height; ++y) {
+    for (int x = 0; x < raw.width; ++x) {
+      const Eigen::Vector2d pixel(x + 0.5, y + 0.5);
+      if ((pixel - silhouette.center_px).norm() > silhouette.radius_px - options.rim_margin_px) continue;
+      if (mask.width > 0 && !mask.at(x, y)) continue;
+      const Eigen::Vector2d xy = diffuse.camera.CamPlaneFromImage(pixel);
+      const Eigen::Vector3d ray = Eigen::Vector3d(xy.x(), xy.y(), 1.0).normalized();
+      const double along = ray.dot(center_in_camera);
+      const double off2 = (center_in_camera - along * ray).squaredNorm();
+      if (off2 > radius * radius) continue;
+      const Eigen::Vector3d p = (along - std::sqrt(radius * radius - off2)) * ray;
+      const Eigen::Vector3d n_camera = (p - center_in_camera) / radius;
+      if (-ray.dot(n_camera) < cos_e_min) continue;
+      const Eigen::Vector3d p_world = camera_from_world.Inverse() * p;
+      const Eigen::Vector3d n_world = world_from_camera * n_camera;
+      const Incidence incidence = IncidenceAt(unit_light, p_world, n_world);
+      const Incidence incidence_nominal = IncidenceAt(unit_nominal, p_world, n_world);
+      const double cos_i = incidence.cos_theta, cos_nominal = incidence_nominal.cos_theta;
+      if (cos_i < cos_i_min) continue;
+      if (saturated[size_t(y) * raw.width + x]) {
+        ++samples.saturated;
+        continue;
+      }
+      double darkest = 1e300, mean = 0.0;
+      for (int c = 0; c < channels; ++c) {
+        darkest = std::min(darkest, radiance.at(x, y, c) * to_signal);
+        mean += radiance.at(x, y, c) / channels;
+      }
+      if (!(darkest >= options.min_signal)) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double value = radiance.at(x, y, std::min(c, channels - 1));
+        const double rho = albedo ? (*albedo)[c] : 1.0;
+        samples.estimate[c].push_back(LambertianIntensity(value, rho, incidence.irradiance[0]));
+        if (cos_nominal > 0.05) {
+          samples.nominal[c].push_back(LambertianIntensity(value, rho, incidence_nominal.irradiance[0]));
+        }
+      }
+      samples.log_cos.push_back(std::log(cos_i));
+      samples.log_signal.push_back(std::log(mean));
+    }
+  }
+}
+
+// One light's intensity from its samples: per channel the median and spread, and the cosine exponent.
+DiffuseLightIntensity Summarize(const std::string& manifest, const std::string& id, const Samples& s,
+                                const DiffuseSphereOptions& options) {
+  DiffuseLightIntensity measured;
+  measured.id = id;
+  measured.pixels = int(s.estimate[0].size());
+  measured.saturated = s.saturated;
+  if (measured.pixels < options.min_pixels) {
+    ThrowError(manifest, "light " + id + ": " + std::to_string(measured.pixels) +
+                             " usable pixels on the diffuse "
+                             "sphere, fewer than " +
+                             std::to_string(options.min_pixels) + " (" + std::to_string(s.saturated) + " clipped)");
+  }
+  for (int c = 0; c < 3; ++c) {
+    measured.intensity[c] = MedianOf(s.estimate[c]);
+    measured.spread[c] = RelativeSpread(s.estimate[c]);
+    measured.nominal_spread[c] = RelativeSpread(s.nominal[c]);
+  }
+  // Least-squares slope of log(signal) on log(cos(theta_i)).
+  double mx = 0, my = 0;
+  const size_t n = s.log_cos.size();
+  for (size_t k = 0; k < n; ++k) {
+    mx += s.log_cos[k] / n;
+    my += s.log_signal[k] / n;
+  }
+  double sxy = 0, sxx = 0;
+  for (size_t k = 0; k < n; ++k) {
+    sxy += (s.log_cos[k] - mx) * (s.log_signal[k] - my);
+    sxx += (s.log_cos[k] - mx) * (s.log_cos[k] - mx);
+  }
+  measured.cosine_exponent = sxx > 0 ? sxy / sxx : 0.0;
+  return measured;
+}
+
+}  // namespace
+
 DiffuseSphereIntensities MeasureDiffuseSphereIntensities(const Session& diffuse, std::vector<Light>* lights,
                                                          const std::optional<Eigen::Vector3d>& albedo,
                                                          const DiffuseSphereOptions& options) {
@@ -122,16 +223,10 @@ DiffuseSphereIntensities MeasureDiffuseSphereIntensities(const Session& diffuse,
   result.absolute = albedo.has_value();
   if (albedo) result.albedo = *albedo;
   const double radius = diffuse.sample.radius;
-  const double cos_i_min = std::cos(options.max_theta_i_deg * kPi / 180.0);
-  const double cos_e_min = std::cos(options.max_theta_e_deg * kPi / 180.0);
 
-  struct Samples {
-    std::vector<double> estimate[3], nominal[3];
-    std::vector<double> log_cos, log_signal;
-    int saturated = 0;
-  };
   std::map<std::string, Samples> by_light;
-  std::map<std::string, std::pair<SphereSilhouette, PixelMask>> cache;
+  SphereSilhouettes silhouettes(diffuse, options.fit_silhouette, options.silhouette);
+  bool first = true;
   for (size_t i = 0; i < diffuse.photos.size(); ++i) {
     const PhotoSpec& photo = diffuse.photos[i];
     if (photo.role != PhotoRole::kMeasurement) continue;
@@ -140,83 +235,16 @@ DiffuseSphereIntensities MeasureDiffuseSphereIntensities(const Session& diffuse,
     const Light* light = nullptr;
     for (const Light& l : *lights) light = (LightName(l) == id) ? &l : light;
     if (!light) ThrowError(photo_path, "photo of light " + id + ", which the calibration does not have");
-    const Light& nominal = diffuse.PhotoLight(i);
     if (!photo.camera_from_world) ThrowError(photo_path, "the photo has no camera_from_world pose (" + manifest + ")");
-    const Rigid3d& camera_from_world = *photo.camera_from_world;
-    const std::string mask_path = diffuse.PhotoMaskPath(i);
-    auto found = cache.find(mask_path);
-    if (found == cache.end()) {
-      PixelMask mask;
-      if (!mask_path.empty()) mask = ReadPixelMask(mask_path, diffuse.camera.width, diffuse.camera.height);
-      SphereSilhouette silhouette;
-      if (options.fit_silhouette) {
-        if (mask_path.empty()) {
-          ThrowError(photo_path, "fitting the diffuse sphere's silhouette needs a mask (the session's \"mask\")");
-        }
-        silhouette = FitSphereSilhouette(diffuse.camera, MaskEdgePoints(mask), options.silhouette);
-        if (!silhouette.fitted) ThrowError(mask_path, "no sphere silhouette: " + silhouette.reason);
-      } else {
-        silhouette = SphereSilhouette::FromCenter(diffuse.camera, camera_from_world * diffuse.sample.center, radius);
-        if (!silhouette.fitted) ThrowError(manifest + ": /sample", silhouette.reason);
-      }
-      if (cache.empty()) {
-        result.silhouette = silhouette;
-        result.center = camera_from_world.Inverse() * silhouette.CenterInCamera(radius);
-        Log(1, "diffuse sphere " + silhouette.BriefReport());
-      }
-      found = cache.emplace(mask_path, std::make_pair(silhouette, std::move(mask))).first;
+    bool added = false;
+    const SphereSilhouettes::Entry& entry = silhouettes.For(i, &added);
+    if (added && first) {
+      result.silhouette = entry.silhouette;
+      result.center = photo.camera_from_world->Inverse() * entry.silhouette.CenterInCamera(radius);
+      Log(1, "diffuse sphere " + entry.silhouette.BriefReport());
+      first = false;
     }
-    const SphereSilhouette& silhouette = found->second.first;
-    const PixelMask& mask = found->second.second;
-    const Eigen::Vector3d center_in_camera = silhouette.CenterInCamera(radius);
-    const Eigen::Matrix3d world_from_camera = camera_from_world.rotation.inverse().toRotationMatrix();
-
-    const Image raw = ReadImage(photo_path);
-    Image radiance = raw;
-    LinearizeImage(diffuse, i, &radiance, /*divide_by_exposure=*/true);
-    const std::vector<uint8_t> saturated = SaturatedPixels(diffuse.radiometry, raw);
-    const double to_signal = photo.exposure_s * photo.gain;
-    Samples& samples = by_light[id];
-    const int channels = std::min(raw.channels, 3);
-    for (int y = 0; y < raw.height; ++y) {
-      for (int x = 0; x < raw.width; ++x) {
-        const Eigen::Vector2d pixel(x + 0.5, y + 0.5);
-        if ((pixel - silhouette.center_px).norm() > silhouette.radius_px - options.rim_margin_px) continue;
-        if (mask.width > 0 && !mask.at(x, y)) continue;
-        const Eigen::Vector2d xy = diffuse.camera.CamPlaneFromImage(pixel);
-        const Eigen::Vector3d ray = Eigen::Vector3d(xy.x(), xy.y(), 1.0).normalized();
-        const double along = ray.dot(center_in_camera);
-        const double off2 = (center_in_camera - along * ray).squaredNorm();
-        if (off2 > radius * radius) continue;
-        const Eigen::Vector3d p = (along - std::sqrt(radius * radius - off2)) * ray;
-        const Eigen::Vector3d n_camera = (p - center_in_camera) / radius;
-        if (-ray.dot(n_camera) < cos_e_min) continue;
-        const Eigen::Vector3d p_world = camera_from_world.Inverse() * p;
-        const Eigen::Vector3d n_world = world_from_camera * n_camera;
-        double cos_i = 0.0, cos_nominal = 0.0;
-        const double unit = UnitIrradiance(*light, p_world, n_world, &cos_i);
-        const double unit_nominal = UnitIrradiance(nominal, p_world, n_world, &cos_nominal);
-        if (cos_i < cos_i_min) continue;
-        if (saturated[size_t(y) * raw.width + x]) {
-          ++samples.saturated;
-          continue;
-        }
-        double darkest = 1e300, mean = 0.0;
-        for (int c = 0; c < channels; ++c) {
-          darkest = std::min(darkest, radiance.at(x, y, c) * to_signal);
-          mean += radiance.at(x, y, c) / channels;
-        }
-        if (!(darkest >= options.min_signal)) continue;
-        for (int c = 0; c < 3; ++c) {
-          const double value = radiance.at(x, y, std::min(c, channels - 1));
-          const double rho = albedo ? (*albedo)[c] : 1.0;
-          samples.estimate[c].push_back(kPi * value / (rho * unit));
-          if (cos_nominal > 0.05) samples.nominal[c].push_back(kPi * value / (rho * unit_nominal));
-        }
-        samples.log_cos.push_back(std::log(cos_i));
-        samples.log_signal.push_back(std::log(mean));
-      }
-    }
+    SamplePhoto(diffuse, i, light, entry.silhouette, entry.mask, albedo, options, &by_light[id]);
   }
 
   std::vector<double> exponents, spreads, nominal_spreads;
@@ -224,35 +252,7 @@ DiffuseSphereIntensities MeasureDiffuseSphereIntensities(const Session& diffuse,
     const std::string id = LightName(light);
     const auto it = by_light.find(id);
     if (it == by_light.end()) ThrowError(manifest, "light " + id + " has no photo of the diffuse sphere");
-    const Samples& s = it->second;
-    DiffuseLightIntensity measured;
-    measured.id = id;
-    measured.pixels = int(s.estimate[0].size());
-    measured.saturated = s.saturated;
-    if (measured.pixels < options.min_pixels) {
-      ThrowError(manifest, "light " + id + ": " + std::to_string(measured.pixels) +
-                               " usable pixels on the diffuse "
-                               "sphere, fewer than " +
-                               std::to_string(options.min_pixels) + " (" + std::to_string(s.saturated) + " clipped)");
-    }
-    for (int c = 0; c < 3; ++c) {
-      measured.intensity[c] = MedianOf(s.estimate[c]);
-      measured.spread[c] = RelativeSpread(s.estimate[c]);
-      measured.nominal_spread[c] = RelativeSpread(s.nominal[c]);
-    }
-    // Least-squares slope of log(signal) on log(cos(theta_i)).
-    double mx = 0, my = 0;
-    const size_t n = s.log_cos.size();
-    for (size_t k = 0; k < n; ++k) {
-      mx += s.log_cos[k] / n;
-      my += s.log_signal[k] / n;
-    }
-    double sxy = 0, sxx = 0;
-    for (size_t k = 0; k < n; ++k) {
-      sxy += (s.log_cos[k] - mx) * (s.log_signal[k] - my);
-      sxx += (s.log_cos[k] - mx) * (s.log_cos[k] - mx);
-    }
-    measured.cosine_exponent = sxx > 0 ? sxy / sxx : 0.0;
+    const DiffuseLightIntensity measured = Summarize(manifest, id, it->second, options);
     exponents.push_back(measured.cosine_exponent);
     spreads.push_back(measured.spread.mean());
     nominal_spreads.push_back(measured.nominal_spread.mean());

@@ -3,7 +3,9 @@
 // pose reflects radiance L = rho / pi * E, with E = I cos(theta_i) / r^2 for a point light (E = I
 // cos(theta_i) for a directional one), so every pixel on it gives I = pi L r^2 / (rho cos(theta_i)) in
 // the session's radiance unit: the camera's sensitivity and the light's power are calibrated together.
-// The estimate is the median over the target's interior, in every white-reference photo.
+// The estimate is the median over the target's interior, in every white-reference photo. A calibration
+// of its own, before derender (`ibrdf lights white`, a stage of `ibrdf run`): it writes the measured
+// intensities into the session, which the derenderer then reads as stated.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
 
 #include "core/logging.h"
 #include "core/session.h"
@@ -60,6 +63,9 @@ struct LightCalibrationReport {
   // "light calibration: white reference, 2 photos, 4210 pixels: intensity (1, 1, 1) -> (0.41, ...)"
   // (one clause per light).
   std::string BriefReport() const;
+  // OUT/white-reference.json: the summary, and per light its photos, pixels, rejections, stated and
+  // calibrated intensity and spread.
+  nlohmann::json ToJson() const;
 };
 
 // The session with each light's intensity replaced by the white reference's measurement under that
@@ -73,5 +79,14 @@ struct LightCalibrationReport {
 // the light or the camera, or too few measurable pixels.
 Session ApplyLightCalibration(const Session& session, LightCalibrationReport* report,
                               const LightCalibrationOptions& options = LightCalibrationOptions());
+
+// The light stage as `ibrdf lights white` runs it: ApplyLightCalibration, then OUT/session.json (the
+// session with the measured intensities and its white reference consumed: the block is left out, so
+// that the derenderer, which refuses a session with a white reference, reads the lights as stated;
+// paths rebased to name the same files) and OUT/white-reference.json (LightCalibrationReport::ToJson),
+// as one folder that appears complete. Throws Error naming the manifest for a session without a white
+// reference, and as ApplyLightCalibration.
+LightCalibrationReport WriteLightCalibrationStage(const Session& session, const LightCalibrationOptions& options,
+                                                  const std::string& out_dir, bool overwrite);
 
 }  // namespace ibrdf
