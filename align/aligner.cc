@@ -18,8 +18,8 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "core/light.h"
-#include "core/linear_image.h"
 #include "core/logging.h"
+#include "radiometry/linear_image.h"
 
 namespace ibrdf {
 namespace {

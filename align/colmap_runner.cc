@@ -14,11 +14,11 @@
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
-#include "core/linear_image.h"
 #include "core/logging.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
 #include "core/subprocess.h"
+#include "radiometry/linear_image.h"
 
 namespace fs = std::filesystem;
 

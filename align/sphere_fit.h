@@ -72,7 +72,7 @@ struct TangentRay {
   Eigen::Vector3d direction;  // unit
 };
 
-// One photo of the sphere: a linear image (core/linear_image.h) and its pose. The image is not owned.
+// One photo of the sphere: a linear image (radiometry/linear_image.h) and its pose. The image is not owned.
 struct SilhouettePhoto {
   const Image* image = nullptr;
   Rigid3d camera_from_world;

@@ -12,8 +12,8 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "core/light.h"
-#include "core/linear_image.h"
 #include "core/logging.h"
+#include "radiometry/linear_image.h"
 
 namespace ibrdf {
 namespace {
@@ -128,6 +128,111 @@ std::string WhiteReferencePose::BriefReport() const {
   return buffer;
 }
 
+namespace {
+
+// Poses white-reference photo `i` of `photos_session`: the camera against the platform's posed markers
+// and the card against its own, each with its covariance; `pose->dropped_reason` says why a photo is
+// not used.
+void PosePhoto(const Session& photos_session, size_t i, const MarkerDictionary& dictionary,
+               const std::map<int, BundleMarker>& platform, const std::map<int, BundleMarker>& card,
+               const WhiteReferencePoseOptions& options, WhiteReferencePhotoPose* pose, Matrix6d* world_covariance,
+               Matrix6d* card_covariance, Rigid3d* camera_from_card) {
+  const Camera& camera = photos_session.camera;
+  Image image = ReadImage(photos_session.PhotoPath(i));
+  LinearizeImage(photos_session, i, &image);
+  std::vector<MarkerDetection> detections = DetectMarkers(image, dictionary);
+  RefineMarkerCorners(image, camera, &detections);
+  std::map<int, int> seen;
+  for (const MarkerDetection& d : detections) ++seen[d.id];
+  detections.erase(
+      std::remove_if(detections.begin(), detections.end(), [&](const MarkerDetection& d) { return seen[d.id] > 1; }),
+      detections.end());
+  BundleImage world_image = ImageOf(detections, platform, &pose->platform_markers);
+  BundleImage card_image = ImageOf(detections, card, &pose->card_markers);
+  char buffer[200];
+  if (pose->platform_markers < options.min_platform_markers) {
+    pose->dropped_reason = "only " + std::to_string(pose->platform_markers) + " posed platform markers seen (need " +
+                          std::to_string(options.min_platform_markers) + ")";
+    return;
+  }
+  if (pose->card_markers < options.min_card_markers) {
+    pose->dropped_reason = "only " + std::to_string(pose->card_markers) + " of the card's markers seen (need " +
+                          std::to_string(options.min_card_markers) + ")";
+    return;
+  }
+  std::string failure;
+  if (!PoseAgainst(camera, options, platform, &world_image, &failure)) {
+    pose->dropped_reason = "no pose from the platform: " + failure;
+    return;
+  }
+  if (!PoseAgainst(camera, options, card, &card_image, &failure)) {
+    pose->dropped_reason = "no pose of the card: " + failure;
+    return;
+  }
+  pose->platform_rms_px = world_image.rms_px;
+  pose->card_rms_px = card_image.rms_px;
+  if (std::max(pose->platform_rms_px, pose->card_rms_px) > options.max_rms_px) {
+    std::snprintf(buffer, sizeof(buffer), "reprojection RMS %.3f px (platform) / %.3f px (card) above %.3f",
+                  pose->platform_rms_px, pose->card_rms_px, options.max_rms_px);
+    pose->dropped_reason = buffer;
+    return;
+  }
+  Rigid3d alternative;
+  pose->card_alternative_rms_px = AlternativePoseRms(camera, card_image, card, options.huber_px, &alternative);
+  if (pose->card_alternative_rms_px >= 0.0 &&
+      pose->card_alternative_rms_px < options.ambiguity_ratio * std::max(pose->card_rms_px, options.corner_sigma_px)) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "ambiguous card pose: a second pose, %.1f deg away, explains its corners with RMS %.3f px (own "
+                  "%.3f px); photograph the card less head-on or closer",
+                  alternative.rotation.angularDistance(card_image.camera_from_world.rotation) * 180.0 / M_PI,
+                  pose->card_alternative_rms_px, pose->card_rms_px);
+    pose->dropped_reason = buffer;
+    return;
+  }
+  pose->used = true;
+  pose->camera_from_world = world_image.camera_from_world;
+  *camera_from_card = card_image.camera_from_world;
+  const Rigid3d world_from_card = world_image.camera_from_world.Inverse() * card_image.camera_from_world;
+  pose->center = world_from_card.translation;
+  pose->normal = world_from_card.rotation * Eigen::Vector3d::UnitZ();
+  *world_covariance =
+      PoseCovariance(camera, world_image, platform, std::max(options.corner_sigma_px, pose->platform_rms_px));
+  *card_covariance = PoseCovariance(camera, card_image, card, std::max(options.corner_sigma_px, pose->card_rms_px));
+}
+
+// The relative sigma of each light's intensity that the pose's uncertainty implies: I ~ 1 / E(centre,
+// normal) for a unit light, its gradient taken numerically.
+void IntensitySensitivity(const Session& session, WhiteReferencePose* pose) {
+  WhiteReferencePose& result = *pose;
+  const WhiteReferenceSpec& white = *session.calibration->white_reference;
+  for (size_t k = 0; k < session.lights.size(); ++k) {
+    bool has_photos = false;
+    for (const PhotoSpec& photo : white.photos) has_photos |= photo.light == k;
+    if (!has_photos) continue;
+    Light unit = session.lights[k];
+    unit.intensity = Eigen::Vector3d::Ones();
+    auto log_irradiance = [&](const Eigen::Vector3d& c, const Eigen::Vector3d& n) {
+      const Incidence incidence = IncidenceAt(unit, c, n.normalized());
+      return incidence.lit ? std::log(incidence.irradiance[0]) : std::numeric_limits<double>::quiet_NaN();
+    };
+    Eigen::Vector3d center_gradient, normal_gradient;
+    for (int j = 0; j < 3; ++j) {
+      const Eigen::Vector3d step = 1e-6 * Eigen::Vector3d::Unit(j);
+      center_gradient[j] =
+          (log_irradiance(result.center + step, result.normal) - log_irradiance(result.center - step, result.normal)) /
+          2e-6;
+      normal_gradient[j] =
+          (log_irradiance(result.center, result.normal + step) - log_irradiance(result.center, result.normal - step)) /
+          2e-6;
+    }
+    const double variance = center_gradient.dot(result.center_covariance * center_gradient) +
+                            normal_gradient.dot(result.normal_covariance * normal_gradient);
+    result.intensity_sigma_relative[k] = std::sqrt(std::max(0.0, variance));
+  }
+}
+
+}  // namespace
+
 WhiteReferencePose PoseWhiteReference(const Session& session, const std::map<int, BundleMarker>& world_markers,
                                       const MarkerDictionary& dictionary, const WhiteReferencePoseOptions& options) {
   Timer timer;
@@ -137,7 +242,6 @@ WhiteReferencePose PoseWhiteReference(const Session& session, const std::map<int
               session.calibration->white_reference);
   const std::string where = session.manifest_path + ": /calibration/white_reference";
   const WhiteReferenceSpec& white = *session.calibration->white_reference;
-  const Camera& camera = session.camera;
 
   // The markers: the pose's posed ones (world frame) and the card's (card frame), all held fixed.
   std::map<int, BundleMarker> platform;
@@ -169,66 +273,8 @@ WhiteReferencePose PoseWhiteReference(const Session& session, const std::map<int
   for (size_t i = 0; i < white.photos.size(); ++i) {
     WhiteReferencePhotoPose& pose = result.photos[i];
     pose.photo = i;
-    Image image = ReadImage(photos_session.PhotoPath(i));
-    LinearizeImage(photos_session, i, &image);
-    std::vector<MarkerDetection> detections = DetectMarkers(image, dictionary);
-    RefineMarkerCorners(image, camera, &detections);
-    std::map<int, int> seen;
-    for (const MarkerDetection& d : detections) ++seen[d.id];
-    detections.erase(
-        std::remove_if(detections.begin(), detections.end(), [&](const MarkerDetection& d) { return seen[d.id] > 1; }),
-        detections.end());
-    BundleImage world_image = ImageOf(detections, platform, &pose.platform_markers);
-    BundleImage card_image = ImageOf(detections, card, &pose.card_markers);
-    char buffer[200];
-    if (pose.platform_markers < options.min_platform_markers) {
-      pose.dropped_reason = "only " + std::to_string(pose.platform_markers) + " posed platform markers seen (need " +
-                            std::to_string(options.min_platform_markers) + ")";
-      continue;
-    }
-    if (pose.card_markers < options.min_card_markers) {
-      pose.dropped_reason = "only " + std::to_string(pose.card_markers) + " of the card's markers seen (need " +
-                            std::to_string(options.min_card_markers) + ")";
-      continue;
-    }
-    std::string failure;
-    if (!PoseAgainst(camera, options, platform, &world_image, &failure)) {
-      pose.dropped_reason = "no pose from the platform: " + failure;
-      continue;
-    }
-    if (!PoseAgainst(camera, options, card, &card_image, &failure)) {
-      pose.dropped_reason = "no pose of the card: " + failure;
-      continue;
-    }
-    pose.platform_rms_px = world_image.rms_px;
-    pose.card_rms_px = card_image.rms_px;
-    if (std::max(pose.platform_rms_px, pose.card_rms_px) > options.max_rms_px) {
-      std::snprintf(buffer, sizeof(buffer), "reprojection RMS %.3f px (platform) / %.3f px (card) above %.3f",
-                    pose.platform_rms_px, pose.card_rms_px, options.max_rms_px);
-      pose.dropped_reason = buffer;
-      continue;
-    }
-    Rigid3d alternative;
-    pose.card_alternative_rms_px = AlternativePoseRms(camera, card_image, card, options.huber_px, &alternative);
-    if (pose.card_alternative_rms_px >= 0.0 &&
-        pose.card_alternative_rms_px < options.ambiguity_ratio * std::max(pose.card_rms_px, options.corner_sigma_px)) {
-      std::snprintf(buffer, sizeof(buffer),
-                    "ambiguous card pose: a second pose, %.1f deg away, explains its corners with RMS %.3f px (own "
-                    "%.3f px); photograph the card less head-on or closer",
-                    alternative.rotation.angularDistance(card_image.camera_from_world.rotation) * 180.0 / M_PI,
-                    pose.card_alternative_rms_px, pose.card_rms_px);
-      pose.dropped_reason = buffer;
-      continue;
-    }
-    pose.used = true;
-    pose.camera_from_world = world_image.camera_from_world;
-    camera_from_card[i] = card_image.camera_from_world;
-    const Rigid3d world_from_card = world_image.camera_from_world.Inverse() * card_image.camera_from_world;
-    pose.center = world_from_card.translation;
-    pose.normal = world_from_card.rotation * Eigen::Vector3d::UnitZ();
-    world_covariances[i] =
-        PoseCovariance(camera, world_image, platform, std::max(options.corner_sigma_px, pose.platform_rms_px));
-    card_covariances[i] = PoseCovariance(camera, card_image, card, std::max(options.corner_sigma_px, pose.card_rms_px));
+    PosePhoto(photos_session, i, dictionary, platform, card, options, &pose, &world_covariances[i], &card_covariances[i],
+              &camera_from_card[i]);
   }
 
   // The mean over the used photos and its covariance (independent photos: the sum over N^2).
@@ -280,31 +326,7 @@ WhiteReferencePose PoseWhiteReference(const Session& session, const std::map<int
           0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(result.normal_covariance).eigenvalues().maxCoeff())) *
       180.0 / M_PI;
 
-  // The intensity's sensitivity: I ~ 1 / E(centre, normal) for a unit light; numerical gradient.
-  for (size_t k = 0; k < session.lights.size(); ++k) {
-    bool has_photos = false;
-    for (const PhotoSpec& photo : white.photos) has_photos |= photo.light == k;
-    if (!has_photos) continue;
-    Light unit = session.lights[k];
-    unit.intensity = Eigen::Vector3d::Ones();
-    auto log_irradiance = [&](const Eigen::Vector3d& c, const Eigen::Vector3d& n) {
-      const Incidence incidence = IncidenceAt(unit, c, n.normalized());
-      return incidence.lit ? std::log(incidence.irradiance[0]) : std::numeric_limits<double>::quiet_NaN();
-    };
-    Eigen::Vector3d center_gradient, normal_gradient;
-    for (int j = 0; j < 3; ++j) {
-      const Eigen::Vector3d step = 1e-6 * Eigen::Vector3d::Unit(j);
-      center_gradient[j] =
-          (log_irradiance(result.center + step, result.normal) - log_irradiance(result.center - step, result.normal)) /
-          2e-6;
-      normal_gradient[j] =
-          (log_irradiance(result.center, result.normal + step) - log_irradiance(result.center, result.normal - step)) /
-          2e-6;
-    }
-    const double variance = center_gradient.dot(result.center_covariance * center_gradient) +
-                            normal_gradient.dot(result.normal_covariance * normal_gradient);
-    result.intensity_sigma_relative[k] = std::sqrt(std::max(0.0, variance));
-  }
+  IntensitySensitivity(session, &result);
   result.posed = true;
   result.total_s = timer.ElapsedSeconds();
   return result;

@@ -4,7 +4,7 @@
 // the platform's markers (their world corners after the bundle adjustment), the card from its own
 // markers (PnP, then a robust refinement), and world_from_card = world_from_camera x camera_from_card;
 // the photos' estimates are averaged. The result is the white reference's centre and normal in the
-// world frame (what the light calibration, derender/light_calibration.h, needs), with a covariance
+// world frame (what the light calibration, calibrate/white_reference_intensity.h, needs), with a covariance
 // from the corners' geometry, so nobody types world coordinates.
 #pragma once
 

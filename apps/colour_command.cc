@@ -1,14 +1,12 @@
-// ibrdf colour: the colour chart's matrix from camera RGB to linear sRGB or XYZ (derender/colour_chart.h;
-// the chart found by its corner patches or by OpenCV's mcc, align/colour_chart_detector.h) behind flags.
+// ibrdf colour: the colour chart's matrix from camera RGB to linear sRGB or XYZ (calibrate/colour_chart.h:
+// the chart found by its corner patches or by OpenCV's mcc) behind flags.
 #include <cstdio>
-#include <limits>
 
-#include "align/colour_chart_detector.h"
 #include "apps/commands.h"
+#include "calibrate/colour_chart.h"
 #include "core/error.h"
 #include "core/logging.h"
 #include "core/session.h"
-#include "derender/colour_chart.h"
 
 namespace ibrdf {
 namespace {
@@ -50,31 +48,7 @@ void AddColourCommand(CLI::App& app) {
     inputs.push_back(session.manifest_path);
     inputs.push_back(session.directory);
     RequireWritableOutput(args->out, args->overwrite, inputs);
-    ColourChartFit fit;
-    if (session.colour_chart->corners && !args->detect) {
-      fit = FitColourChart(session, *session.colour_chart->corners, args->options, "corner patches (session)");
-    } else {
-      const ColourChartDetection detection = DetectColorChecker(ColourChartDisplayImage(session));
-      if (!detection.found) {
-        ThrowError(session.AbsolutePath(session.colour_chart->photos.front().file),
-                   detection.why +
-                       "; give the centres of patches 1, 6, 24 and 19 in colour_chart.corners "
-                       "(docs/session-format.md)");
-      }
-      char cost[64];
-      std::snprintf(cost, sizeof(cost), "%.3g", detection.cost);
-      Log(1, std::string("OpenCV mcc found a chart (cost ") + cost + "); choosing its orientation by the fit");
-      std::string last_error;
-      for (const auto& corners : CornerPatchCandidates(detection.box)) {
-        try {
-          ColourChartFit candidate = FitColourChart(session, corners, args->options, "OpenCV mcc detector");
-          if (!fit.success || candidate.rms_residual < fit.rms_residual) fit = candidate;
-        } catch (const Error& error) {
-          last_error = error.what();
-        }
-      }
-      if (!fit.success) ThrowError(session.manifest_path, "the detected chart gives no usable fit: " + last_error);
-    }
+    const ColourChartFit fit = LocateAndFitColourChart(session, args->options, args->detect);
     Log(1, fit.BriefReport());
     for (const ColourPatch& patch : fit.patches) {
       char line[200];

@@ -79,8 +79,8 @@ IBRDF_COMMAND(80, Run) {
         ->type_name("VALUE");
   }
   c->add_option("--stop-after", o.stop_after,
-                "Stop after this stage (synth, scan, align, colour, derender, check, compare,\n"
-                "reconstruct, report); later stages are left as they are");
+                "Stop after this stage (synth, scan, align, lights, colour, derender, check,\n"
+                "compare, reconstruct, report); later stages are left as they are");
   c->callback([args] {
     Timer wall;
     RequireValidOptions(args->o, "ibrdf run");

@@ -28,7 +28,7 @@
 #include "derender/analytic_sample.h"
 #include "derender/derenderer.h"
 #include "derender/mesh_sample.h"
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 #include "scan/convexity.h"
 #include "scan/mesh_file.h"
 #include "scan/ply_io.h"

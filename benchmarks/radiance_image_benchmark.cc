@@ -1,4 +1,4 @@
-// Speed of the radiometric chain (derender/radiance_image.h) against decoding the same photos: it
+// Speed of the radiometric chain (radiometry/radiance_image.h) against decoding the same photos: it
 // runs for every pixel of every photo, so it should cost little beside the decode.
 //
 //   build/benchmarks/radiance_image_benchmark [--benchmark_filter=...]
@@ -15,12 +15,12 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include "calibrate/white_reference_intensity.h"
 #include "core/brdf_model.h"
 #include "core/image_io.h"
 #include "core/logging.h"
 #include "core/session.h"
-#include "derender/light_calibration.h"
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 #include "synth/synthetic.h"
 
 namespace ibrdf {

@@ -1,6 +1,6 @@
 // Colour vocabulary: the target spaces of a colour correction and the published reference values of
 // the X-Rite ColorChecker Classic (24 patches), converted to them. The correction itself (measuring
-// a chart photo, fitting camera RGB to the reference) is derender/colour_chart.h; docs/radiometry.md,
+// a chart photo, fitting camera RGB to the reference) is calibrate/colour_chart.h; docs/radiometry.md,
 // "Colour".
 #pragma once
 

@@ -22,7 +22,7 @@ struct Light {
   // times square metres for a point light.
   Eigen::Vector3d intensity = Eigen::Vector3d::Ones();
   // False where the session states no intensity for this light: a calibration (the white reference,
-  // derender/light_calibration.h) must measure it before the light is used; `intensity` is then a
+  // calibrate/white_reference_intensity.h) must measure it before the light is used; `intensity` is then a
   // placeholder (ones).
   bool has_intensity = true;
 };

@@ -12,6 +12,7 @@
 #include "core/file_util.h"
 #include "core/image_io.h"
 #include "core/json_reader.h"
+#include "core/light_json.h"
 
 namespace fs = std::filesystem;
 
@@ -681,26 +682,14 @@ nlohmann::json Session::ToJson() const {
                     {"width", camera.width},
                     {"height", camera.height},
                     {"params", camera.params}};
-  auto light_json = [](const Light& light) {
-    nlohmann::json l;
-    if (!light.id.empty()) l["id"] = light.id;
-    l["kind"] = LightKindName(light.kind);
-    if (light.kind == Light::Kind::kPoint) {
-      l["position"] = ibrdf::ToJson(light.position);
-    } else {
-      l["direction"] = ibrdf::ToJson(light.direction);
-    }
-    if (light.has_intensity) l["intensity"] = ibrdf::ToJson(light.intensity);
-    return l;
-  };
   IBRDF_CHECK(!lights.empty()) << "a session without lights";
   // One unnamed light: the `light` shorthand; otherwise the `lights` array, and photos name theirs.
   const bool named_lights = lights.size() > 1 || !lights[0].id.empty();
   if (!named_lights) {
-    json["light"] = light_json(lights[0]);
+    json["light"] = LightJson(lights[0]);
   } else {
     json["lights"] = nlohmann::json::array();
-    for (const Light& light : lights) json["lights"].push_back(light_json(light));
+    for (const Light& light : lights) json["lights"].push_back(LightJson(light));
   }
   if (!mask.empty()) json["mask"] = mask;
   nlohmann::json& s = json["sample"];

@@ -148,7 +148,7 @@ struct PhotoSpec {
   std::optional<Rigid3d> camera_from_world;  // known pose, if any
   PhotoRole role = PhotoRole::kMeasurement;
   // Exposure bracket: measurement photos with the same bracket id are exposures of one pose under one
-  // light, merged into one high-dynamic-range radiance image (derender/radiance_image.h). Absent:
+  // light, merged into one high-dynamic-range radiance image (radiometry/radiance_image.h). Absent:
   // photos with identical poses and the same light still form one bracket.
   std::optional<int> bracket;
   // The light the photo was taken under: an index into Session::lights (the manifest names it by id).
@@ -160,7 +160,7 @@ struct PhotoSpec {
 
 // A white reference (the paper's Spectralon step): a flat Lambertian target of known reflectance at a
 // known pose, photographed under the session's light; it gives the light's RGB intensity in the
-// session's radiance unit (derender/light_calibration.h).
+// session's radiance unit (calibrate/white_reference_intensity.h, `ibrdf lights white`, before derender).
 struct WhiteReferenceSpec {
   Eigen::Vector3d reflectance = Eigen::Vector3d::Constant(0.99);  // Lambertian albedo per channel
   Eigen::Vector3d center = Eigen::Vector3d::Zero();               // the target's centre, world frame, metres
@@ -190,7 +190,7 @@ struct ColourPatchFit {
 // one of the session's lights, read through the same radiometric chain as the measurement photos.
 // `ibrdf colour` locates the chart (OpenCV's mcc detector, or the four corner patches given here),
 // fits a 3x3 matrix from camera RGB to `space` and writes it back as `matrix` with the per-patch fit;
-// the derenderer then applies it to every sample (derender/colour_chart.h).
+// the derenderer then applies it to every sample (derender/colour_correction.h).
 struct ColourChartSpec {
   std::string chart = kColorCheckerClassic24;    // the chart type (the only one for now)
   ColourSpace space = ColourSpace::kLinearSrgb;  // what the samples are corrected into

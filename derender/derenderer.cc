@@ -24,17 +24,16 @@
 #include "core/brdf_coords.h"
 #include "core/error.h"
 #include "core/file_util.h"
+#include "core/huge_pages.h"
 #include "core/json_reader.h"
 #include "core/light.h"
 #include "core/logging.h"
 #include "core/sample_file.h"
 #include "derender/analytic_sample.h"
-#include "derender/colour_chart.h"
-#include "derender/huge_pages.h"
-#include "derender/light_calibration.h"
+#include "derender/colour_correction.h"
 #include "derender/mesh_sample.h"
-#include "derender/photo_mask.h"
-#include "derender/radiance_image.h"
+#include "radiometry/photo_mask.h"
+#include "radiometry/radiance_image.h"
 #include "scan/convexity.h"
 #include "scan/mesh_file.h"
 
@@ -995,17 +994,18 @@ DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& o
   return DerenderSetup(session, options).DerenderAll();
 }
 
-DerenderResult Derender(const Session& measured_session, const DerenderOptions& options) {
+DerenderResult Derender(const Session& session, const DerenderOptions& options) {
   std::string why;
   if (!options.Check(&why)) ThrowError("derender options", why);
-  // The light's intensity from the white reference, where the session has one (light_calibration.h).
-  LightCalibrationReport calibration;
-  LightCalibrationOptions calibration_options;
-  calibration_options.min_signal = options.min_signal;
-  const Session session = ApplyLightCalibration(measured_session, &calibration, calibration_options);
-  if (calibration.calibrated) Log(1, calibration.BriefReport());
+  // The derenderer reads calibrated lights only: the white reference is a calibration of its own
+  // (calibrate/white_reference_intensity.h), which writes the lights' intensities into the session.
+  if (session.calibration && session.calibration->white_reference) {
+    ThrowError(session.manifest_path + ": /calibration/white_reference",
+               "the lights are not calibrated from the white reference yet: run `ibrdf lights white` on the "
+               "session and derender the session it writes (`ibrdf run` does both)");
+  }
   DerenderResult result = DerenderSetup(session, options).DerenderAll();
-  // The colour chart's matrix, per sample by its photo's light (colour_chart.h), after the light's calibration.
+  // The colour chart's matrix, per sample by its photo's light (colour_correction.h).
   size_t colour_dropped = 0;
   result.summary.colour_matrices = ApplyColourCorrection(session, &result.samples, &colour_dropped);
   if (!result.summary.colour_matrices.empty()) Log(1, ColourCorrectionReport(session, result.summary.colour_matrices));

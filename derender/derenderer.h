@@ -20,7 +20,7 @@
 #include "core/logging.h"
 #include "core/sample_file.h"
 #include "core/session.h"
-#include "derender/exposure_advice.h"
+#include "radiometry/exposure_advice.h"
 
 namespace ibrdf {
 
@@ -84,7 +84,7 @@ struct DerenderSummary {
   double decode_s = 0.0;              // summed over threads: time to decode the photos
   double total_s = 0.0;               // wall clock
   double mesh_setup_s = 0.0;          // mesh: reading it, the ray-tracing scene, the convexity verdict
-  // With a colour chart: the matrix applied to the samples' brdf, per light (derender/colour_chart.h).
+  // With a colour chart: the matrix applied to the samples' brdf, per light (colour_correction.h).
   std::vector<Eigen::Matrix3d> colour_matrices;
   // Accepted samples whose channel c (R, G, B) is not measured (valid 0).
   std::array<uint64_t, 3> channels_not_measured{};
@@ -102,9 +102,10 @@ struct DerenderResult {
 // The rejection reasons in the order they are tested, each with a one-line meaning.
 const std::vector<std::pair<std::string, std::string>>& RejectionReasons();
 
-// Derenders every measurement photo of a session: first the white-reference light calibration where
-// the session has one (light_calibration.h), then the analytic path for a sphere or cylinder, the
-// mesh path for a scanned mesh. Every photo needs a known camera_from_world pose. Throws Error for a
+// Derenders every measurement photo of a calibrated session: the analytic path for a sphere or
+// cylinder, the mesh path for a scanned mesh, then the colour chart's matrix where the session has
+// one. Every photo needs a known camera_from_world pose. Throws Error for a session whose white
+// reference is not applied yet (calibrate/white_reference_intensity.h: `ibrdf lights white`), a
 // missing or mis-sized photo, a photo without a pose, a camera inside the sample, a sample that no
 // photo sees, and (mesh) a missing or corrupt mesh file or one without normals.
 DerenderResult Derender(const Session& session, const DerenderOptions& options);

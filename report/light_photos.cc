@@ -12,10 +12,11 @@
 #include "core/file_util.h"
 #include "core/image_io.h"
 #include "core/json_reader.h"
-#include "core/linear_image.h"
+#include "core/light_json.h"
 #include "core/sample_file.h"
 #include "core/session.h"
 #include "core/statistics.h"
+#include "radiometry/linear_image.h"
 #include "report/report_png.h"
 #include "report/tone_map.h"
 
@@ -70,12 +71,9 @@ nlohmann::json WriteLightPhotos(const std::string& samples_path, const std::map<
   fs::create_directories(fs::path(tmp_dir) / "lights");
   for (size_t k = 0; k < session.lights.size(); ++k) {
     const Light& light = session.lights[k];
-    nlohmann::json entry = {{"id", light.id}, {"kind", LightKindName(light.kind)}};
-    if (light.kind == Light::Kind::kPoint) {
-      entry["position"] = ToJson(light.position);
-    } else {
-      entry["direction"] = ToJson(light.direction);
-    }
+    nlohmann::json entry = LightJson(light);
+    entry["id"] = light.id;
+    entry.erase("intensity");
     int photo_count = 0;
     uint64_t samples = 0;
     int best = -1;

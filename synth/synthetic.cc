@@ -245,7 +245,7 @@ Session BuildSession(const SynthOptions& options) {
   const CameraEffects& effects = options.effects;
   session.radiometry.response.kind = effects.srgb ? Response::Kind::kSrgb : Response::Kind::kLinear;
   session.radiometry.black_level = effects.black_level;
-  // Unclipped files state no saturation level (float files then have none; core/linear_image.h).
+  // Unclipped files state no saturation level (float files then have none; radiometry/linear_image.h).
   session.radiometry.saturation_stated = effects.clip;
   session.radiometry.saturation_level = 1.0;
   if (effects.shot_noise || effects.read_noise || effects.bits > 0) {

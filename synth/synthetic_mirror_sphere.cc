@@ -12,6 +12,7 @@
 #include "core/file_util.h"
 #include "core/image_io.h"
 #include "core/json_reader.h"
+#include "core/light_json.h"
 
 namespace ibrdf {
 namespace {
@@ -164,14 +165,11 @@ SyntheticMirrorSphere WriteSyntheticMirrorSphere(const SyntheticMirrorSphereOpti
     WriteImage((tmp / file).string(), image, PixelFormat::kUint8);
     photos.push_back(
         {{"file", file}, {"exposure_s", 1.0}, {"light", id}, {"camera_from_world", PoseJson(truth.camera_from_world)}});
-    nlohmann::json entry = {{"id", id}, {"kind", light.kind == Light::Kind::kPoint ? "point" : "directional"}};
-    if (light.kind == Light::Kind::kPoint) {
-      entry["position"] = ToJson(light.position);
-    } else {
-      entry["direction"] = ToJson(light.direction);
-    }
-    entry["intensity"] = {1.0, 1.0, 1.0};
-    lights.push_back(entry);
+    Light stated = light;
+    stated.id = id;
+    stated.intensity = Eigen::Vector3d::Ones();
+    stated.has_intensity = true;
+    lights.push_back(LightJson(stated));
   }
 
   nlohmann::json session = {

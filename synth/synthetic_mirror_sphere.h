@@ -1,5 +1,5 @@
 // Synthetic photos of a mirror (chrome) sphere under N known lights from a fixed camera: the input of
-// `ibrdf lights calibrate` (align/light_calibration_stage.h) with its truth, so the calibration is
+// `ibrdf lights calibrate` (calibrate/light_rig.h) with its truth, so the calibration is
 // measured against known directions. Each light is a small source with a Gaussian angular profile
 // (bright enough to clip its core, as a real highlight does), reflected by a sphere of given
 // reflectance in a dim uniform environment; the camera adds shot and read noise and stores 8-bit PNGs

@@ -70,6 +70,7 @@ class Planner {
   void Synth(const Recipe& recipe);
   void Scan();
   void Align();
+  void Lights();
   void Colour();
   void Derender();
   void SampleStages();  // check, compare, reconstruct, report
@@ -146,6 +147,25 @@ void Planner::Align() {
   if (applies) current = At("align/session.json");
 }
 
+// Sessions with a white reference: `ibrdf lights white` measures the lights' intensities into
+// DIR/lights/session.json (the white reference consumed), which the later stages read. Sessions without
+// one have no such stage in their plan (unless --stop-after names it), so their runs are as before.
+void Planner::Lights() {
+  const std::optional<Session> session = SessionAt(current);
+  Stage lights = MakeStage("lights", {"lights", "white", current, "--out", At("lights"), "--overwrite"}, {current},
+                           {At("lights/session.json"), At("lights/white-reference.json")});
+  if (session) {
+    for (const std::string& file : session->InputFiles()) lights.inputs.push_back(file);
+  }
+  if (!session || !session->calibration || !session->calibration->white_reference) {
+    if (options_.stop_after != "lights") return;
+    lights.not_applicable = "the session has no white reference";
+  }
+  const bool applies = lights.not_applicable.empty();
+  Execute(lights);
+  if (applies) current = At("lights/session.json");
+}
+
 // Sessions with a colour chart: `ibrdf colour` fits its matrix into DIR/colour/session.json, which the
 // derenderer applies.
 void Planner::Colour() {
@@ -209,7 +229,7 @@ void Planner::SampleStages() {
   pass("--radius-h-deg", options_.radius_h_deg, -1.0);
   pass("--radius-d-deg", options_.radius_d_deg, -1.0);
   if (!options_.fits) reconstruct.arguments.push_back("--no-fits");
-  // The input's name, not that of the stage folder (align/, colour/) whose session the samples came from.
+  // The input's name, not that of the stage folder (align/, lights/, colour/) whose session the samples came from.
   const std::vector<std::string>& extra = options_.reconstruct_args;
   if (!material_name.empty() && std::find(extra.begin(), extra.end(), "--name") == extra.end()) {
     reconstruct.arguments.insert(reconstruct.arguments.end(), {"--name", material_name});
@@ -247,8 +267,8 @@ void Planner::SampleStages() {
 }  // namespace
 
 const std::vector<std::string>& MeasurementStageNames() {
-  static const std::vector<std::string> kStages = {"synth", "scan",    "align",       "colour", "derender",
-                                                   "check", "compare", "reconstruct", "report"};
+  static const std::vector<std::string> kStages = {"synth",    "scan",  "align",   "lights",      "colour",
+                                                   "derender", "check", "compare", "reconstruct", "report"};
   return kStages;
 }
 
@@ -268,7 +288,7 @@ bool MeasurementOptions::Check(std::string* why) const {
   const std::vector<std::string>& stages = MeasurementStageNames();
   if (!stop_after.empty() && std::find(stages.begin(), stages.end(), stop_after) == stages.end()) {
     *why = "--stop-after: unknown stage \"" + stop_after +
-           "\" (synth, scan, align, colour, derender, check, compare, reconstruct, report)";
+           "\" (synth, scan, align, lights, colour, derender, check, compare, reconstruct, report)";
     return false;
   }
   return true;
@@ -308,6 +328,7 @@ std::string RunMeasurement(const MeasurementInput& input, const MeasurementOptio
   plan.current = plan.manifest_path;
   plan.Scan();
   plan.Align();
+  plan.Lights();
   plan.Colour();
   plan.Derender();
   plan.SampleStages();

@@ -14,8 +14,8 @@
 
 #include <gtest/gtest.h>
 
-#include "align/mirror_sphere.h"
 #include "align/sphere_fit.h"
+#include "calibrate/mirror_sphere.h"
 #include "core/image_io.h"
 
 namespace ibrdf {

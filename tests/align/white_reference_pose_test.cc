@@ -17,8 +17,8 @@
 #include "align/aligner.h"
 #include "align/targets.h"
 #include "align/white_reference_pose.h"
+#include "calibrate/white_reference_intensity.h"
 #include "core/error.h"
-#include "derender/light_calibration.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {

@@ -47,6 +47,8 @@ TEST(RunCommand, AllStagesWriteTheSummaryAndASecondRunSkipsEveryStage) {
   // No scans and no targets: the session's poses are used as given.
   EXPECT_EQ(summary["stages"]["scan"]["status"], "not_applicable");
   EXPECT_EQ(summary["stages"]["align"]["status"], "not_applicable");
+  // No white reference: no light stage in the plan at all.
+  EXPECT_FALSE(summary["stages"].contains("lights"));
 
   const nlohmann::json& samples = summary["samples"];
   const uint64_t accepted = samples["accepted"];
@@ -173,6 +175,27 @@ TEST(RunCommand, ResumesAfterAnInterruptedDerenderWithIdenticalSamples) {
   const std::string clean = Slurp(dir / "clean/samples.npy");
   ASSERT_GT(clean.size(), 1000u);
   EXPECT_TRUE(clean == Slurp(dir / "resumed/samples.npy")) << "resumed samples differ from an uninterrupted run's";
+}
+
+// A session whose light is measured by its white reference: the light stage (`ibrdf lights white`)
+// runs before derender, which reads the session it writes.
+TEST(RunCommand, WhiteReferenceSessionRunsTheLightStageBeforeDerender) {
+  ScratchDir dir;
+  ASSERT_EQ(RunIbrdf(kSynth + dir / "s" + " --light-unknown --light-intensity 0.7 0.9 1.2").exit_code, 0);
+  const RunResult run = RunIbrdf("run " + dir / "s" + " --out " + dir / "run" + " --stop-after derender", true);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json summary = ReadJson(dir / "run/summary.json");
+  EXPECT_EQ(summary["stages"]["lights"]["status"], "ran");
+  EXPECT_EQ(summary["stages"]["derender"]["status"], "ran");
+  const nlohmann::json calibrated = ReadJson(dir / "run/lights/session.json");
+  EXPECT_FALSE(calibrated.contains("calibration"));
+  const nlohmann::json light = calibrated.contains("light") ? calibrated["light"] : calibrated["lights"][0];
+  ASSERT_TRUE(light.contains("intensity"));
+  EXPECT_NEAR(light["intensity"][0].get<double>(), 0.7, 0.02);
+  EXPECT_NEAR(light["intensity"][2].get<double>(), 1.2, 0.03);
+  const std::string sidecar_session = ReadJson(dir / "run/samples.npy.json")["session"];
+  EXPECT_TRUE(fs::equivalent(sidecar_session, dir / "run/lights/session.json")) << sidecar_session;
+  EXPECT_TRUE(fs::exists(dir / "run/lights/white-reference.json"));
 }
 
 TEST(RunCommand, BadInputIsOneClearLine) {

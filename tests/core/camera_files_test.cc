@@ -11,8 +11,8 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
-#include "core/linear_image.h"
 #include "core/session.h"
+#include "radiometry/linear_image.h"
 #include "tests/core/test_dng.h"
 #include "tests/scratch_dir.h"
 

@@ -8,9 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include "calibrate/colour_chart.h"
 #include "core/brdf_model.h"
 #include "core/statistics.h"
-#include "derender/colour_chart.h"
 #include "derender/derenderer.h"
 #include "tests/test_util.h"
 

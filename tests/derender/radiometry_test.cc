@@ -9,12 +9,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "calibrate/white_reference_intensity.h"
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/logging.h"
 #include "derender/derenderer.h"
-#include "derender/light_calibration.h"
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 #include "reconstruct/truth_comparison.h"
 #include "tests/test_util.h"
 
@@ -246,11 +246,12 @@ TEST(Radiometry, FlatFieldOfTheWrongSizeIsAnError) {
   }
 }
 
-// The derender stage as `ibrdf derender` runs it (DerenderToFile), on a session made as `ibrdf synth
-// --photos 2 --width 200 --height 150 --srgb --black-level 0.03 --vignetting 0.4 --light-unknown
-// --light-intensity 0.7 0.9 1.2` makes it: the light is calibrated and the samples match the truth; a
-// saturated white reference stops it with a clear message and no output.
-TEST(Radiometry, DerenderStageCalibratesAndRefusesSaturatedReference) {
+// The light and derender stages as `ibrdf run` runs them (`ibrdf lights white`, then `ibrdf derender`:
+// DerenderToFile), on a session made as `ibrdf synth --photos 2 --width 200 --height 150 --srgb
+// --black-level 0.03 --vignetting 0.4 --light-unknown --light-intensity 0.7 0.9 1.2` makes it: the
+// derenderer refuses the uncalibrated session, the light stage calibrates the light and the samples
+// match the truth; a saturated white reference stops the light stage with a clear message and no output.
+TEST(Radiometry, LightStageCalibratesAndRefusesSaturatedReference) {
   ScratchDir dir;
   const std::string session = dir / "s";
   SynthOptions options;
@@ -264,13 +265,27 @@ TEST(Radiometry, DerenderStageCalibratesAndRefusesSaturatedReference) {
   options.scene.light_intensity = Eigen::Vector3d(0.7, 0.9, 1.2);
   const std::string material = MaterialPath("bluepaint");
   ASSERT_TRUE(WriteSyntheticSession(options, *LoadMaterial(material), material, session, false).success);
-  SetVerbosity(1);
-  ::testing::internal::CaptureStderr();
-  const DerenderResult result = DerenderToFile(Session::Load(session), DerenderOptions(), dir / "a.npy");
-  const std::string log = ::testing::internal::GetCapturedStderr();
-  SetVerbosity(0);
+  std::string refused;
+  try {
+    DerenderToFile(Session::Load(session), DerenderOptions(), dir / "u.npy");
+  } catch (const Error& e) {
+    refused = e.what();
+  }
+  EXPECT_NE(refused.find("/calibration/white_reference"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("ibrdf lights white"), std::string::npos) << refused;
+  EXPECT_FALSE(std::filesystem::exists(dir / "u.npy"));
+
+  const LightCalibrationReport report =
+      WriteLightCalibrationStage(Session::Load(session), LightCalibrationOptions(), dir / "lights", false);
+  EXPECT_NE(report.BriefReport().find("light calibration: white reference"), std::string::npos)
+      << report.BriefReport();
+  const Session calibrated = Session::Load(dir / "lights/session.json");
+  EXPECT_FALSE(calibrated.calibration.has_value());
+  ASSERT_EQ(calibrated.lights.size(), 1u);
+  EXPECT_TRUE(calibrated.lights[0].has_intensity);
+  EXPECT_EQ(calibrated.lights[0].intensity, report.lights.at(0).calibrated_intensity);
+  const DerenderResult result = DerenderToFile(calibrated, DerenderOptions(), dir / "a.npy");
   EXPECT_GT(result.summary.accepted, 0u);
-  EXPECT_NE(log.find("light calibration: white reference"), std::string::npos) << log;
   const auto samples = ReadSamples(dir / "a.npy");
   EXPECT_EQ(samples.size(), result.samples.size());
   const TruthComparison comparison = CompareWithTruth(samples, *LoadMaterial(MaterialPath("bluepaint")));
@@ -281,13 +296,13 @@ TEST(Radiometry, DerenderStageCalibratesAndRefusesSaturatedReference) {
   WriteImage(session + "/calibration/white-000.png", white, PixelFormat::kUint16);
   std::string message;
   try {
-    DerenderToFile(Session::Load(session), DerenderOptions(), dir / "b.npy");
+    WriteLightCalibrationStage(Session::Load(session), LightCalibrationOptions(), dir / "b", false);
   } catch (const Error& e) {
     message = e.what();
   }
   EXPECT_NE(message.find("white-000.png"), std::string::npos) << message;
   EXPECT_NE(message.find("saturated"), std::string::npos) << message;
-  EXPECT_FALSE(std::filesystem::exists(dir / "b.npy"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "b"));
 }
 
 // The session keys round-trip: calibration block, flat field, brackets.

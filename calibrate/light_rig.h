@@ -1,0 +1,61 @@
+// A multi-light rig's lights calibrated as `ibrdf lights calibrate` does it: their directions or
+// positions from a mirror sphere (light_probe_calibration.h), their intensities from a diffuse sphere
+// under the same lights when one is given (diffuse_sphere_intensity.h; absolute with its albedo,
+// relative without), else relative (1). The result is the "ibrdf-lights" file (the session format's
+// `lights` array and where the intensities come from), its report, and a session given those lights.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "calibrate/diffuse_sphere_intensity.h"
+#include "calibrate/light_probe_calibration.h"
+#include "core/session.h"
+
+namespace ibrdf {
+
+struct LightRigOptions {
+  LightProbeOptions probe;
+  DiffuseSphereOptions diffuse;
+  // The diffuse sphere's albedo (absolute intensities); absent: relative intensities (mean 1).
+  std::optional<Eigen::Vector3d> albedo;
+  bool Check(std::string* why) const;
+};
+
+struct LightRigCalibration {
+  LightProbeCalibration probe;                         // the lights, intensities included
+  std::optional<DiffuseSphereIntensities> intensities;  // with a diffuse sphere
+  std::vector<std::string> inputs;                     // the sessions' manifests, placements then diffuse
+
+  // "ibrdf-lights" version 1: the lights as the session format writes them, and intensity_reference.
+  nlohmann::json LightsFileJson() const;
+  // <out>.calibration.json: the probe's report, the diffuse sphere's, the inputs.
+  nlohmann::json ReportJson() const;
+  // One line per light: "  L01    to (+0.1000, ...)  +- 0.020 deg  0.310 deg from the nominal".
+  std::vector<std::string> LightLines() const;
+};
+
+// Calibrates the lights from the mirror sphere's `placements` and, when `diffuse` is given, measures
+// their intensities on it. Throws Error naming the session for bad input (light_probe_calibration.h,
+// diffuse_sphere_intensity.h), and naming "--albedo" for an albedo without a diffuse sphere.
+LightRigCalibration CalibrateLightRig(const std::vector<Session>& placements, const Session* diffuse,
+                                      const LightRigOptions& options);
+
+// "lights.json" -> "lights.calibration.json": the calibration's report beside the lights.
+std::string LightRigReportPath(const std::string& lights_path);
+
+// Writes the lights to `lights_path` and the report beside it (LightRigReportPath).
+void WriteLightRig(const LightRigCalibration& calibration, const std::string& lights_path);
+
+// `target` with each light replaced by the calibrated light of the same id (the only one, for a
+// session's one unnamed light), its id kept; with `diffuse_center`, the sample's centre becomes the
+// diffuse sphere's as its silhouette gave it. The description names `lights_path`. Throws Error naming
+// the manifest for a light that was not calibrated.
+Session WithCalibratedLights(const Session& target, const LightRigCalibration& calibration,
+                             const std::string& lights_path, bool diffuse_center);
+
+}  // namespace ibrdf
