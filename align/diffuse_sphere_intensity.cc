@@ -9,11 +9,10 @@
 #include "core/json_reader.h"
 #include "core/linear_image.h"
 #include "core/logging.h"
+#include "core/math.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string Fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
   char buffer[256];
@@ -41,14 +40,14 @@ std::string LightName(const Light& light) { return light.id.empty() ? std::strin
 
 // Irradiance per unit intensity at `point` with `normal`, and the cosine: E / I.
 double UnitIrradiance(const Light& light, const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double* cos_i) {
-  Eigen::Vector3d wi;
+  const Eigen::Vector3d wi = DirectionToLight(light, point);
   double falloff = 1.0;
-  if (light.kind == Light::Kind::kDirectional) {
-    wi = light.direction.normalized();
-  } else {
-    const Eigen::Vector3d d = light.position - point;
-    falloff = 1.0 / d.squaredNorm();
-    wi = d.normalized();
+  switch (light.kind) {
+    case Light::Kind::kDirectional:
+      break;
+    case Light::Kind::kPoint:
+      falloff = 1.0 / (light.position - point).squaredNorm();
+      break;
   }
   *cos_i = wi.dot(normal);
   return *cos_i * falloff;

@@ -12,6 +12,7 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/logging.h"
+#include "core/version.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -19,7 +20,7 @@ int main(int argc, char** argv) {
       "Photograph a curved sample under one small light from many positions; every pixel is a BRDF sample.",
       "ibrdf"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "ibrdf " IBRDF_VERSION);
+  app.set_version_flag("--version", ibrdf::kIbrdfVersionLine);
   int verbosity = 2;
   int threads = 0;
   app.add_flag_callback(

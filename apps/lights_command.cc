@@ -158,10 +158,18 @@ void AddCalibrate(CLI::App& group) {
     Log(1, calibration.BriefReport());
     for (const CalibratedLight& c : calibration.lights) {
       char line[256];
-      const Eigen::Vector3d& d = c.light.kind == Light::Kind::kPoint ? c.light.position : c.light.direction;
+      const Eigen::Vector3d& d = LightPlacement(c.light);
+      const char* preposition = "";
+      switch (c.light.kind) {
+        case Light::Kind::kPoint:
+          preposition = "at";
+          break;
+        case Light::Kind::kDirectional:
+          preposition = "to";
+          break;
+      }
       std::snprintf(line, sizeof(line), "  %-6s %s (%+.4f, %+.4f, %+.4f)  +- %.3f deg  %.3f deg from the nominal",
-                    c.light.id.c_str(), c.light.kind == Light::Kind::kPoint ? "at" : "to", d.x(), d.y(), d.z(),
-                    c.sigma_deg, c.angle_from_nominal_deg);
+                    c.light.id.c_str(), preposition, d.x(), d.y(), d.z(), c.sigma_deg, c.angle_from_nominal_deg);
       Log(1, line);
     }
     Log(1, "lights written to " + args->out + " (report: " + report_path + ")");

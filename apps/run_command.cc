@@ -14,6 +14,7 @@
 #include "core/json_reader.h"
 #include "core/logging.h"
 #include "core/subprocess.h"
+#include "core/version.h"
 #include "workflow/build_id.h"
 #include "workflow/measurement.h"
 #include "workflow/run_summary.h"
@@ -176,7 +177,7 @@ void AddRunCommand(CLI::App& app) {
     // The input: a recipe folder, or a session (validated here, so a bad one is one clear line).
     const MeasurementInput input = OpenMeasurementInput(args->input, args->out);
     ClaimRunFolder(args->out, fs::absolute(args->input).lexically_normal().string(), args->overwrite);
-    WorkflowRun run({args->out, ExecutableBuildId(), "ibrdf 0.1.0", args->options.force, args->options.stop_after});
+    WorkflowRun run({args->out, ExecutableBuildId(), kIbrdfVersionLine, args->options.force, args->options.stop_after});
     const std::string truth_path = RunMeasurement(input, args->options, ChildLauncher(), &run);
 
     const nlohmann::json summary =

@@ -13,6 +13,7 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "core/linear_image.h"
+#include "core/math.h"
 #include "core/sample_file.h"
 #include "core/session.h"
 #include "core/statistics.h"
@@ -23,8 +24,6 @@ namespace fs = std::filesystem;
 
 namespace ibrdf {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // The photo's samples' box (with a margin), linearized and shrunk by an integer box filter to at most
 // `size` pixels on a side, tone-mapped.
@@ -71,11 +70,7 @@ nlohmann::json WriteLightPhotos(const std::string& samples_path, const std::map<
   for (size_t k = 0; k < session.lights.size(); ++k) {
     const Light& light = session.lights[k];
     nlohmann::json entry = {{"id", light.id}, {"kind", LightKindName(light.kind)}};
-    if (light.kind == Light::Kind::kPoint) {
-      entry["position"] = ToJson(light.position);
-    } else {
-      entry["direction"] = ToJson(light.direction);
-    }
+    entry[LightPlacementKey(light.kind)] = ToJson(LightPlacement(light));
     int photo_count = 0;
     uint64_t samples = 0;
     int best = -1;
@@ -91,7 +86,7 @@ nlohmann::json WriteLightPhotos(const std::string& samples_path, const std::map<
     }
     entry["photos"] = photo_count;
     entry["samples"] = samples;
-    entry["phase_deg"] = phases.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(phases) / kDeg);
+    entry["phase_deg"] = phases.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(phases) / kDegree);
     entry["photo"] = best;
     entry["file"] = "";
     if (best >= 0) {

@@ -18,7 +18,7 @@
 #include "core/json_reader.h"
 #include "derender/analytic_sample.h"
 #include "scan/ply_io.h"
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
