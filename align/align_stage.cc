@@ -68,7 +68,7 @@ ColmapAlignment MergeColmap(const Session& session, const AlignStageOptions& opt
 
 // A scanned mesh whose scan saw the platform's markers: its similarity into the world.
 void RegisterScannedMesh(const Session& session, SampleSpec* sample, nlohmann::json* extra) {
-  if (sample->kind != SampleSpec::Kind::kMesh || sample->scan_targets.empty()) return;
+  if (!IsMeshSample(sample->kind) || sample->scan_targets.empty()) return;
   if (!session.targets)
     ThrowError(session.manifest_path, "/sample/scan_targets needs a \"targets\" block with the markers' layout");
   const MeshRegistration registration =

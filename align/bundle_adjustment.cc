@@ -16,12 +16,11 @@
 #include "align/cost_functions/reprojection_error.h"
 #include "core/error.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "core/statistics.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 ceres::Solver::Options SolverOptions(int parameters, int max_iterations, double tolerance) {
   ceres::Solver::Options options;

@@ -13,13 +13,12 @@
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "core/math.h"
 
 namespace fs = std::filesystem;
 
 namespace ibrdf {
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 // True when the points (columns) span at least a plane: the second singular value of the centred
 // points is not negligible against the first.
@@ -83,15 +82,12 @@ bool ColmapAlignmentOptions::Check(std::string* why) const {
   return true;
 }
 
-ColmapAlignment AlignColmapModel(const ColmapModel& model, const std::vector<std::string>& photo_files,
-                                 const std::vector<std::optional<Rigid3d>>& target_poses,
-                                 const ColmapAlignmentOptions& options, const std::string& model_directory) {
-  std::string why;
-  if (!options.Check(&why)) ThrowError("COLMAP alignment options", why);
-  IBRDF_CHECK(photo_files.size() == target_poses.size());
-  ColmapAlignment result;
+namespace {
 
-  // Names: the exact relative path first, then the file name where it is unique in the model.
+// Each photo's image in the model (result->photos, matched): the exact relative path first, then the
+// file name where it is unique in the model.
+void MatchPhotos(const ColmapModel& model, const std::vector<std::string>& photo_files,
+                 const std::vector<std::optional<Rigid3d>>& target_poses, ColmapAlignment* result) {
   std::map<std::string, int64_t> by_path, by_file_name;
   for (const auto& [id, image] : model.images) {
     by_path[fs::path(image.name).lexically_normal().generic_string()] = id;
@@ -116,10 +112,45 @@ ColmapAlignment AlignColmapModel(const ColmapModel& model, const std::vector<std
     if (id >= 0 && !claimed.count(id)) {
       match.image_id = id;
       claimed[id] = static_cast<int>(i);
-      ++result.matched;
+      ++result->matched;
     }
-    result.photos.push_back(match);
+    result->photos.push_back(match);
   }
+}
+
+// The triples of photos (indices below n) that propose similarities: all of them when there are at
+// most max_triples, else max_triples drawn with a fixed seed.
+std::vector<std::array<size_t, 3>> CandidateTriples(size_t n, int max_triples) {
+  std::vector<std::array<size_t, 3>> triples;
+  const double all_triples = double(n) * (n - 1) * (n - 2) / 6.0;
+  if (all_triples <= max_triples) {
+    for (size_t a = 0; a < n; ++a) {
+      for (size_t b = a + 1; b < n; ++b) {
+        for (size_t c = b + 1; c < n; ++c) triples.push_back({a, b, c});
+      }
+    }
+  } else {
+    std::mt19937_64 rng(42);
+    std::uniform_int_distribution<size_t> pick(0, n - 1);
+    while (triples.size() < static_cast<size_t>(max_triples)) {
+      const size_t a = pick(rng), b = pick(rng), c = pick(rng);
+      if (a != b && b != c && a != c) triples.push_back({a, b, c});
+    }
+  }
+  return triples;
+}
+
+}  // namespace
+
+ColmapAlignment AlignColmapModel(const ColmapModel& model, const std::vector<std::string>& photo_files,
+                                 const std::vector<std::optional<Rigid3d>>& target_poses,
+                                 const ColmapAlignmentOptions& options, const std::string& model_directory) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("COLMAP alignment options", why);
+  IBRDF_CHECK(photo_files.size() == target_poses.size());
+  ColmapAlignment result;
+
+  MatchPhotos(model, photo_files, target_poses, &result);
   result.unmatched_images = static_cast<int>(model.images.size()) - result.matched;
 
   // Photos posed both ways.
@@ -160,22 +191,7 @@ ColmapAlignment AlignColmapModel(const ColmapModel& model, const std::vector<std
 
   // Consensus over triples: all of them when few enough, else a seeded sample.
   const size_t n = both.size();
-  const double all_triples = double(n) * (n - 1) * (n - 2) / 6.0;
-  std::vector<std::array<size_t, 3>> triples;
-  if (all_triples <= options.max_triples) {
-    for (size_t a = 0; a < n; ++a) {
-      for (size_t b = a + 1; b < n; ++b) {
-        for (size_t c = b + 1; c < n; ++c) triples.push_back({a, b, c});
-      }
-    }
-  } else {
-    std::mt19937_64 rng(42);
-    std::uniform_int_distribution<size_t> pick(0, n - 1);
-    while (triples.size() < static_cast<size_t>(options.max_triples)) {
-      const size_t a = pick(rng), b = pick(rng), c = pick(rng);
-      if (a != b && b != c && a != c) triples.push_back({a, b, c});
-    }
-  }
+  const std::vector<std::array<size_t, 3>> triples = CandidateTriples(n, options.max_triples);
   std::pair<int, double> best_score(0, 0.0);
   std::vector<bool> best_inliers;
   for (const auto& triple : triples) {

@@ -132,24 +132,31 @@ void WritePng(const Sheet& sheet, double dpi, const std::string& path) {
   cv::Mat image(height, width, CV_8UC1, cv::Scalar(255));
   for (const Shape& s : sheet.shapes) {
     const uint8_t value = s.black ? 0 : 255;
-    if (s.kind == Shape::Kind::kRect) {
-      // Pixels whose centre lies inside: columns ceil(x px - 0.5) .. ceil((x + w) px - 0.5) - 1.
-      const int x0 = std::max(0, static_cast<int>(std::ceil(s.x * px_per_mm - 0.5)));
-      const int x1 = std::min(width, static_cast<int>(std::ceil((s.x + s.w) * px_per_mm - 0.5)));
-      const int y0 = std::max(0, static_cast<int>(std::ceil(s.y * px_per_mm - 0.5)));
-      const int y1 = std::min(height, static_cast<int>(std::ceil((s.y + s.h) * px_per_mm - 0.5)));
-      if (x1 > x0 && y1 > y0) image(cv::Rect(x0, y0, x1 - x0, y1 - y0)).setTo(value);
-    } else if (s.kind == Shape::Kind::kDisc) {
-      const double cx = s.x * px_per_mm, cy = s.y * px_per_mm, r = s.w * px_per_mm;
-      for (int y = std::max(0, int(cy - r - 1)); y < std::min(height, int(cy + r + 2)); ++y) {
-        for (int x = std::max(0, int(cx - r - 1)); x < std::min(width, int(cx + r + 2)); ++x) {
-          if (std::hypot(x + 0.5 - cx, y + 0.5 - cy) <= r) image.at<uint8_t>(y, x) = value;
-        }
+    switch (s.kind) {
+      case Shape::Kind::kRect: {
+        // Pixels whose centre lies inside: columns ceil(x px - 0.5) .. ceil((x + w) px - 0.5) - 1.
+        const int x0 = std::max(0, static_cast<int>(std::ceil(s.x * px_per_mm - 0.5)));
+        const int x1 = std::min(width, static_cast<int>(std::ceil((s.x + s.w) * px_per_mm - 0.5)));
+        const int y0 = std::max(0, static_cast<int>(std::ceil(s.y * px_per_mm - 0.5)));
+        const int y1 = std::min(height, static_cast<int>(std::ceil((s.y + s.h) * px_per_mm - 0.5)));
+        if (x1 > x0 && y1 > y0) image(cv::Rect(x0, y0, x1 - x0, y1 - y0)).setTo(value);
+        break;
       }
-    } else {
-      const double scale = s.h * px_per_mm / 22.0;  // Hershey simplex: about 22 px tall at scale 1
-      cv::putText(image, s.text, cv::Point(int(s.x * px_per_mm), int(s.y * px_per_mm)), cv::FONT_HERSHEY_SIMPLEX, scale,
-                  cv::Scalar(value), std::max(1, int(std::lround(scale * 1.5))), cv::LINE_AA);
+      case Shape::Kind::kDisc: {
+        const double cx = s.x * px_per_mm, cy = s.y * px_per_mm, r = s.w * px_per_mm;
+        for (int y = std::max(0, int(cy - r - 1)); y < std::min(height, int(cy + r + 2)); ++y) {
+          for (int x = std::max(0, int(cx - r - 1)); x < std::min(width, int(cx + r + 2)); ++x) {
+            if (std::hypot(x + 0.5 - cx, y + 0.5 - cy) <= r) image.at<uint8_t>(y, x) = value;
+          }
+        }
+        break;
+      }
+      case Shape::Kind::kText: {
+        const double scale = s.h * px_per_mm / 22.0;  // Hershey simplex: about 22 px tall at scale 1
+        cv::putText(image, s.text, cv::Point(int(s.x * px_per_mm), int(s.y * px_per_mm)), cv::FONT_HERSHEY_SIMPLEX,
+                    scale, cv::Scalar(value), std::max(1, int(std::lround(scale * 1.5))), cv::LINE_AA);
+        break;
+      }
     }
   }
   OIIO::ImageSpec spec(width, height, 1, OIIO::TypeDesc::UINT8);
@@ -314,10 +321,10 @@ nlohmann::json TargetsToJson(const TargetsSpec& targets) {
   return json;
 }
 
-TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const std::string& out_dir) {
-  std::string why;
-  if (!options.Check(&why)) ThrowError("targets options", why);
-  const MarkerDictionary dictionary(options.dictionary, "--dictionary");
+namespace {
+
+// The layout's ids fit the dictionary and do not collide; the ChArUco board is one OpenCV draws.
+void CheckLayout(const TargetSheetsOptions& options, const MarkerDictionary& dictionary) {
   int last_id = options.light_marker_count > 0 ? options.light_marker_first_id + options.light_marker_count - 1
                                                : options.ring_count - 1;
   if (options.white_card) last_id = std::max(last_id, options.white_marker_first_id + 3);
@@ -337,6 +344,195 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
       ThrowError("ChArUco board", "needs marker_size < square_size, an odd number of rows and 3 columns or more");
     }
   }
+}
+
+// The platform: the black disc with the ring of reference markers, the sample's cross at the world origin.
+Sheet PlatformSheet(const TargetSheetsOptions& options, const MarkerDictionary& dictionary, const TargetsSpec& targets,
+                    std::ostringstream* readme) {
+  const double r_mm = 1e3 * options.platform_radius;
+  Sheet sheet;
+  sheet.name = "platform";
+  sheet.width_mm = std::max(2.0 * r_mm + 20.0, 150.0);
+  sheet.height_mm = 2.0 * r_mm + 60.0;
+  const double cx = 0.5 * sheet.width_mm, cy = 10.0 + r_mm;
+  sheet.Disc(cx, cy, r_mm, true);
+  for (const TargetSpec& target : targets.reference) {
+    const Eigen::Vector3d c = 0.25 * (target.corners[0] + target.corners[1] + target.corners[2] + target.corners[3]);
+    DrawMarker(dictionary, target.id, cx + 1e3 * c.x(), cy - 1e3 * c.y(), 1e3 * options.marker_size,
+               options.card_margin, &sheet);
+  }
+  // Where the sample rests: a thin white cross at the centre (the world origin).
+  sheet.Cross(cx, cy, 4.0, 0.4, false);
+  const double text_y = cy + r_mm + 10.0;
+  DrawScaleBar(10.0, text_y, 1e3 * options.scale_bar, &sheet);
+  sheet.Text(10.0, text_y + 14.0, 3.5,
+             options.dictionary + " markers " + Mm(1e3 * options.marker_size) + " (border included), centres " +
+                 Mm(1e3 * options.ring_radius) + " from the cross");
+  sheet.Text(10.0, text_y + 20.0, 3.5,
+             "platform " + Mm(2e3 * options.platform_radius) + " across; sample on the cross");
+  sheet.Text(10.0, text_y + 26.0, 3.5, "world frame: origin at the cross, x right, y up this sheet, z up");
+  *readme << "platform.svg/.png: lay it flat under the sample, the sample on the white cross at its centre. The\n"
+          << "  black disc keeps the sphere's silhouette against black; keep it matte and free of dust.\n"
+          << "  Markers " << options.dictionary << ", side " << Mm(1e3 * options.marker_size) << ", centres "
+          << Mm(1e3 * options.ring_radius) << " from the centre. Corners (mm, x right, y up the sheet):\n";
+  for (const TargetSpec& target : targets.reference) {
+    *readme << "    id " << target.id << ":" << Corners(target) << "\n";
+  }
+  return sheet;
+}
+
+// The light card: a row of markers below the light's emitter.
+Sheet LightCardSheet(const TargetSheetsOptions& options, const MarkerDictionary& dictionary,
+                     std::ostringstream* readme) {
+  const double side = 1e3 * options.light_marker_size;
+  const double pitch = side * (1.0 + 2.0 * options.card_margin);
+  const double drop = 1e3 * options.light_drop;
+  Sheet sheet;
+  sheet.name = "light-card";
+  sheet.width_mm = std::max(pitch * options.light_marker_count + 20.0, 150.0);
+  sheet.height_mm = drop + 0.5 * pitch + 60.0;
+  const double cx = 0.5 * sheet.width_mm, row_y = 15.0 + drop;
+  sheet.Cross(cx, row_y - drop, 8.0, 0.5, true);
+  sheet.Text(cx + 10.0, row_y - drop + 1.5, 3.5, "the light's emitter here");
+  for (int k = 0; k < options.light_marker_count; ++k) {
+    const double dx = pitch * (k - 0.5 * (options.light_marker_count - 1));
+    DrawMarker(dictionary, options.light_marker_first_id + k, cx + dx, row_y, side, options.card_margin, &sheet);
+  }
+  const double text_y = row_y + 0.5 * pitch + 12.0;
+  DrawScaleBar(10.0, text_y, std::min(1e3 * options.scale_bar, sheet.width_mm - 20.0), &sheet);
+  sheet.Text(10.0, text_y + 14.0, 3.5,
+             "markers " + Mm(side) + ", centres " + Mm(pitch) + " apart, " + Mm(drop) + " below the cross");
+  *readme << "\nlight-card.svg/.png: fix it upright to the light, facing the sample, the emitter at the cross";
+  if (options.light_offset > 0.0) *readme << " and " << Mm(1e3 * options.light_offset) << " in front of the card";
+  *readme << ".\n  Take 3 or more photos (role \"targets\") that see it and the platform's ring: `ibrdf align` then\n"
+          << "  finds the light (targets.light in targets.json: the emitter in each marker's frame).\n";
+  return sheet;
+}
+
+// The white reference's card: four markers around the patch's corner marks.
+Sheet WhiteCardSheet(const TargetSheetsOptions& options, const MarkerDictionary& dictionary, const TargetsSpec& targets,
+                     std::ostringstream* readme) {
+  const double side = 1e3 * options.white_marker_size, patch = 1e3 * options.white_patch_size;
+  const double card = patch + 2.0 * side * (1.0 + 2.0 * options.card_margin);
+  Sheet sheet;
+  sheet.name = "white-card";
+  sheet.width_mm = std::max(card + 20.0, 190.0);  // room for the captions
+  sheet.height_mm = card + 70.0;
+  const double cx = 0.5 * sheet.width_mm, cy = 10.0 + 0.5 * card;
+  // The card's outline (cut along it), thin.
+  const double line = 0.2, h = 0.5 * card;
+  sheet.Rect(cx - h, cy - h, card, line, true);
+  sheet.Rect(cx - h, cy + h - line, card, line, true);
+  sheet.Rect(cx - h, cy - h, line, card, true);
+  sheet.Rect(cx + h - line, cy - h, line, card, true);
+  for (const TargetSpec& target : targets.white_reference->markers) {
+    const Eigen::Vector3d c = 0.25 * (target.corners[0] + target.corners[1] + target.corners[2] + target.corners[3]);
+    DrawMarker(dictionary, target.id, cx + 1e3 * c.x(), cy - 1e3 * c.y(), side, 0.0, &sheet);
+  }
+  // The patch's corners: small L marks 1.5 mm outside it.
+  const double p = 0.5 * patch + 1.5, arm = 4.0, w = 0.3;
+  for (const double sx : {-1.0, 1.0}) {
+    for (const double sy : {-1.0, 1.0}) {
+      // The corner at (x, y); its arms point away from the patch.
+      const double x = cx + sx * p, y = cy + sy * p;
+      sheet.Rect(std::min(x, x + sx * arm), y - 0.5 * w, arm, w, true);
+      sheet.Rect(x - 0.5 * w, std::min(y, y + sy * arm), w, arm, true);
+    }
+  }
+  const double text_y = cy + h + 12.0;
+  DrawScaleBar(10.0, text_y, std::min(1e3 * options.scale_bar, sheet.width_mm - 20.0), &sheet);
+  sheet.Text(10.0, text_y + 14.0, 3.5, "white patch " + Mm(patch) + " square inside the corner marks");
+  sheet.Text(10.0, text_y + 20.0, 3.5,
+             "markers " + Mm(side) + ", ids " + std::to_string(options.white_marker_first_id) + " to " +
+                 std::to_string(options.white_marker_first_id + 3));
+  sheet.Text(10.0, text_y + 26.0, 3.5,
+             "patch surface " + Mm(1e3 * options.white_patch_thickness) + " in front of the card");
+  *readme << "\nwhite-card.svg/.png: glue it flat to a rigid board and mount the white reference (Spectralon, "
+          << Mm(patch) << "\n  square) inside the corner marks";
+  if (options.white_patch_thickness > 0.0) {
+    *readme << ", its surface " << Mm(1e3 * options.white_patch_thickness) << " in front of the card";
+  } else {
+    *readme << ", its surface flush with the card (or rerun with --white-patch-thickness-mm)";
+  }
+  *readme << ".\n  Stand it where the sample was, facing between the light and the camera, and photograph it so\n"
+          << "  that the card's 4 markers and 2 or more platform markers are in view: `ibrdf align` then poses it\n"
+          << "  (targets.white_reference: the markers' corners in the card's frame, origin at the patch's\n"
+          << "  centre, x right, y up, z out of the patch). Corners (mm):\n";
+  for (const TargetSpec& target : targets.white_reference->markers) {
+    *readme << "    id " << target.id << ":" << Corners(target) << "\n";
+  }
+  return sheet;
+}
+
+// The ChArUco board for the camera's calibration, drawn by OpenCV and traced into rectangles.
+Sheet CharucoSheet(const TargetSheetsOptions& options, std::ostringstream* readme) {
+  const CharucoBoardSpec& board = options.board;
+  const double square = 1e3 * board.square_size;
+  Sheet sheet;
+  sheet.name = "charuco";
+  const double board_w = square * board.squares_x, board_h = square * board.squares_y;
+  sheet.width_mm = board_w + 2.0 * std::max(0.5 * square, 10.0);
+  sheet.height_mm = board_h + 2.0 * std::max(0.5 * square, 10.0) + 30.0;
+  const double x0 = 0.5 * (sheet.width_mm - board_w), y0 = std::max(0.5 * square, 10.0);
+  // OpenCV's drawing, at a texel size that puts every square and marker-module edge on a texel edge.
+  int texels = 0;
+  const double module_mm = 1e3 * board.marker_size / MarkerDictionary(board.dictionary, "board").modules();
+  const double inset_mm = 0.5 * (square - 1e3 * board.marker_size);
+  for (int t = 8; t <= 1024 && texels == 0; ++t) {
+    const double texel = square / t;
+    auto aligned = [&](double length) { return std::abs(length / texel - std::round(length / texel)) < 1e-6; };
+    if (aligned(module_mm) && aligned(inset_mm)) texels = t;
+  }
+  if (texels == 0) texels = 400;  // no exact grid: edges within a quarter of a 0.06 mm texel
+  int width = 0, height = 0;
+  const std::vector<uint8_t> texture = DrawCharucoBoard(board, texels, &width, &height);
+  const double texel = square / texels;
+  // Runs of black texels per row; identical consecutive rows merge into one rectangle.
+  std::vector<std::pair<int, int>> previous, runs;
+  int run_start_row = 0;
+  auto flush = [&](int end_row) {
+    for (const auto& [a, b] : previous) {
+      sheet.Rect(x0 + a * texel, y0 + run_start_row * texel, (b - a) * texel, (end_row - run_start_row) * texel, true);
+    }
+  };
+  for (int row = 0; row <= height; ++row) {
+    runs.clear();
+    if (row < height) {
+      for (int col = 0; col < width;) {
+        if (texture[size_t(row) * width + col] != 0) {
+          ++col;
+          continue;
+        }
+        int end = col;
+        while (end < width && texture[size_t(row) * width + end] == 0) ++end;
+        runs.emplace_back(col, end);
+        col = end;
+      }
+    }
+    if (row == height || runs != previous) {
+      flush(row);
+      previous = runs;
+      run_start_row = row;
+    }
+  }
+  const double text_y = y0 + board_h + 12.0;
+  DrawScaleBar(10.0, text_y, std::min(1e3 * options.scale_bar, sheet.width_mm - 20.0), &sheet);
+  sheet.Text(10.0, text_y + 14.0, 3.5,
+             "ChArUco " + std::to_string(board.squares_x) + " x " + std::to_string(board.squares_y) + ", squares " +
+                 Mm(square) + ", markers " + Mm(1e3 * board.marker_size) + " " + board.dictionary);
+  *readme << "\ncharuco.svg/.png and board.json: glue the board flat to something rigid; take 12 or more photos of\n"
+          << "  it with the measurement's focus and zoom, filling the frame, tilted up to 45 degrees, reaching the\n"
+          << "  corners; put them in a folder with board.json and pass it to `ibrdf align --calibrate DIR`.\n";
+  return sheet;
+}
+
+}  // namespace
+
+TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const std::string& out_dir) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("targets options", why);
+  const MarkerDictionary dictionary(options.dictionary, "--dictionary");
+  CheckLayout(options, dictionary);
   TargetSheetsResult result;
   result.targets = TargetLayout(options);
   AtomicDirectory directory(out_dir, options.overwrite);
@@ -354,182 +550,13 @@ TargetSheetsResult WriteTargetSheets(const TargetSheetsOptions& options, const s
          << "scale bar with a ruler: if it is not the stated length, the printer scaled the sheet: reprint, or\n"
          << "scale every length in targets.json by measured / stated. SVG files are exact (vector); the PNGs\n"
          << "are " << options.dpi << " dpi with the resolution stored in the file.\n\n";
-
-  // The platform.
-  {
-    const double r_mm = 1e3 * options.platform_radius;
-    Sheet sheet;
-    sheet.name = "platform";
-    sheet.width_mm = std::max(2.0 * r_mm + 20.0, 150.0);
-    sheet.height_mm = 2.0 * r_mm + 60.0;
-    const double cx = 0.5 * sheet.width_mm, cy = 10.0 + r_mm;
-    sheet.Disc(cx, cy, r_mm, true);
-    for (const TargetSpec& target : result.targets.reference) {
-      const Eigen::Vector3d c = 0.25 * (target.corners[0] + target.corners[1] + target.corners[2] + target.corners[3]);
-      DrawMarker(dictionary, target.id, cx + 1e3 * c.x(), cy - 1e3 * c.y(), 1e3 * options.marker_size,
-                 options.card_margin, &sheet);
-    }
-    // Where the sample rests: a thin white cross at the centre (the world origin).
-    sheet.Cross(cx, cy, 4.0, 0.4, false);
-    const double text_y = cy + r_mm + 10.0;
-    DrawScaleBar(10.0, text_y, 1e3 * options.scale_bar, &sheet);
-    sheet.Text(10.0, text_y + 14.0, 3.5,
-               options.dictionary + " markers " + Mm(1e3 * options.marker_size) + " (border included), centres " +
-                   Mm(1e3 * options.ring_radius) + " from the cross");
-    sheet.Text(10.0, text_y + 20.0, 3.5,
-               "platform " + Mm(2e3 * options.platform_radius) + " across; sample on the cross");
-    sheet.Text(10.0, text_y + 26.0, 3.5, "world frame: origin at the cross, x right, y up this sheet, z up");
-    emit(sheet);
-    readme << "platform.svg/.png: lay it flat under the sample, the sample on the white cross at its centre. The\n"
-           << "  black disc keeps the sphere's silhouette against black; keep it matte and free of dust.\n"
-           << "  Markers " << options.dictionary << ", side " << Mm(1e3 * options.marker_size) << ", centres "
-           << Mm(1e3 * options.ring_radius) << " from the centre. Corners (mm, x right, y up the sheet):\n";
-    for (const TargetSpec& target : result.targets.reference) {
-      readme << "    id " << target.id << ":" << Corners(target) << "\n";
-    }
-  }
-  // The light card.
-  if (result.targets.light) {
-    const double side = 1e3 * options.light_marker_size;
-    const double pitch = side * (1.0 + 2.0 * options.card_margin);
-    const double drop = 1e3 * options.light_drop;
-    Sheet sheet;
-    sheet.name = "light-card";
-    sheet.width_mm = std::max(pitch * options.light_marker_count + 20.0, 150.0);
-    sheet.height_mm = drop + 0.5 * pitch + 60.0;
-    const double cx = 0.5 * sheet.width_mm, row_y = 15.0 + drop;
-    sheet.Cross(cx, row_y - drop, 8.0, 0.5, true);
-    sheet.Text(cx + 10.0, row_y - drop + 1.5, 3.5, "the light's emitter here");
-    for (int k = 0; k < options.light_marker_count; ++k) {
-      const double dx = pitch * (k - 0.5 * (options.light_marker_count - 1));
-      DrawMarker(dictionary, options.light_marker_first_id + k, cx + dx, row_y, side, options.card_margin, &sheet);
-    }
-    const double text_y = row_y + 0.5 * pitch + 12.0;
-    DrawScaleBar(10.0, text_y, std::min(1e3 * options.scale_bar, sheet.width_mm - 20.0), &sheet);
-    sheet.Text(10.0, text_y + 14.0, 3.5,
-               "markers " + Mm(side) + ", centres " + Mm(pitch) + " apart, " + Mm(drop) + " below the cross");
-    emit(sheet);
-    readme << "\nlight-card.svg/.png: fix it upright to the light, facing the sample, the emitter at the cross";
-    if (options.light_offset > 0.0) readme << " and " << Mm(1e3 * options.light_offset) << " in front of the card";
-    readme << ".\n  Take 3 or more photos (role \"targets\") that see it and the platform's ring: `ibrdf align` then\n"
-           << "  finds the light (targets.light in targets.json: the emitter in each marker's frame).\n";
-  }
-  // The white reference's card.
-  if (result.targets.white_reference) {
-    const double side = 1e3 * options.white_marker_size, patch = 1e3 * options.white_patch_size;
-    const double card = patch + 2.0 * side * (1.0 + 2.0 * options.card_margin);
-    Sheet sheet;
-    sheet.name = "white-card";
-    sheet.width_mm = std::max(card + 20.0, 190.0);  // room for the captions
-    sheet.height_mm = card + 70.0;
-    const double cx = 0.5 * sheet.width_mm, cy = 10.0 + 0.5 * card;
-    // The card's outline (cut along it), thin.
-    const double line = 0.2, h = 0.5 * card;
-    sheet.Rect(cx - h, cy - h, card, line, true);
-    sheet.Rect(cx - h, cy + h - line, card, line, true);
-    sheet.Rect(cx - h, cy - h, line, card, true);
-    sheet.Rect(cx + h - line, cy - h, line, card, true);
-    for (const TargetSpec& target : result.targets.white_reference->markers) {
-      const Eigen::Vector3d c = 0.25 * (target.corners[0] + target.corners[1] + target.corners[2] + target.corners[3]);
-      DrawMarker(dictionary, target.id, cx + 1e3 * c.x(), cy - 1e3 * c.y(), side, 0.0, &sheet);
-    }
-    // The patch's corners: small L marks 1.5 mm outside it.
-    const double p = 0.5 * patch + 1.5, arm = 4.0, w = 0.3;
-    for (const double sx : {-1.0, 1.0}) {
-      for (const double sy : {-1.0, 1.0}) {
-        // The corner at (x, y); its arms point away from the patch.
-        const double x = cx + sx * p, y = cy + sy * p;
-        sheet.Rect(std::min(x, x + sx * arm), y - 0.5 * w, arm, w, true);
-        sheet.Rect(x - 0.5 * w, std::min(y, y + sy * arm), w, arm, true);
-      }
-    }
-    const double text_y = cy + h + 12.0;
-    DrawScaleBar(10.0, text_y, std::min(1e3 * options.scale_bar, sheet.width_mm - 20.0), &sheet);
-    sheet.Text(10.0, text_y + 14.0, 3.5, "white patch " + Mm(patch) + " square inside the corner marks");
-    sheet.Text(10.0, text_y + 20.0, 3.5,
-               "markers " + Mm(side) + ", ids " + std::to_string(options.white_marker_first_id) + " to " +
-                   std::to_string(options.white_marker_first_id + 3));
-    sheet.Text(10.0, text_y + 26.0, 3.5,
-               "patch surface " + Mm(1e3 * options.white_patch_thickness) + " in front of the card");
-    emit(sheet);
-    readme << "\nwhite-card.svg/.png: glue it flat to a rigid board and mount the white reference (Spectralon, "
-           << Mm(patch) << "\n  square) inside the corner marks";
-    if (options.white_patch_thickness > 0.0) {
-      readme << ", its surface " << Mm(1e3 * options.white_patch_thickness) << " in front of the card";
-    } else {
-      readme << ", its surface flush with the card (or rerun with --white-patch-thickness-mm)";
-    }
-    readme << ".\n  Stand it where the sample was, facing between the light and the camera, and photograph it so\n"
-           << "  that the card's 4 markers and 2 or more platform markers are in view: `ibrdf align` then poses it\n"
-           << "  (targets.white_reference: the markers' corners in the card's frame, origin at the patch's\n"
-           << "  centre, x right, y up, z out of the patch). Corners (mm):\n";
-    for (const TargetSpec& target : result.targets.white_reference->markers) {
-      readme << "    id " << target.id << ":" << Corners(target) << "\n";
-    }
-  }
-  // The ChArUco board.
+  emit(PlatformSheet(options, dictionary, result.targets, &readme));
+  if (result.targets.light) emit(LightCardSheet(options, dictionary, &readme));
+  if (result.targets.white_reference) emit(WhiteCardSheet(options, dictionary, result.targets, &readme));
   if (options.charuco) {
-    const CharucoBoardSpec& board = options.board;
-    const double square = 1e3 * board.square_size;
-    Sheet sheet;
-    sheet.name = "charuco";
-    const double board_w = square * board.squares_x, board_h = square * board.squares_y;
-    sheet.width_mm = board_w + 2.0 * std::max(0.5 * square, 10.0);
-    sheet.height_mm = board_h + 2.0 * std::max(0.5 * square, 10.0) + 30.0;
-    const double x0 = 0.5 * (sheet.width_mm - board_w), y0 = std::max(0.5 * square, 10.0);
-    // OpenCV's drawing, at a texel size that puts every square and marker-module edge on a texel edge.
-    int texels = 0;
-    const double module_mm = 1e3 * board.marker_size / MarkerDictionary(board.dictionary, "board").modules();
-    const double inset_mm = 0.5 * (square - 1e3 * board.marker_size);
-    for (int t = 8; t <= 1024 && texels == 0; ++t) {
-      const double texel = square / t;
-      auto aligned = [&](double length) { return std::abs(length / texel - std::round(length / texel)) < 1e-6; };
-      if (aligned(module_mm) && aligned(inset_mm)) texels = t;
-    }
-    if (texels == 0) texels = 400;  // no exact grid: edges within a quarter of a 0.06 mm texel
-    int width = 0, height = 0;
-    const std::vector<uint8_t> texture = DrawCharucoBoard(board, texels, &width, &height);
-    const double texel = square / texels;
-    // Runs of black texels per row; identical consecutive rows merge into one rectangle.
-    std::vector<std::pair<int, int>> previous, runs;
-    int run_start_row = 0;
-    auto flush = [&](int end_row) {
-      for (const auto& [a, b] : previous) {
-        sheet.Rect(x0 + a * texel, y0 + run_start_row * texel, (b - a) * texel, (end_row - run_start_row) * texel,
-                   true);
-      }
-    };
-    for (int row = 0; row <= height; ++row) {
-      runs.clear();
-      if (row < height) {
-        for (int col = 0; col < width;) {
-          if (texture[size_t(row) * width + col] != 0) {
-            ++col;
-            continue;
-          }
-          int end = col;
-          while (end < width && texture[size_t(row) * width + end] == 0) ++end;
-          runs.emplace_back(col, end);
-          col = end;
-        }
-      }
-      if (row == height || runs != previous) {
-        flush(row);
-        previous = runs;
-        run_start_row = row;
-      }
-    }
-    const double text_y = y0 + board_h + 12.0;
-    DrawScaleBar(10.0, text_y, std::min(1e3 * options.scale_bar, sheet.width_mm - 20.0), &sheet);
-    sheet.Text(10.0, text_y + 14.0, 3.5,
-               "ChArUco " + std::to_string(board.squares_x) + " x " + std::to_string(board.squares_y) + ", squares " +
-                   Mm(square) + ", markers " + Mm(1e3 * board.marker_size) + " " + board.dictionary);
-    emit(sheet);
-    WriteJsonFile((fs::path(tmp) / "board.json").string(), board.ToJson());
+    emit(CharucoSheet(options, &readme));
+    WriteJsonFile((fs::path(tmp) / "board.json").string(), options.board.ToJson());
     result.files.push_back("board.json");
-    readme << "\ncharuco.svg/.png and board.json: glue the board flat to something rigid; take 12 or more photos of\n"
-           << "  it with the measurement's focus and zoom, filling the frame, tilted up to 45 degrees, reaching the\n"
-           << "  corners; put them in a folder with board.json and pass it to `ibrdf align --calibrate DIR`.\n";
   }
   WriteJsonFile((fs::path(tmp) / "targets.json").string(),
                 {{"format", "ibrdf-targets"}, {"version", 1}, {"targets", TargetsToJson(result.targets)}});

@@ -6,6 +6,7 @@
 #include <tbb/global_control.h>
 
 #include "apps/commands.h"
+#include "core/version.h"
 #include "workflow/run_folder.h"
 
 namespace ibrdf {
@@ -86,7 +87,7 @@ IBRDF_COMMAND(80, Run) {
     RequireValidOptions(args->o, "ibrdf run");
     const int threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     const nlohmann::json summary =
-        RunInFolder(args->input, args->out, args->o, args->overwrite, ChildStageLauncher(threads), "ibrdf 0.1.0", wall);
+        RunInFolder(args->input, args->out, args->o, args->overwrite, ChildStageLauncher(threads), kIbrdfVersionLine, wall);
     for (const std::string& line : RunFolderReport(summary, args->out, wall.ElapsedSeconds())) Log(1, line);
   });
 }

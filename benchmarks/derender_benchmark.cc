@@ -32,8 +32,8 @@
 #include "scan/convexity.h"
 #include "scan/mesh_file.h"
 #include "scan/ply_io.h"
-#include "scan/synthetic_scan.h"
 #include "synth/synthetic.h"
+#include "synth/synthetic_scan.h"
 
 namespace ibrdf {
 namespace {

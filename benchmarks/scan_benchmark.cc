@@ -15,7 +15,7 @@
 #include "scan/adapters.h"
 #include "scan/local_plane_normals.h"
 #include "scan/range_grid.h"
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 
 namespace ibrdf {
 namespace {

@@ -10,12 +10,11 @@
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "radiometry/linear_image.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string Fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
   char buffer[256];

@@ -12,14 +12,12 @@
 #include "core/json_reader.h"
 #include "core/light_json.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "core/statistics.h"
 #include "radiometry/linear_image.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = 180.0 / kPi;
 
 std::string Fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
   char buffer[256];
@@ -28,15 +26,14 @@ std::string Fmt(const char* format, double a, double b = 0, double c = 0, double
 }
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * kDeg;
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * kDegreesPerRadian;
 }
 
 std::string LightName(const Light& light) { return light.id.empty() ? std::string("light") : light.id; }
 
 // The nominal light's direction as seen from `center`.
 Eigen::Vector3d NominalDirection(const Light& light, const Eigen::Vector3d& center) {
-  if (light.kind == Light::Kind::kDirectional) return light.direction.normalized();
-  return (light.position - center).normalized();
+  return DirectionToLight(light, center);
 }
 
 nlohmann::json Vec2(const Eigen::Vector2d& v) { return {v.x(), v.y()}; }
@@ -70,8 +67,8 @@ bool LightProbeOptions::Check(std::string* why) const {
 
 std::string LightProbeCalibration::BriefReport() const {
   if (!success) return "light probe: not calibrated";
-  const bool point = !lights.empty() && lights[0].light.kind == Light::Kind::kPoint;
-  return "light probe: " + std::to_string(lights.size()) + (point ? " point" : " directional") + " lights from " +
+  const char* kind = lights.empty() ? "directional" : LightKindName(lights[0].light.kind);
+  return "light probe: " + std::to_string(lights.size()) + " " + kind + " lights from " +
          std::to_string(silhouettes.size()) + " placement" + (silhouettes.size() == 1 ? "" : "s") +
          Fmt(", uncertainty median %.3f / max %.3f deg; from the nominal: median %.3f / max %.3f deg", median_sigma_deg,
              max_sigma_deg, median_angle_from_nominal_deg, max_angle_from_nominal_deg) +
@@ -125,9 +122,13 @@ nlohmann::json LightProbeCalibration::ReportJson() const {
                             {"sigma_from_highlight_deg", c.sigma_from_highlight_deg},
                             {"angle_from_nominal_deg", c.angle_from_nominal_deg},
                             {"highlights", highlights}};
-    if (c.light.kind == Light::Kind::kPoint) {
-      entry["position_sigma_m"] = c.position_sigma_m;
-      entry["position_from_nominal_m"] = c.position_from_nominal_m;
+    switch (c.light.kind) {
+      case Light::Kind::kPoint:
+        entry["position_sigma_m"] = c.position_sigma_m;
+        entry["position_from_nominal_m"] = c.position_from_nominal_m;
+        break;
+      case Light::Kind::kDirectional:
+        break;
     }
     per_light.push_back(entry);
   }
@@ -194,8 +195,8 @@ void ObservePlacement(const Session& session, size_t p, const LightProbeOptions&
     ray.origin = camera_from_world.Inverse() * direction.surface_point;
     ray.direction = world_from_camera * direction.direction;
     ray.covariance = world_from_camera * direction.covariance * world_from_camera.transpose();
-    ray.sigma_rad = direction.sigma_deg / kDeg;
-    ray.sigma_highlight_rad = direction.sigma_from_highlight_deg / kDeg;
+    ray.sigma_rad = direction.sigma_deg / kDegreesPerRadian;
+    ray.sigma_highlight_rad = direction.sigma_from_highlight_deg / kDegreesPerRadian;
     ray.placement = int(p);
     observations->rays[id].push_back(ray);
     observations->highlights[id].push_back(highlight);
@@ -244,7 +245,7 @@ void LocatePointLight(const std::string& manifest, const std::string& id, const 
   const double t =
       -b + std::sqrt(std::max(0.0, b * b - oc.squaredNorm() + options.light_distance * options.light_distance));
   c->light.position = ray.origin + t * ray.direction;
-  c->position_sigma_m = t * c->sigma_deg / kDeg;
+  c->position_sigma_m = t * c->sigma_deg / kDegreesPerRadian;
 }
 
 // The calibrated light of `nominal` (a light of the first session) from its observations.
@@ -273,8 +274,8 @@ CalibratedLight CalibrateLight(const Session& first, const Light& nominal, const
     weights_highlight += 1.0 / std::max(1e-18, ray.sigma_highlight_rad * ray.sigma_highlight_rad);
   }
   const Eigen::Vector3d direction = sum.normalized();
-  c.sigma_deg = kDeg / std::sqrt(weights);
-  c.sigma_from_highlight_deg = kDeg / std::sqrt(weights_highlight);
+  c.sigma_deg = kDegreesPerRadian / std::sqrt(weights);
+  c.sigma_from_highlight_deg = kDegreesPerRadian / std::sqrt(weights_highlight);
   const Eigen::Vector3d& center0 = centers[0];
   if (!point) {
     c.light.kind = Light::Kind::kDirectional;
@@ -282,7 +283,13 @@ CalibratedLight CalibrateLight(const Session& first, const Light& nominal, const
   } else {
     c.light.kind = Light::Kind::kPoint;
     LocatePointLight(first.manifest_path, id, list, centers, options, &c);
-    if (nominal.kind == Light::Kind::kPoint) c.position_from_nominal_m = (nominal.position - c.light.position).norm();
+    switch (nominal.kind) {
+      case Light::Kind::kPoint:
+        c.position_from_nominal_m = (nominal.position - c.light.position).norm();
+        break;
+      case Light::Kind::kDirectional:
+        break;
+    }
   }
   const Eigen::Vector3d calibrated_direction =
       point ? Eigen::Vector3d((c.light.position - center0).normalized()) : c.light.direction;

@@ -32,10 +32,18 @@ std::vector<std::string> LightRigCalibration::LightLines() const {
   std::vector<std::string> lines;
   for (const CalibratedLight& c : probe.lights) {
     char line[256];
-    const bool point = c.light.kind == Light::Kind::kPoint;
-    const Eigen::Vector3d& d = point ? c.light.position : c.light.direction;
+    const Eigen::Vector3d& d = LightPlacement(c.light);
+    const char* preposition = "";
+    switch (c.light.kind) {
+      case Light::Kind::kPoint:
+        preposition = "at";
+        break;
+      case Light::Kind::kDirectional:
+        preposition = "to";
+        break;
+    }
     std::snprintf(line, sizeof(line), "  %-6s %s (%+.4f, %+.4f, %+.4f)  +- %.3f deg  %.3f deg from the nominal",
-                  c.light.id.c_str(), point ? "at" : "to", d.x(), d.y(), d.z(), c.sigma_deg, c.angle_from_nominal_deg);
+                  c.light.id.c_str(), preposition, d.x(), d.y(), d.z(), c.sigma_deg, c.angle_from_nominal_deg);
     lines.push_back(line);
   }
   return lines;

@@ -8,11 +8,10 @@
 #include <Eigen/Dense>
 
 #include "core/error.h"
+#include "core/math.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string Format(const char* format, double a, double b, double c = 0, double d = 0, double e = 0, double f = 0) {
   char buffer[256];

@@ -12,13 +12,12 @@
 #include "core/file_util.h"
 #include "core/json_reader.h"
 #include "core/light.h"
+#include "core/math.h"
 #include "core/statistics.h"
 #include "radiometry/radiance_image.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 // The pixel box holding the image of a disc (centre, normal, radius), with a 2-pixel margin; the
 // whole image where part of the disc is behind the camera.

@@ -174,11 +174,11 @@ int GroupBrackets(const SessionInitOptions& options, std::vector<InitPhoto>* pho
   return brackets;
 }
 
-SessionInitResult InitSession(const SessionInitOptions& options, const std::string& out_dir) {
-  std::string why;
-  if (!options.Check(&why)) ThrowError("session init options", why);
-  SessionInitResult result;
-  // Every photo's metadata.
+namespace {
+
+// Every photo's metadata, in the manifest's order (measurement, target, white-reference and chart photos);
+// one size for all and an exposure time for each.
+void ReadPhotos(const SessionInitOptions& options, SessionInitResult* result) {
   for (int pass = 0; pass < 4; ++pass) {
     for (const std::string& file : pass == 0   ? options.photos
                                    : pass == 1 ? options.target_photos
@@ -190,13 +190,12 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
       photo.target = pass == 1;
       photo.white = pass == 2;
       photo.chart = pass == 3;
-      result.photos.push_back(photo);
+      result->photos.push_back(photo);
     }
   }
-  const InitPhoto& first = result.photos.front();
+  const InitPhoto& first = result->photos.front();
   std::vector<std::string> no_exposure;
-  double lowest_iso = 0.0;
-  for (const InitPhoto& photo : result.photos) {
+  for (const InitPhoto& photo : result->photos) {
     if (photo.metadata.width != first.metadata.width || photo.metadata.height != first.metadata.height) {
       ThrowError(photo.file, "is " + std::to_string(photo.metadata.width) + "x" +
                                  std::to_string(photo.metadata.height) + ", " + first.file + " is " +
@@ -204,7 +203,6 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
                                  ": one session, one camera");
     }
     if (!photo.metadata.exposure_s) no_exposure.push_back(photo.file);
-    if (photo.metadata.iso && (lowest_iso == 0.0 || *photo.metadata.iso < lowest_iso)) lowest_iso = *photo.metadata.iso;
   }
   if (!no_exposure.empty()) {
     std::string list;
@@ -215,10 +213,17 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
                                         "); session init reads exposures from the photos, so state them in "
                                         "session.json by hand (docs/session-format.md)");
   }
-  // Gain from ISO.
+}
+
+// Each photo's gain, ISO over the base ISO (--base-iso, else the lowest ISO among the photos).
+void AssignGains(const SessionInitOptions& options, SessionInitResult* result) {
+  double lowest_iso = 0.0;
+  for (const InitPhoto& photo : result->photos) {
+    if (photo.metadata.iso && (lowest_iso == 0.0 || *photo.metadata.iso < lowest_iso)) lowest_iso = *photo.metadata.iso;
+  }
   const double base_iso = options.base_iso > 0.0 ? options.base_iso : lowest_iso;
   bool some_iso_missing = false;
-  for (InitPhoto& photo : result.photos) {
+  for (InitPhoto& photo : result->photos) {
     if (photo.metadata.iso && base_iso > 0.0) {
       photo.gain = *photo.metadata.iso / base_iso;
     } else {
@@ -226,47 +231,212 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
     }
   }
   if (base_iso > 0.0) {
-    result.assumptions.push_back("gain = ISO / " + Format("%g", base_iso) +
-                                 (options.base_iso > 0.0 ? " (--base-iso)" : " (the lowest ISO among the photos)"));
+    result->assumptions.push_back("gain = ISO / " + Format("%g", base_iso) +
+                                  (options.base_iso > 0.0 ? " (--base-iso)" : " (the lowest ISO among the photos)"));
   }
-  if (some_iso_missing) result.assumptions.push_back("photos without an EXIF ISO have gain 1");
-  result.brackets = GroupBrackets(options, &result.photos);
+  if (some_iso_missing) result->assumptions.push_back("photos without an EXIF ISO have gain 1");
+}
 
-  // The camera.
+// The camera: the calibration file given, else a pinhole guess from EXIF; nullopt (and a missing
+// entry) when neither is there.
+std::optional<Camera> ResolveCamera(const SessionInitOptions& options, const PhotoMetadata& first,
+                                    SessionInitResult* result) {
   std::optional<Camera> camera;
   if (!options.camera_file.empty()) {
     camera = CameraFromFile(options.camera_file);
-    result.camera_source = "calibration " + options.camera_file;
-    if (camera->width != first.metadata.width || camera->height != first.metadata.height) {
+    result->camera_source = "calibration " + options.camera_file;
+    if (camera->width != first.width || camera->height != first.height) {
       ThrowError(options.camera_file, "the camera is " + std::to_string(camera->width) + "x" +
                                           std::to_string(camera->height) + ", the photos " +
-                                          std::to_string(first.metadata.width) + "x" +
-                                          std::to_string(first.metadata.height));
+                                          std::to_string(first.width) + "x" + std::to_string(first.height));
     }
   } else {
     Camera guess;
-    if (CameraFromMetadata(first.metadata, options.sensor_width_mm, &guess, &result.camera_source)) {
+    if (CameraFromMetadata(first, options.sensor_width_mm, &guess, &result->camera_source)) {
       camera = guess;
-      result.assumptions.push_back(
-          "camera: a pinhole guess (no distortion, principal point at the centre) from " + result.camera_source +
+      result->assumptions.push_back(
+          "camera: a pinhole guess (no distortion, principal point at the centre) from " + result->camera_source +
           "; calibrate it with `ibrdf align --calibrate BOARD_DIR` (ChArUco photos) or pass --camera");
     } else {
-      result.missing.push_back("the camera: pass --camera FILE (a calibrated camera block) or --sensor-width-mm");
+      result->missing.push_back("the camera: pass --camera FILE (a calibrated camera block) or --sensor-width-mm");
     }
   }
-  if (camera) result.camera = *camera;
+  if (camera) result->camera = *camera;
+  return camera;
+}
 
-  // The manifest.
+// The manifest's description: how many photos, the camera's make and model, the f-number.
+std::string Description(const SessionInitResult& result) {
+  const PhotoMetadata& first = result.photos.front().metadata;
+  std::string description = "Drafted by `ibrdf session init` from " + std::to_string(result.photos.size()) + " photos";
+  if (!first.make.empty() || !first.model.empty()) description += " (" + first.make + " " + first.model + ")";
+  if (first.f_number) description += ", f/" + Format("%g", *first.f_number);
+  return description;
+}
+
+// The one point light: position and intensity as given, placeholders where a later stage measures
+// them (markers on the light, the white reference), null and a missing entry otherwise.
+nlohmann::json LightJson(const SessionInitOptions& options, bool light_markers, SessionInitResult* result) {
+  nlohmann::json light = {{"kind", LightKindName(Light::Kind::kPoint)}};
+  if (options.light_position) {
+    light["position"] = ToJson(*options.light_position);
+  } else if (light_markers) {
+    light["position"] = {0.0, 0.0, 1.0};
+    result->assumptions.push_back(
+        "light position: a placeholder (0, 0, 1); `ibrdf align` finds the light from its markers");
+  } else {
+    light["position"] = nullptr;
+    result->missing.push_back(
+        "the light's position (metres, the targets' frame): pass --light-position-m X Y Z or put markers on the "
+        "light (`ibrdf targets` prints its card)");
+  }
+  if (options.light_intensity) {
+    light["intensity"] = ToJson(*options.light_intensity);
+  } else if (!options.white_photos.empty()) {
+    result->assumptions.push_back("light intensity: none stated; the white reference measures it (ibrdf derender)");
+  } else {
+    light["intensity"] = nullptr;
+    result->missing.push_back(
+        "the light's RGB intensity in the session's radiance unit: pass --light-intensity R,G,B (a white "
+        "reference photo measures it: docs/capture.md)");
+  }
+  return light;
+}
+
+// The sample: its radius and centre as given; with targets, the centre of a sphere resting on the platform.
+nlohmann::json SampleJson(const SessionInitOptions& options, bool has_targets, SessionInitResult* result) {
+  nlohmann::json sample = {{"kind", options.sample_kind}};
+  if (options.sample_radius) {
+    sample["radius"] = *options.sample_radius;
+    if (options.radius_known) sample["radius_known"] = true;
+  } else {
+    sample["radius"] = nullptr;
+    result->missing.push_back(
+        "the sphere's radius (metres): pass --sample-radius-m R (and --radius-known if measured)");
+  }
+  if (options.sample_center) {
+    sample["center"] = ToJson(*options.sample_center);
+  } else if (has_targets && options.sample_radius) {
+    sample["center"] = {0.0, 0.0, *options.sample_radius};
+    result->assumptions.push_back(
+        "sphere centre: resting on the platform's centre, (0, 0, radius); `ibrdf align` fits it from the silhouettes");
+  } else {
+    sample["center"] = nullptr;
+    result->missing.push_back("the sphere's centre (metres, the targets' frame): pass --sample-center-m X Y Z");
+  }
+  return sample;
+}
+
+// The response (--response, else linear for RAW, float and deep photos, sRGB for 8-bit ones) and black level 0.
+nlohmann::json RadiometryJson(const SessionInitOptions& options, const PhotoMetadata& first,
+                              SessionInitResult* result) {
+  std::string response = options.response;
+  if (response.empty()) {
+    const bool linear_file = first.raw || first.floating_point || first.bits > 8;
+    response = linear_file ? "linear" : "srgb";
+    result->assumptions.push_back("response \"" + response + "\" (" +
+                                  (first.raw              ? std::string("camera RAW decodes linearly")
+                                   : first.floating_point ? std::string("floating-point photos")
+                                   : first.bits > 8       ? std::to_string(first.bits) + "-bit photos, taken as linear"
+                                                          : std::string("8-bit photos, taken as sRGB-encoded")) +
+                                  "); pass --response or calibrate the response if it is not");
+  }
+  result->assumptions.push_back(
+      "black level 0 and no saturation level stated (integer photos clip at full scale, float photos never; "
+      "camera RAW: the file's black and white levels are applied when decoding)");
+  return {{"response", response}, {"black_level", 0.0}};
+}
+
+// The colour chart: its photos (exposure and gain from EXIF like the others) and, when given, its
+// corner patches; `ibrdf colour` fits the matrix (and detects the chart without corners).
+nlohmann::json ColourChartJson(const SessionInitOptions& options, const nlohmann::json& chart_photos,
+                               SessionInitResult* result) {
+  nlohmann::json chart = {{"chart", kColorCheckerClassic24},
+                          {"space", ColourSpaceName(ColourSpace::kLinearSrgb)},
+                          {"photos", chart_photos}};
+  if (options.chart_corners) {
+    for (const Eigen::Vector2d& p : *options.chart_corners) chart["corners"].push_back({p.x(), p.y()});
+  }
+  result->assumptions.push_back(
+      "colour chart: a ColorChecker Classic 24 under the session's light, corrected into linear sRGB; " +
+      std::string(options.chart_corners ? "located by the corner patches given"
+                                        : "no corner patches given, so `ibrdf colour` detects it (OpenCV mcc)") +
+      "; run `ibrdf colour` on the session to fit its matrix before `ibrdf derender`");
+  return chart;
+}
+
+// The white reference: posed by `ibrdf align` from the white card's markers, when the targets have them.
+nlohmann::json WhiteReferenceJson(const SessionInitOptions& options, const nlohmann::json& white_photos,
+                                  bool white_card_markers, SessionInitResult* result) {
+  nlohmann::json white = {{"photos", white_photos}};
+  white["reflectance"] = ToJson(options.white_reflectance.value_or(Eigen::Vector3d::Constant(0.99)));
+  if (!options.white_reflectance) {
+    result->assumptions.push_back("white reference reflectance 0.99 (Spectralon's); pass --white-reflectance R,G,B");
+  }
+  if (options.white_size) {
+    white["size"] = *options.white_size;
+  } else {
+    white["size"] = nullptr;
+    result->missing.push_back("the white reference's size (metres, the patch's side): pass --white-size-m S");
+  }
+  if (!white_card_markers) {
+    white["center"] = nullptr;
+    white["normal"] = nullptr;
+    result->missing.push_back(
+        "the white reference's centre and normal: print the white card (`ibrdf targets`), mount the reference on "
+        "it and pass its targets.json with --targets (`ibrdf align` then poses it), or state them by hand");
+  }
+  return white;
+}
+
+// Writes session.json when the manifest validates, else session.draft.json with the missing list.
+void WriteManifest(const SessionInitOptions& options, const std::string& out_dir, nlohmann::json json,
+                   SessionInitResult* result) {
+  fs::create_directories(out_dir);
+  const std::string session_path = (fs::path(out_dir) / "session.json").string();
+  const std::string draft_path = (fs::path(out_dir) / "session.draft.json").string();
+  for (const std::string& path : {session_path, draft_path}) {
+    if (fs::exists(path) && !options.overwrite) ThrowError(path, "exists; pass --overwrite to replace it");
+  }
+  if (result->missing.empty()) {
+    const std::string trial = (fs::path(out_dir) / ".session.init.json").string();
+    WriteJsonFile(trial, json);
+    try {
+      Session::Load(trial);
+      fs::rename(trial, session_path);
+      if (fs::exists(draft_path)) fs::remove(draft_path);
+      result->complete = true;
+      result->path = session_path;
+    } catch (const Error& e) {
+      fs::remove(trial);
+      result->missing.push_back(std::string("the draft does not validate: ") + e.what());
+    }
+  }
+  if (!result->complete) {
+    json["missing"] = result->missing;
+    WriteJsonFile(draft_path, json);
+    result->path = draft_path;
+  }
+  result->written = true;
+}
+
+}  // namespace
+
+SessionInitResult InitSession(const SessionInitOptions& options, const std::string& out_dir) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("session init options", why);
+  SessionInitResult result;
+  ReadPhotos(options, &result);
+  AssignGains(options, &result);
+  result.brackets = GroupBrackets(options, &result.photos);
+  const PhotoMetadata& first = result.photos.front().metadata;
+  const std::optional<Camera> camera = ResolveCamera(options, first, &result);
+
   nlohmann::json json;
   json["format"] = "ibrdf-session";
   json["version"] = 1;
   json["name"] = options.name.empty() ? fs::path(out_dir).filename().string() : options.name;
-  std::string description = "Drafted by `ibrdf session init` from " + std::to_string(result.photos.size()) + " photos";
-  if (!first.metadata.make.empty() || !first.metadata.model.empty()) {
-    description += " (" + first.metadata.make + " " + first.metadata.model + ")";
-  }
-  if (first.metadata.f_number) description += ", f/" + Format("%g", *first.metadata.f_number);
-  json["description"] = description;
+  json["description"] = Description(result);
   if (camera) {
     json["camera"] = {{"model", CameraModelName(camera->model)},
                       {"width", camera->width},
@@ -275,75 +445,14 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
   } else {
     json["camera"] = nullptr;
   }
-  // Targets.
   bool light_markers = false;
   if (!options.targets_file.empty()) {
     json["targets"] = TargetsFromFile(options.targets_file);
     light_markers = json["targets"].contains("light");
   }
-  // The light.
-  nlohmann::json light = {{"kind", "point"}};
-  if (options.light_position) {
-    light["position"] = ToJson(*options.light_position);
-  } else if (light_markers) {
-    light["position"] = {0.0, 0.0, 1.0};
-    result.assumptions.push_back(
-        "light position: a placeholder (0, 0, 1); `ibrdf align` finds the light from its markers");
-  } else {
-    light["position"] = nullptr;
-    result.missing.push_back(
-        "the light's position (metres, the targets' frame): pass --light-position-m X Y Z or put markers on the "
-        "light (`ibrdf targets` prints its card)");
-  }
-  if (options.light_intensity) {
-    light["intensity"] = ToJson(*options.light_intensity);
-  } else if (!options.white_photos.empty()) {
-    result.assumptions.push_back("light intensity: none stated; the white reference measures it (ibrdf derender)");
-  } else {
-    light["intensity"] = nullptr;
-    result.missing.push_back(
-        "the light's RGB intensity in the session's radiance unit: pass --light-intensity R,G,B (a white "
-        "reference photo measures it: docs/capture.md)");
-  }
-  json["light"] = light;
-  // The sample.
-  nlohmann::json sample = {{"kind", options.sample_kind}};
-  if (options.sample_radius) {
-    sample["radius"] = *options.sample_radius;
-    if (options.radius_known) sample["radius_known"] = true;
-  } else {
-    sample["radius"] = nullptr;
-    result.missing.push_back("the sphere's radius (metres): pass --sample-radius-m R (and --radius-known if measured)");
-  }
-  if (options.sample_center) {
-    sample["center"] = ToJson(*options.sample_center);
-  } else if (json.contains("targets") && options.sample_radius) {
-    sample["center"] = {0.0, 0.0, *options.sample_radius};
-    result.assumptions.push_back(
-        "sphere centre: resting on the platform's centre, (0, 0, radius); `ibrdf align` fits it from the silhouettes");
-  } else {
-    sample["center"] = nullptr;
-    result.missing.push_back("the sphere's centre (metres, the targets' frame): pass --sample-center-m X Y Z");
-  }
-  json["sample"] = sample;
-  // Radiometry.
-  std::string response = options.response;
-  if (response.empty()) {
-    const bool linear_file = first.metadata.raw || first.metadata.floating_point || first.metadata.bits > 8;
-    response = linear_file ? "linear" : "srgb";
-    result.assumptions.push_back("response \"" + response + "\" (" +
-                                 (first.metadata.raw              ? std::string("camera RAW decodes linearly")
-                                  : first.metadata.floating_point ? std::string("floating-point photos")
-                                  : first.metadata.bits > 8
-                                      ? std::to_string(first.metadata.bits) + "-bit photos, taken as linear"
-                                      : std::string("8-bit photos, taken as sRGB-encoded")) +
-                                 "); pass --response or calibrate the response if it is not");
-  }
-  json["radiometry"] = {{"response", response}, {"black_level", 0.0}};
-  result.assumptions.push_back(
-      "black level 0 and no saturation level stated (integer photos clip at full scale, float photos never; "
-      "camera RAW: the file's black and white levels are applied when decoding)");
-  // Photos.
+  json["light"] = LightJson(options, light_markers, &result);
+  json["sample"] = SampleJson(options, json.contains("targets"), &result);
+  json["radiometry"] = RadiometryJson(options, first, &result);
   nlohmann::json photos = nlohmann::json::array(), white_photos = nlohmann::json::array(),
                  chart_photos = nlohmann::json::array();
   for (const InitPhoto& photo : result.photos) {
@@ -354,77 +463,17 @@ SessionInitResult InitSession(const SessionInitOptions& options, const std::stri
     (photo.white ? white_photos : photo.chart ? chart_photos : photos).push_back(entry);
   }
   json["photos"] = photos;
-  // The colour chart: its photos (exposure and gain from EXIF like the others) and, when given, its
-  // corner patches; `ibrdf colour` fits the matrix (and detects the chart without corners).
-  if (!chart_photos.empty()) {
-    nlohmann::json chart = {{"chart", kColorCheckerClassic24},
-                            {"space", ColourSpaceName(ColourSpace::kLinearSrgb)},
-                            {"photos", chart_photos}};
-    if (options.chart_corners) {
-      for (const Eigen::Vector2d& p : *options.chart_corners) chart["corners"].push_back({p.x(), p.y()});
-    }
-    json["colour_chart"] = chart;
-    result.assumptions.push_back(
-        "colour chart: a ColorChecker Classic 24 under the session's light, corrected into linear sRGB; " +
-        std::string(options.chart_corners ? "located by the corner patches given"
-                                          : "no corner patches given, so `ibrdf colour` detects it (OpenCV mcc)") +
-        "; run `ibrdf colour` on the session to fit its matrix before `ibrdf derender`");
-  }
-  // The white reference: posed by `ibrdf align` from the white card's markers, when the targets have them.
+  if (!chart_photos.empty()) json["colour_chart"] = ColourChartJson(options, chart_photos, &result);
   if (!white_photos.empty()) {
-    nlohmann::json white = {{"photos", white_photos}};
-    white["reflectance"] = ToJson(options.white_reflectance.value_or(Eigen::Vector3d::Constant(0.99)));
-    if (!options.white_reflectance) {
-      result.assumptions.push_back("white reference reflectance 0.99 (Spectralon's); pass --white-reflectance R,G,B");
-    }
-    if (options.white_size) {
-      white["size"] = *options.white_size;
-    } else {
-      white["size"] = nullptr;
-      result.missing.push_back("the white reference's size (metres, the patch's side): pass --white-size-m S");
-    }
-    if (!(json.contains("targets") && json["targets"].contains("white_reference"))) {
-      white["center"] = nullptr;
-      white["normal"] = nullptr;
-      result.missing.push_back(
-          "the white reference's centre and normal: print the white card (`ibrdf targets`), mount the reference on "
-          "it and pass its targets.json with --targets (`ibrdf align` then poses it), or state them by hand");
-    }
-    json["calibration"] = {{"white_reference", white}};
+    const bool white_card_markers = json.contains("targets") && json["targets"].contains("white_reference");
+    json["calibration"] = {{"white_reference", WhiteReferenceJson(options, white_photos, white_card_markers, &result)}};
   }
   if (!json.contains("targets")) {
     result.missing.push_back(
         "the photos' poses: pass --targets FILE (the markers' layout from `ibrdf targets`) and run `ibrdf align`, "
         "or add camera_from_world poses by hand");
   }
-
-  // Write: session.json when it validates, else session.draft.json with the missing list.
-  fs::create_directories(out_dir);
-  const std::string session_path = (fs::path(out_dir) / "session.json").string();
-  const std::string draft_path = (fs::path(out_dir) / "session.draft.json").string();
-  for (const std::string& path : {session_path, draft_path}) {
-    if (fs::exists(path) && !options.overwrite) ThrowError(path, "exists; pass --overwrite to replace it");
-  }
-  if (result.missing.empty()) {
-    const std::string trial = (fs::path(out_dir) / ".session.init.json").string();
-    WriteJsonFile(trial, json);
-    try {
-      Session::Load(trial);
-      fs::rename(trial, session_path);
-      if (fs::exists(draft_path)) fs::remove(draft_path);
-      result.complete = true;
-      result.path = session_path;
-    } catch (const Error& e) {
-      fs::remove(trial);
-      result.missing.push_back(std::string("the draft does not validate: ") + e.what());
-    }
-  }
-  if (!result.complete) {
-    json["missing"] = result.missing;
-    WriteJsonFile(draft_path, json);
-    result.path = draft_path;
-  }
-  result.written = true;
+  WriteManifest(options, out_dir, std::move(json), &result);
   return result;
 }
 

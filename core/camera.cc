@@ -5,6 +5,7 @@
 #include <Eigen/LU>
 
 #include "core/error.h"
+#include "core/kind.h"
 
 namespace ibrdf {
 namespace {
@@ -29,6 +30,21 @@ const ModelInfo& Info(CameraModelId id) {
   }
   IBRDF_CHECK(false) << "unknown camera model id";
   return kModels[0];
+}
+
+// Whether the model's parameters start fx, fy, cx, cy (PINHOLE, OPENCV) rather than f, cx, cy (COLMAP's
+// parameter order).
+bool HasTwoFocalLengths(CameraModelId model) {
+  switch (model) {
+    case CameraModelId::kSimplePinhole:
+    case CameraModelId::kSimpleRadial:
+    case CameraModelId::kRadial:
+      return false;
+    case CameraModelId::kPinhole:
+    case CameraModelId::kOpenCV:
+      return true;
+  }
+  UnhandledKind("CameraModelId", static_cast<int>(model));
 }
 
 // Distortion coefficients in OpenCV's form (k1, k2, p1, p2), zero where the model has none.
@@ -107,15 +123,9 @@ Camera Camera::Create(CameraModelId model, int width, int height, std::vector<do
 }
 
 double Camera::FocalX() const { return params[0]; }
-double Camera::FocalY() const {
-  return model == CameraModelId::kPinhole || model == CameraModelId::kOpenCV ? params[1] : params[0];
-}
-double Camera::PrincipalX() const {
-  return model == CameraModelId::kPinhole || model == CameraModelId::kOpenCV ? params[2] : params[1];
-}
-double Camera::PrincipalY() const {
-  return model == CameraModelId::kPinhole || model == CameraModelId::kOpenCV ? params[3] : params[2];
-}
+double Camera::FocalY() const { return HasTwoFocalLengths(model) ? params[1] : params[0]; }
+double Camera::PrincipalX() const { return HasTwoFocalLengths(model) ? params[2] : params[1]; }
+double Camera::PrincipalY() const { return HasTwoFocalLengths(model) ? params[3] : params[2]; }
 
 bool Camera::HasDistortion() const {
   const Coefficients c = CoefficientsOf(*this);

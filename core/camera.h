@@ -15,9 +15,11 @@
 
 #include <Eigen/Core>
 
+#include "core/kind.h"
+
 namespace ibrdf {
 
-enum class CameraModelId { kSimplePinhole, kPinhole, kSimpleRadial, kRadial, kOpenCV };
+enum class CameraModelId { kSimplePinhole, kPinhole, kSimpleRadial, kRadial, kOpenCV, IBRDF_DUMMY_KIND };
 
 // "OPENCV" for kOpenCV; the names of COLMAP's cameras.txt.
 const char* CameraModelName(CameraModelId id);

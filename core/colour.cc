@@ -43,7 +43,37 @@ const char* ColourSpaceName(ColourSpace space) {
     case ColourSpace::kXyz:
       return "xyz";
   }
-  return "unknown";
+  UnhandledKind("ColourSpace", static_cast<int>(space));
+}
+
+const char* ColourSpaceLabel(ColourSpace space) {
+  switch (space) {
+    case ColourSpace::kLinearSrgb:
+      return "linear sRGB (D65)";
+    case ColourSpace::kXyz:
+      return "CIE XYZ (D65)";
+  }
+  UnhandledKind("ColourSpace", static_cast<int>(space));
+}
+
+Eigen::Matrix3d LinearSrgbFromSpace(ColourSpace space, const Eigen::Matrix3d& m) {
+  switch (space) {
+    case ColourSpace::kLinearSrgb:
+      return m;
+    case ColourSpace::kXyz:
+      return LinearSrgbFromXyz() * m;
+  }
+  UnhandledKind("ColourSpace", static_cast<int>(space));
+}
+
+Eigen::Matrix3d SpaceFromLinearSrgb(ColourSpace space, const Eigen::Matrix3d& m) {
+  switch (space) {
+    case ColourSpace::kLinearSrgb:
+      return m;
+    case ColourSpace::kXyz:
+      return XyzFromLinearSrgb() * m;
+  }
+  UnhandledKind("ColourSpace", static_cast<int>(space));
 }
 
 bool ColourSpaceFromName(const std::string& name, ColourSpace* space) {
@@ -83,7 +113,14 @@ std::array<Eigen::Vector3d, kColorCheckerPatches> ColorCheckerReference(ColourSp
     const Eigen::Vector3d xyz_d50 =
         Eigen::Vector3d(LabInverse(fx), LabInverse(fy), LabInverse(fz)).cwiseProduct(kWhiteD50);
     const Eigen::Vector3d xyz_d65 = adapt * xyz_d50;
-    values[k] = space == ColourSpace::kXyz ? xyz_d65 : Eigen::Vector3d(LinearSrgbFromXyz() * xyz_d65);
+    values[k] = xyz_d65;
+    switch (space) {
+      case ColourSpace::kLinearSrgb:
+        values[k] = LinearSrgbFromXyz() * xyz_d65;
+        break;
+      case ColourSpace::kXyz:
+        break;
+    }
   }
   return values;
 }

@@ -9,17 +9,26 @@
 
 #include <Eigen/Core>
 
+#include "core/kind.h"
+
 namespace ibrdf {
 
 // The space a colour correction maps camera RGB into.
 enum class ColourSpace {
   kLinearSrgb,  // linear sRGB (IEC 61966-2-1 primaries, D65 white), no transfer curve
   kXyz,         // CIE 1931 XYZ, D65 white (Y = 1 for a perfect white diffuser)
+  IBRDF_DUMMY_KIND
 };
 
 // "linear_srgb", "xyz"; and back (false for any other name).
 const char* ColourSpaceName(ColourSpace space);
 bool ColourSpaceFromName(const std::string& name, ColourSpace* space);
+// "linear sRGB (D65)", "CIE XYZ (D65)": the space's name for people.
+const char* ColourSpaceLabel(ColourSpace space);
+// `m`, a matrix into `space`, made a matrix into linear sRGB (`m` itself for linear sRGB); and a matrix
+// into linear sRGB made one into `space`.
+Eigen::Matrix3d LinearSrgbFromSpace(ColourSpace space, const Eigen::Matrix3d& m);
+Eigen::Matrix3d SpaceFromLinearSrgb(ColourSpace space, const Eigen::Matrix3d& m);
 
 // The chart types a session's colour_chart block may name. Only the ColorChecker Classic 24 for now
 // (also its Mini and Nano editions: the same patches, smaller).

@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 
+#include "core/kind.h"
+
 namespace ibrdf {
 
 struct Light {
@@ -14,6 +16,7 @@ struct Light {
   enum class Kind {
     kPoint,        // a small source at `position`; `intensity` is radiant intensity (per steradian)
     kDirectional,  // a distant source towards `direction`; `intensity` is irradiance at normal incidence
+    IBRDF_DUMMY_KIND
   };
   Kind kind = Kind::kPoint;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();    // metres, world frame (point light)
@@ -27,8 +30,15 @@ struct Light {
   bool has_intensity = true;
 };
 
-// "point", "directional".
+// "point", "directional": the kind's name in the session format.
 const char* LightKindName(Light::Kind kind);
+// The vector that places the light: its position (point light) or its direction (directional light).
+const Eigen::Vector3d& LightPlacement(const Light& light);
+// That vector's key in the session format: "position" or "direction".
+const char* LightPlacementKey(Light::Kind kind);
+// The unit direction from `point` towards the light (the light's direction, normalized, for a
+// directional light).
+Eigen::Vector3d DirectionToLight(const Light& light, const Eigen::Vector3d& point);
 // The light's name for messages: "light L07", or "the light" for an unnamed one.
 std::string LightLabel(const Light& light);
 

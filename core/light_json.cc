@@ -10,11 +10,7 @@ nlohmann::json LightJson(const Light& light) {
   nlohmann::json l;
   if (!light.id.empty()) l["id"] = light.id;
   l["kind"] = LightKindName(light.kind);
-  if (light.kind == Light::Kind::kPoint) {
-    l["position"] = ToJson(light.position);
-  } else {
-    l["direction"] = ToJson(light.direction);
-  }
+  l[LightPlacementKey(light.kind)] = ToJson(LightPlacement(light));
   if (light.has_intensity) l["intensity"] = ToJson(light.intensity);
   return l;
 }

@@ -8,10 +8,19 @@
 
 #include "core/brdf_coords.h"
 #include "core/error.h"
+#include "core/kind.h"
 
 namespace ibrdf {
 
-const char* MerlLookupName(MerlLookup lookup) { return lookup == MerlLookup::kLinear ? "linear" : "nearest"; }
+const char* MerlLookupName(MerlLookup lookup) {
+  switch (lookup) {
+    case MerlLookup::kNearest:
+      return "nearest";
+    case MerlLookup::kLinear:
+      return "linear";
+  }
+  UnhandledKind("MerlLookup", static_cast<int>(lookup));
+}
 
 MerlLookup MerlLookupFromName(const std::string& name, const std::string& where) {
   if (name == "nearest") return MerlLookup::kNearest;

@@ -60,7 +60,7 @@ std::string Response::Describe() const {
     case Kind::kTable:
       return "table (" + std::to_string(table.size()) + " entries)";
   }
-  return "unknown";
+  UnhandledKind("Response::Kind", static_cast<int>(kind));
 }
 
 bool Response::Check(std::string* why) const {

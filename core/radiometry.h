@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "core/kind.h"
+
 namespace ibrdf {
 
 struct Response {
@@ -17,6 +19,7 @@ struct Response {
     kSrgb,    // IEC 61966-2-1 sRGB transfer curve
     kGamma,   // file value = linear^(1/gamma)
     kTable,   // measured: linear value at N file values evenly spaced over [0, 1]
+    IBRDF_DUMMY_KIND
   };
   Kind kind = Kind::kLinear;
   double gamma = 2.2;         // kGamma only

@@ -6,15 +6,14 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/math.h"
 #include "core/tensor_file.h"
 
 namespace ibrdf {
 namespace {
 
-constexpr float kPi = 3.14159265358979323846f;
-
-float ThetaToU(float theta) { return std::sqrt(theta * (2.0f / kPi)); }
-float PhiToU(float phi) { return (phi + kPi) / (2.0f * kPi); }
+float ThetaToU(float theta) { return std::sqrt(theta * (2.0f / kPiFloat)); }
+float PhiToU(float phi) { return (phi + kPiFloat) / (2.0f * kPiFloat); }
 
 }  // namespace
 

@@ -14,6 +14,7 @@
 #endif
 
 #include "core/error.h"
+#include "core/math.h"
 #include "core/npy.h"
 
 namespace ibrdf {
@@ -46,7 +47,6 @@ void AdviseHugePages(const void* data, size_t bytes) {
 // most invalid ones; ReadSamples asks InvalidSampleReason only when this is false. The same tests and
 // slack as InvalidSampleReason.
 inline bool PlausibleSample(const BrdfSample& s) {
-  constexpr float kPi = 3.14159265358979f;
   constexpr float kAngleSlack = 1e-4f;
   constexpr float kUnitSlack = 1e-3f;
   for (int c = 0; c < 3; ++c) {
@@ -56,9 +56,10 @@ inline bool PlausibleSample(const BrdfSample& s) {
   const double wi = std::sqrt(double(s.wi[0]) * s.wi[0] + double(s.wi[1]) * s.wi[1] + double(s.wi[2]) * s.wi[2]);
   const double wo = std::sqrt(double(s.wo[0]) * s.wo[0] + double(s.wo[1]) * s.wo[1] + double(s.wo[2]) * s.wo[2]);
   return std::abs(wi - 1.0) <= kUnitSlack && std::abs(wo - 1.0) <= kUnitSlack && s.theta_i >= -kAngleSlack &&
-         s.theta_i <= kPi / 2 + kAngleSlack && s.theta_e >= -kAngleSlack && s.theta_e <= kPi / 2 + kAngleSlack &&
-         s.delta_phi >= -kPi - kAngleSlack && s.delta_phi <= kPi + kAngleSlack && s.valid[0] <= 1 && s.valid[1] <= 1 &&
-         s.valid[2] <= 1 && (s.valid[0] || s.valid[1] || s.valid[2]);
+         s.theta_i <= kPiFloat / 2 + kAngleSlack && s.theta_e >= -kAngleSlack &&
+         s.theta_e <= kPiFloat / 2 + kAngleSlack && s.delta_phi >= -kPiFloat - kAngleSlack &&
+         s.delta_phi <= kPiFloat + kAngleSlack && s.valid[0] <= 1 && s.valid[1] <= 1 && s.valid[2] <= 1 &&
+         (s.valid[0] || s.valid[1] || s.valid[2]);
 }
 
 }  // namespace
@@ -83,7 +84,6 @@ void WriteSamples(const std::string& path, const std::vector<BrdfSample>& sample
 }
 
 std::string InvalidSampleReason(const BrdfSample& s) {
-  constexpr float kPi = 3.14159265358979f;
   constexpr float kAngleSlack = 1e-4f;  // float32 rounding of angles at the ends of their range
   constexpr float kUnitSlack = 1e-3f;   // float32 rounding of unit vectors
   const auto finite3 = [](const float v[3]) {
@@ -95,13 +95,13 @@ std::string InvalidSampleReason(const BrdfSample& s) {
   if (!finite3(s.wi) || !finite3(s.wo)) return "wi or wo is not finite";
   if (std::abs(length(s.wi) - 1.0) > kUnitSlack) return "|wi| = " + std::to_string(length(s.wi)) + ", not 1";
   if (std::abs(length(s.wo) - 1.0) > kUnitSlack) return "|wo| = " + std::to_string(length(s.wo)) + ", not 1";
-  if (!(s.theta_i >= -kAngleSlack && s.theta_i <= kPi / 2 + kAngleSlack)) {
+  if (!(s.theta_i >= -kAngleSlack && s.theta_i <= kPiFloat / 2 + kAngleSlack)) {
     return "theta_i = " + std::to_string(s.theta_i) + " is outside [0, pi/2]";
   }
-  if (!(s.theta_e >= -kAngleSlack && s.theta_e <= kPi / 2 + kAngleSlack)) {
+  if (!(s.theta_e >= -kAngleSlack && s.theta_e <= kPiFloat / 2 + kAngleSlack)) {
     return "theta_e = " + std::to_string(s.theta_e) + " is outside [0, pi/2]";
   }
-  if (!(s.delta_phi >= -kPi - kAngleSlack && s.delta_phi <= kPi + kAngleSlack)) {
+  if (!(s.delta_phi >= -kPiFloat - kAngleSlack && s.delta_phi <= kPiFloat + kAngleSlack)) {
     return "delta_phi = " + std::to_string(s.delta_phi) + " is outside [-pi, pi]";
   }
   for (int c = 0; c < 3; ++c) {

@@ -557,6 +557,166 @@ nlohmann::json PoseToJson(const Rigid3d& pose) {
   return {{"rotation", {q.w(), q.x(), q.y(), q.z()}}, {"translation", ToJson(pose.translation)}};
 }
 
+// The writers of Session::ToJson, one per block of docs/session-format.md. `named_lights` is the
+// session's lights where photos and light markers name their light by id, nullptr where the session
+// has one unnamed light.
+
+nlohmann::json CornersToJson(const std::array<Eigen::Vector3d, 4>& corners) {
+  nlohmann::json json = nlohmann::json::array();
+  for (const Eigen::Vector3d& c : corners) json.push_back(ibrdf::ToJson(c));
+  return json;
+}
+
+nlohmann::json MarkersToJson(const std::vector<TargetSpec>& markers) {
+  nlohmann::json json = nlohmann::json::array();
+  for (const TargetSpec& target : markers) {
+    json.push_back({{"id", target.id}, {"corners", CornersToJson(target.corners)}});
+  }
+  return json;
+}
+
+// A mesh sample's fields: its file, pose, raw scans, scan markers and visibility.
+void WriteMeshSample(const SampleSpec& sample, nlohmann::json* s) {
+  (*s)["file"] = sample.mesh_file;
+  if (!sample.world_from_mesh.IsIdentity()) (*s)["world_from_mesh"] = Sim3dToJson(sample.world_from_mesh);
+  if (!sample.scan_inputs.empty()) {
+    nlohmann::json inputs = nlohmann::json::array();
+    for (const ScanInputSpec& input : sample.scan_inputs) {
+      if (input.world_from_scan) {
+        inputs.push_back({{"file", input.file}, {"world_from_scan", PoseToJson(*input.world_from_scan)}});
+      } else {
+        inputs.push_back(input.file);
+      }
+    }
+    (*s)["scan_inputs"] = inputs;
+  }
+  if (!sample.scan_targets.empty()) {
+    nlohmann::json targets_json = nlohmann::json::array();
+    for (const ScanTargetSpec& target : sample.scan_targets) {
+      targets_json.push_back({{"id", target.id}, {"corners", CornersToJson(target.corners)}});
+    }
+    (*s)["scan_targets"] = targets_json;
+  }
+  if (sample.visibility != Visibility::kAuto) (*s)["visibility"] = VisibilityName(sample.visibility);
+}
+
+// The fields a sphere and a cylinder share: centre and radius.
+void WriteRoundSample(const SampleSpec& sample, nlohmann::json* s) {
+  (*s)["center"] = ibrdf::ToJson(sample.center);
+  (*s)["radius"] = sample.radius;
+  if (sample.radius_known) (*s)["radius_known"] = true;
+}
+
+nlohmann::json SampleToJson(const SampleSpec& sample) {
+  nlohmann::json s;
+  s["kind"] = SampleKindName(sample.kind);
+  switch (sample.kind) {
+    case SampleSpec::Kind::kMesh:
+      WriteMeshSample(sample, &s);
+      break;
+    case SampleSpec::Kind::kSphere:
+      WriteRoundSample(sample, &s);
+      break;
+    case SampleSpec::Kind::kCylinder:
+      WriteRoundSample(sample, &s);
+      s["axis"] = ibrdf::ToJson(sample.axis);
+      s["length"] = sample.length;
+      break;
+  }
+  return s;
+}
+
+nlohmann::json RadiometryToJson(const RadiometrySpec& radiometry) {
+  nlohmann::json r;
+  switch (radiometry.response.kind) {
+    case Response::Kind::kLinear:
+      r["response"] = "linear";
+      break;
+    case Response::Kind::kSrgb:
+      r["response"] = "srgb";
+      break;
+    case Response::Kind::kGamma:
+      r["response"] = {{"gamma", radiometry.response.gamma}};
+      break;
+    case Response::Kind::kTable:
+      r["response"] = {{"table", radiometry.response.table}};
+      break;
+  }
+  r["black_level"] = radiometry.black_level;
+  if (radiometry.saturation_stated) r["saturation_level"] = radiometry.saturation_level;
+  if (radiometry.noise) {
+    r["noise"] = {{"full_well_e", radiometry.noise->full_well_e},
+                  {"read_noise_e", radiometry.noise->read_noise_e},
+                  {"bits", radiometry.noise->bits}};
+  }
+  if (!radiometry.flat_field.empty()) r["flat_field"] = radiometry.flat_field;
+  return r;
+}
+
+nlohmann::json TargetsToJson(const TargetsSpec& targets, const std::vector<Light>* named_lights) {
+  nlohmann::json t = {{"dictionary", targets.dictionary}, {"reference", MarkersToJson(targets.reference)}};
+  if (targets.unknown_layout) {
+    const UnknownLayoutSpec& layout = *targets.unknown_layout;
+    t["unknown_layout"] = {{"size", layout.size}, {"ids", layout.ids}};
+    if (layout.origin_id) t["unknown_layout"]["origin_id"] = *layout.origin_id;
+  }
+  if (targets.sample) t["sample"] = {{"markers", MarkersToJson(targets.sample->markers)}};
+  if (targets.white_reference) t["white_reference"] = {{"markers", MarkersToJson(targets.white_reference->markers)}};
+  if (targets.light) {
+    nlohmann::json markers = nlohmann::json::array();
+    for (const LightMarkerSpec& m : targets.light->markers) {
+      markers.push_back({{"id", m.id}, {"light_in_marker", ibrdf::ToJson(m.light_in_marker)}});
+    }
+    t["light"] = {{"size", targets.light->size}, {"markers", markers}};
+    if (named_lights) t["light"]["light"] = named_lights->at(targets.light->light).id;
+  }
+  return t;
+}
+
+nlohmann::json PhotoToJson(const PhotoSpec& photo, const std::vector<Light>* named_lights) {
+  nlohmann::json p = {{"file", photo.file}, {"exposure_s", photo.exposure_s}, {"gain", photo.gain}};
+  if (named_lights) p["light"] = named_lights->at(photo.light).id;
+  if (!photo.mask.empty()) p["mask"] = photo.mask;
+  if (photo.camera_from_world) p["camera_from_world"] = PoseToJson(*photo.camera_from_world);
+  if (photo.role == PhotoRole::kTargets) p["role"] = "targets";
+  if (photo.bracket) p["bracket"] = *photo.bracket;
+  return p;
+}
+
+nlohmann::json CalibrationToJson(const CalibrationSpec& calibration, const std::vector<Light>* named_lights) {
+  nlohmann::json json = nlohmann::json::object();
+  if (calibration.white_reference) {
+    const WhiteReferenceSpec& white = *calibration.white_reference;
+    nlohmann::json white_photos = nlohmann::json::array();
+    for (const PhotoSpec& photo : white.photos) white_photos.push_back(PhotoToJson(photo, named_lights));
+    json["white_reference"] = {
+        {"reflectance", ibrdf::ToJson(white.reflectance)}, {"size", white.size}, {"photos", white_photos}};
+    if (white.posed) {
+      json["white_reference"]["center"] = ibrdf::ToJson(white.center);
+      json["white_reference"]["normal"] = ibrdf::ToJson(white.normal);
+    }
+  }
+  return json;
+}
+
+nlohmann::json ColourChartToJson(const ColourChartSpec& chart, const std::vector<Light>* named_lights) {
+  nlohmann::json c = {
+      {"chart", chart.chart}, {"space", ColourSpaceName(chart.space)}, {"photos", nlohmann::json::array()}};
+  for (const PhotoSpec& photo : chart.photos) c["photos"].push_back(PhotoToJson(photo, named_lights));
+  if (chart.corners) {
+    for (const Eigen::Vector2d& p : *chart.corners) c["corners"].push_back({p.x(), p.y()});
+  }
+  if (chart.matrix) {
+    for (int row = 0; row < 3; ++row)
+      c["matrix"].push_back({(*chart.matrix)(row, 0), (*chart.matrix)(row, 1), (*chart.matrix)(row, 2)});
+  }
+  for (const ColourPatchFit& fit : chart.patches) {
+    c["patches"].push_back(fit.excluded.empty() ? nlohmann::json{{"name", fit.name}, {"residual", fit.residual}}
+                                                : nlohmann::json{{"name", fit.name}, {"excluded", fit.excluded}});
+  }
+  return c;
+}
+
 }  // namespace
 
 const char* SampleKindName(SampleSpec::Kind kind) {
@@ -568,7 +728,18 @@ const char* SampleKindName(SampleSpec::Kind kind) {
     case SampleSpec::Kind::kMesh:
       return "mesh";
   }
-  return "unknown";
+  UnhandledKind("SampleSpec::Kind", static_cast<int>(kind));
+}
+
+bool IsMeshSample(SampleSpec::Kind kind) {
+  switch (kind) {
+    case SampleSpec::Kind::kSphere:
+    case SampleSpec::Kind::kCylinder:
+      return false;
+    case SampleSpec::Kind::kMesh:
+      return true;
+  }
+  UnhandledKind("SampleSpec::Kind", static_cast<int>(kind));
 }
 
 const char* VisibilityName(Visibility visibility) {
@@ -580,7 +751,7 @@ const char* VisibilityName(Visibility visibility) {
     case Visibility::kOff:
       return "off";
   }
-  return "unknown";
+  UnhandledKind("Visibility", static_cast<int>(visibility));
 }
 
 bool VisibilityFromName(const std::string& name, Visibility* visibility) {
@@ -692,146 +863,14 @@ nlohmann::json Session::ToJson() const {
     for (const Light& light : lights) json["lights"].push_back(LightJson(light));
   }
   if (!mask.empty()) json["mask"] = mask;
-  nlohmann::json& s = json["sample"];
-  s["kind"] = SampleKindName(sample.kind);
-  if (sample.kind == SampleSpec::Kind::kMesh) {
-    s["file"] = sample.mesh_file;
-    if (!sample.world_from_mesh.IsIdentity()) s["world_from_mesh"] = Sim3dToJson(sample.world_from_mesh);
-    if (!sample.scan_inputs.empty()) {
-      nlohmann::json inputs = nlohmann::json::array();
-      for (const ScanInputSpec& input : sample.scan_inputs) {
-        if (input.world_from_scan) {
-          inputs.push_back({{"file", input.file}, {"world_from_scan", PoseToJson(*input.world_from_scan)}});
-        } else {
-          inputs.push_back(input.file);
-        }
-      }
-      s["scan_inputs"] = inputs;
-    }
-    if (!sample.scan_targets.empty()) {
-      nlohmann::json targets_json = nlohmann::json::array();
-      for (const ScanTargetSpec& target : sample.scan_targets) {
-        nlohmann::json corners = nlohmann::json::array();
-        for (const Eigen::Vector3d& c : target.corners) corners.push_back(ibrdf::ToJson(c));
-        targets_json.push_back({{"id", target.id}, {"corners", corners}});
-      }
-      s["scan_targets"] = targets_json;
-    }
-    if (sample.visibility != Visibility::kAuto) s["visibility"] = VisibilityName(sample.visibility);
-  } else {
-    s["center"] = ibrdf::ToJson(sample.center);
-    s["radius"] = sample.radius;
-    if (sample.radius_known) s["radius_known"] = true;
-    if (sample.kind == SampleSpec::Kind::kCylinder) {
-      s["axis"] = ibrdf::ToJson(sample.axis);
-      s["length"] = sample.length;
-    }
-  }
-  nlohmann::json& r = json["radiometry"];
-  switch (radiometry.response.kind) {
-    case Response::Kind::kLinear:
-      r["response"] = "linear";
-      break;
-    case Response::Kind::kSrgb:
-      r["response"] = "srgb";
-      break;
-    case Response::Kind::kGamma:
-      r["response"] = {{"gamma", radiometry.response.gamma}};
-      break;
-    case Response::Kind::kTable:
-      r["response"] = {{"table", radiometry.response.table}};
-      break;
-  }
-  r["black_level"] = radiometry.black_level;
-  if (radiometry.saturation_stated) r["saturation_level"] = radiometry.saturation_level;
-  if (radiometry.noise) {
-    r["noise"] = {{"full_well_e", radiometry.noise->full_well_e},
-                  {"read_noise_e", radiometry.noise->read_noise_e},
-                  {"bits", radiometry.noise->bits}};
-  }
-  if (!radiometry.flat_field.empty()) r["flat_field"] = radiometry.flat_field;
-  if (targets) {
-    nlohmann::json reference = nlohmann::json::array();
-    for (const TargetSpec& target : targets->reference) {
-      nlohmann::json corners = nlohmann::json::array();
-      for (const Eigen::Vector3d& c : target.corners) corners.push_back(ibrdf::ToJson(c));
-      reference.push_back({{"id", target.id}, {"corners", corners}});
-    }
-    json["targets"] = {{"dictionary", targets->dictionary}, {"reference", reference}};
-    if (targets->unknown_layout) {
-      const UnknownLayoutSpec& layout = *targets->unknown_layout;
-      json["targets"]["unknown_layout"] = {{"size", layout.size}, {"ids", layout.ids}};
-      if (layout.origin_id) json["targets"]["unknown_layout"]["origin_id"] = *layout.origin_id;
-    }
-    if (targets->sample) {
-      nlohmann::json markers = nlohmann::json::array();
-      for (const TargetSpec& target : targets->sample->markers) {
-        nlohmann::json corners = nlohmann::json::array();
-        for (const Eigen::Vector3d& c : target.corners) corners.push_back(ibrdf::ToJson(c));
-        markers.push_back({{"id", target.id}, {"corners", corners}});
-      }
-      json["targets"]["sample"] = {{"markers", markers}};
-    }
-    if (targets->white_reference) {
-      nlohmann::json markers = nlohmann::json::array();
-      for (const TargetSpec& target : targets->white_reference->markers) {
-        nlohmann::json corners = nlohmann::json::array();
-        for (const Eigen::Vector3d& c : target.corners) corners.push_back(ibrdf::ToJson(c));
-        markers.push_back({{"id", target.id}, {"corners", corners}});
-      }
-      json["targets"]["white_reference"] = {{"markers", markers}};
-    }
-    if (targets->light) {
-      nlohmann::json markers = nlohmann::json::array();
-      for (const LightMarkerSpec& m : targets->light->markers) {
-        markers.push_back({{"id", m.id}, {"light_in_marker", ibrdf::ToJson(m.light_in_marker)}});
-      }
-      json["targets"]["light"] = {{"size", targets->light->size}, {"markers", markers}};
-      if (named_lights) json["targets"]["light"]["light"] = lights.at(targets->light->light).id;
-    }
-  }
-  auto photo_json = [&](const PhotoSpec& photo) {
-    nlohmann::json p = {{"file", photo.file}, {"exposure_s", photo.exposure_s}, {"gain", photo.gain}};
-    if (named_lights) p["light"] = lights.at(photo.light).id;
-    if (!photo.mask.empty()) p["mask"] = photo.mask;
-    if (photo.camera_from_world) p["camera_from_world"] = PoseToJson(*photo.camera_from_world);
-    if (photo.role == PhotoRole::kTargets) p["role"] = "targets";
-    if (photo.bracket) p["bracket"] = *photo.bracket;
-    return p;
-  };
-  if (calibration) {
-    json["calibration"] = nlohmann::json::object();
-    if (calibration->white_reference) {
-      const WhiteReferenceSpec& white = *calibration->white_reference;
-      nlohmann::json white_photos = nlohmann::json::array();
-      for (const PhotoSpec& photo : white.photos) white_photos.push_back(photo_json(photo));
-      json["calibration"]["white_reference"] = {
-          {"reflectance", ibrdf::ToJson(white.reflectance)}, {"size", white.size}, {"photos", white_photos}};
-      if (white.posed) {
-        json["calibration"]["white_reference"]["center"] = ibrdf::ToJson(white.center);
-        json["calibration"]["white_reference"]["normal"] = ibrdf::ToJson(white.normal);
-      }
-    }
-  }
-  if (colour_chart) {
-    const ColourChartSpec& chart = *colour_chart;
-    nlohmann::json& c = json["colour_chart"];
-    c = {{"chart", chart.chart}, {"space", ColourSpaceName(chart.space)}, {"photos", nlohmann::json::array()}};
-    for (const PhotoSpec& photo : chart.photos) c["photos"].push_back(photo_json(photo));
-    if (chart.corners) {
-      for (const Eigen::Vector2d& p : *chart.corners) c["corners"].push_back({p.x(), p.y()});
-    }
-    if (chart.matrix) {
-      for (int row = 0; row < 3; ++row)
-        c["matrix"].push_back({(*chart.matrix)(row, 0), (*chart.matrix)(row, 1), (*chart.matrix)(row, 2)});
-    }
-    for (const ColourPatchFit& fit : chart.patches) {
-      c["patches"].push_back(fit.excluded.empty() ? nlohmann::json{{"name", fit.name}, {"residual", fit.residual}}
-                                                  : nlohmann::json{{"name", fit.name}, {"excluded", fit.excluded}});
-    }
-  }
+  json["sample"] = SampleToJson(sample);
+  json["radiometry"] = RadiometryToJson(radiometry);
+  const std::vector<Light>* named = named_lights ? &lights : nullptr;
+  if (targets) json["targets"] = TargetsToJson(*targets, named);
+  if (calibration) json["calibration"] = CalibrationToJson(*calibration, named);
+  if (colour_chart) json["colour_chart"] = ColourChartToJson(*colour_chart, named);
   json["photos"] = nlohmann::json::array();
-  for (const PhotoSpec& photo : photos) json["photos"].push_back(photo_json(photo));
+  for (const PhotoSpec& photo : photos) json["photos"].push_back(PhotoToJson(photo, named));
   return json;
 }
 
@@ -862,7 +901,7 @@ Session Session::Rebased(const std::string& dir, PathStyle style) const {
   if (rebased.colour_chart) {
     for (PhotoSpec& photo : rebased.colour_chart->photos) rebase(&photo.file);
   }
-  if (rebased.sample.kind == SampleSpec::Kind::kMesh) {
+  if (IsMeshSample(rebased.sample.kind)) {
     rebase(&rebased.sample.mesh_file);
     for (ScanInputSpec& input : rebased.sample.scan_inputs) rebase(&input.file);
   }
@@ -891,7 +930,7 @@ std::vector<std::string> Session::InputFiles() const {
   if (colour_chart) {
     for (const PhotoSpec& photo : colour_chart->photos) files.push_back(AbsolutePath(photo.file));
   }
-  if (sample.kind == SampleSpec::Kind::kMesh) {
+  if (IsMeshSample(sample.kind)) {
     files.push_back(AbsolutePath(sample.mesh_file));
     for (const ScanInputSpec& input : sample.scan_inputs) files.push_back(AbsolutePath(input.file));
   }

@@ -13,6 +13,7 @@
 
 #include "core/camera.h"
 #include "core/colour.h"
+#include "core/kind.h"
 #include "core/light.h"
 #include "core/radiometry.h"
 #include "core/rigid3.h"
@@ -60,10 +61,11 @@ enum class Visibility {
   kAuto,  // only where the mesh's convexity report (scan/convexity.h) says needs_shadow_rays
   kOn,    // always
   kOff,   // never
+  IBRDF_DUMMY_KIND
 };
 
 struct SampleSpec {
-  enum class Kind { kSphere, kCylinder, kMesh };
+  enum class Kind { kSphere, kCylinder, kMesh, IBRDF_DUMMY_KIND };
   Kind kind = Kind::kSphere;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // sphere centre; cylinder axis midpoint
   double radius = 0.0;                               // sphere and cylinder, metres
@@ -275,6 +277,9 @@ struct Session {
 
 // "sphere", "cylinder", "mesh".
 const char* SampleKindName(SampleSpec::Kind kind);
+// Whether a sample of this kind is a scanned mesh (SampleSpec::mesh_file) rather than an analytic
+// shape (centre, radius, ...).
+bool IsMeshSample(SampleSpec::Kind kind);
 // "auto", "on", "off"; and back (false for any other name).
 const char* VisibilityName(Visibility visibility);
 bool VisibilityFromName(const std::string& name, Visibility* visibility);

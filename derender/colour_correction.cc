@@ -28,12 +28,11 @@ std::string Percent(double value) {
 
 Eigen::Matrix3d SampleColourMatrix(const ColourChartSpec& chart, const Eigen::Vector3d& light_intensity) {
   IBRDF_CHECK(chart.matrix.has_value());
-  const Eigen::Matrix3d srgb_from_camera =
-      chart.space == ColourSpace::kXyz ? Eigen::Matrix3d(LinearSrgbFromXyz() * *chart.matrix) : *chart.matrix;
+  const Eigen::Matrix3d srgb_from_camera = LinearSrgbFromSpace(chart.space, *chart.matrix);
   const Eigen::Vector3d light_srgb = srgb_from_camera * light_intensity;
   const Eigen::Matrix3d corrected =
       light_srgb.cwiseInverse().asDiagonal() * srgb_from_camera * light_intensity.asDiagonal();
-  return chart.space == ColourSpace::kXyz ? Eigen::Matrix3d(XyzFromLinearSrgb() * corrected) : corrected;
+  return SpaceFromLinearSrgb(chart.space, corrected);
 }
 
 std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples,
@@ -48,9 +47,7 @@ std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::
   std::vector<Eigen::Matrix3d> matrices;
   for (size_t k = 0; k < session.lights.size(); ++k) {
     const Eigen::Vector3d& intensity = session.lights[k].intensity;
-    const Eigen::Vector3d light_srgb =
-        (chart.space == ColourSpace::kXyz ? Eigen::Matrix3d(LinearSrgbFromXyz() * *chart.matrix) : *chart.matrix) *
-        intensity;
+    const Eigen::Vector3d light_srgb = LinearSrgbFromSpace(chart.space, *chart.matrix) * intensity;
     if (!(light_srgb.minCoeff() > 0.0)) {
       ThrowError(session.manifest_path + ": /colour_chart/matrix",
                  "maps the light's intensity to a colour with a channel <= 0; the chart's matrix does not fit "
@@ -152,7 +149,7 @@ std::string ColourCorrectionReport(const Session& session, const std::vector<Eig
 
 std::string ColourSpaceDescription(const Session& session) {
   if (session.colour_chart && session.colour_chart->matrix) {
-    return std::string(session.colour_chart->space == ColourSpace::kXyz ? "CIE XYZ (D65)" : "linear sRGB (D65)") +
+    return std::string(ColourSpaceLabel(session.colour_chart->space)) +
            ": camera RGB through the colour chart's matrix (see \"colour\")";
   }
   return "camera RGB, linear (the session's response inverted, black level subtracted)";

@@ -28,6 +28,7 @@
 #include "core/json_reader.h"
 #include "core/light.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "core/sample_file.h"
 #include "derender/analytic_sample.h"
 #include "derender/colour_correction.h"
@@ -41,8 +42,6 @@ namespace ibrdf {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr double kDegree = M_PI / 180.0;
 
 // Rejection reasons in RejectionReasons() order; each pixel counts once, under the first that applies.
 enum Reason {
@@ -255,10 +254,18 @@ Reason ShadowTest(const MeshSample& mesh, const Light& light, const Incidence& i
                   const Eigen::Vector3d& normal, float fit_rms_m, const DerenderOptions& options, uint64_t* rays) {
   const double offset = 4.0 * mesh.Epsilon() + options.shadow_ray_offset_fit_rms * std::max(0.0f, fit_rms_m);
   const Eigen::Vector3d from = point + offset * normal;
-  const double distance =
-      light.kind == Light::Kind::kPoint ? (light.position - from).norm() : 4.0 * mesh.BoundingRadius();
-  const Eigen::Vector3d to =
-      light.kind == Light::Kind::kPoint ? light.position : Eigen::Vector3d(from + distance * incidence.wi);
+  double distance = 0.0;
+  Eigen::Vector3d to = Eigen::Vector3d::Zero();
+  switch (light.kind) {
+    case Light::Kind::kPoint:
+      distance = (light.position - from).norm();
+      to = light.position;
+      break;
+    case Light::Kind::kDirectional:
+      distance = 4.0 * mesh.BoundingRadius();
+      to = from + distance * incidence.wi;
+      break;
+  }
   ++*rays;
   if (mesh.Occluded(from, to)) return kShadowed;
   if (options.shadow_edge_rays > 0 && options.shadow_edge_deg > 0.0) {
@@ -987,7 +994,7 @@ std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera) {
 }
 
 DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& options) {
-  if (session.sample.kind == SampleSpec::Kind::kMesh) {
+  if (IsMeshSample(session.sample.kind)) {
     ThrowError("sample", "a mesh sample needs the mesh derenderer (Derender); DerenderAnalytic takes a sphere or a "
                          "cylinder");
   }
@@ -1057,7 +1064,7 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
       {"timings_s", {{"total", summary.total_s}, {"decode_cpu", summary.decode_s}}},
   };
   if (session.colour_chart) sidecar["colour"] = ColourSidecar(session, summary.colour_matrices);
-  if (session.sample.kind == SampleSpec::Kind::kMesh) {
+  if (IsMeshSample(session.sample.kind)) {
     sidecar["timings_s"]["mesh_setup"] = summary.mesh_setup_s;
     sidecar["mesh"] = {
         {"file", session.sample.mesh_file},          {"faces", summary.mesh_faces},

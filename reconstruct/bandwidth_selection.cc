@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/kind.h"
 #include "core/logging.h"
 
 namespace ibrdf {
@@ -24,7 +25,13 @@ bool ParseBandwidthCriterion(const std::string& name, BandwidthCriterion* criter
 }
 
 const char* BandwidthCriterionName(BandwidthCriterion criterion) {
-  return criterion == BandwidthCriterion::kLeaveOneOut ? "loo" : "gcv";
+  switch (criterion) {
+    case BandwidthCriterion::kLeaveOneOut:
+      return "loo";
+    case BandwidthCriterion::kGeneralizedCrossValidation:
+      return "gcv";
+  }
+  UnhandledKind("BandwidthCriterion", static_cast<int>(criterion));
 }
 
 bool BandwidthSelectionOptions::Check(std::string* why) const {

@@ -14,13 +14,12 @@
 
 #include "core/error.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "core/statistics.h"
 #include "reconstruct/prediction_check.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 // A point of the isotropic domain embedded so that distances are angles: (theta_i, theta_e cos dphi,
 // theta_e sin dphi), radians (the exitant direction's azimuthal-equidistant projection in the frame where

@@ -16,12 +16,12 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/math.h"
 #include "reconstruct/normal_accumulation.h"
 
 namespace ibrdf {
 namespace {
 
-constexpr double kDegree = M_PI / 180.0;
 constexpr int kMaxCoefficients = 10;
 constexpr int kCoefficients[3] = {1, 4, 10};
 
@@ -414,6 +414,7 @@ LocalRegression::LocalRegression(const std::vector<BrdfSample>& samples, const s
   Build(samples, &leave_out);
 }
 
+// Long on purpose: the per-sample loops share locals and run hot, and pieces would cost calls and copies.
 void LocalRegression::Build(const std::vector<BrdfSample>& all_samples, const std::vector<uint8_t>* leave_out) {
   const LocalRegressionOptions& options = options_;
   std::string why;

@@ -11,12 +11,11 @@
 #include "core/brdf_coords.h"
 #include "core/error.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "core/statistics.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 Eigen::Vector3d Coordinates(double theta_i, double theta_e, double delta_phi) {
   Eigen::Vector3d wi, wo;

@@ -305,6 +305,81 @@ std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, con
   return std::move(lafortune_chosen ? lafortune.brdf : ggx.brdf);
 }
 
+// The .bsdf file's description: what it was made from, and how many nodes were measured,
+// interpolated, or unmeasured and filled how.
+std::string BsdfDescription(const std::string& name, const std::string& samples_file, const DomainCounts& classes,
+                            const BrdfModel* chosen, uint64_t filled_extrapolated, uint64_t zero) {
+  const uint64_t nodes = classes.measured + classes.interpolated + classes.unmeasured;
+  auto percent = [nodes](uint64_t n) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof(buffer), "%.1f", nodes ? 100.0 * double(n) / double(nodes) : 0.0);
+    return std::string(buffer);
+  };
+  std::ostringstream text;
+  text << "ibrdf reconstruct: the isotropic RGB BRDF of " << name << " from "
+       << (samples_file.empty() ? std::string("samples") : samples_file)
+       << " by local polynomial regression (Marschner et al. 1999); tables after Dupuy and Jakob 2018 (NDF from"
+          " retro-reflection). Of the "
+       << nodes << " BRDF nodes, " << classes.measured << " measured, " << classes.interpolated << " interpolated, "
+       << classes.unmeasured << " (" << percent(classes.unmeasured) << " %) unmeasured: ";
+  if (!classes.unmeasured) {
+    text << "none";
+  } else if (chosen) {
+    text << "filled with the " << chosen->ModelName() << " fit (invented values)";
+  } else {
+    text << filled_extrapolated << " filled with the regression's extrapolation (invented values), " << zero
+         << " set to 0 (no estimate, no fit)";
+  }
+  text << ". Spectra: a box-like upsampling of the RGB (not colour-exact); the rgb field is exact.";
+  return text.str();
+}
+
+// Relative errors of the written file, read back as a reader does, against the table over its
+// measured cells (theta <= 80 degrees, a sample of at most ~200 000 cells), each channel: all of them
+// and by theta_max band (0-25, 25-50, 50-80 degrees), each list sorted.
+void CompareWithTable(const RglBsdf& written, const MerlTable& table, const std::vector<uint8_t>& domain,
+                      std::vector<double>* errors, std::vector<std::vector<double>>* band_errors) {
+  std::vector<size_t> cells;
+  for (size_t flat = 0; flat < domain.size(); ++flat) {
+    if (domain[flat] == uint8_t(DomainClass::kMeasured)) cells.push_back(flat);
+  }
+  const size_t stride = std::max<size_t>(1, cells.size() / 200000);
+  // Each checked cell's band (-1: beyond 80 degrees) and relative errors (-1: no positive table value),
+  // TBB-parallel; gathered in cell order after.
+  const size_t checked = (cells.size() + stride - 1) / stride;
+  std::vector<int8_t> cell_band(checked, -1);
+  std::vector<Eigen::Vector3d> cell_errors(checked);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, checked, 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t m = range.begin(); m != range.end(); ++m) {
+      const size_t flat = cells[m * stride];
+      const int i_h = int(flat / (size_t(kMerlThetaD) * kMerlPhiD)), i_d = int(flat / kMerlPhiD % kMerlThetaD),
+                i_p = int(flat % kMerlPhiD);
+      Eigen::Vector3d wi, wo;
+      FromHalfDiff(MerlCellCentre(i_h, i_d, i_p), &wi, &wo);
+      const double theta_max = std::acos(std::min(wi.z(), wo.z())) * 180 / M_PI;
+      if (theta_max > 80.0) continue;
+      const Eigen::Vector3d t = table.Cell(flat), g = written.Eval(wi, wo);
+      cell_band[m] = static_cast<int8_t>(theta_max < 25.0 ? 0 : theta_max < 50.0 ? 1 : 2);
+      for (int c = 0; c < 3; ++c) cell_errors[m][c] = t[c] > 0.0 ? std::abs(g[c] - t[c]) / t[c] : -1.0;
+    }
+  });
+  errors->clear();
+  band_errors->assign(3, {});
+  for (size_t m = 0; m < checked; ++m) {
+    if (cell_band[m] < 0) continue;
+    for (int c = 0; c < 3; ++c) {
+      if (cell_errors[m][c] < 0.0) continue;
+      errors->push_back(cell_errors[m][c]);
+      (*band_errors)[cell_band[m]].push_back(errors->back());
+    }
+  }
+  // Each list sorted once (the bands beside the whole), then read at its quantiles.
+  tbb::parallel_for(0, 4, [&](int list) {
+    std::vector<double>& sorted = list < 3 ? (*band_errors)[list] : *errors;
+    std::sort(sorted.begin(), sorted.end());
+  });
+}
+
 // NAME.bsdf from the regression (measured and interpolated nodes) and, where it has no data, the chosen
 // fit (else the regression's extrapolation, else 0), said in the file's description and the summary;
 // then read back as the readers do and compared with the table over its measured cells.
@@ -365,72 +440,16 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
   // are built first with a placeholder and the text replaced.
   TensorFile file = BuildRglBsdf(source, "", options.bsdf_export);
   const uint64_t nodes = classes.measured + classes.interpolated + classes.unmeasured;
-  auto percent = [nodes](uint64_t n) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof(buffer), "%.1f", nodes ? 100.0 * double(n) / double(nodes) : 0.0);
-    return std::string(buffer);
-  };
-  std::ostringstream text;
-  text << "ibrdf reconstruct: the isotropic RGB BRDF of " << name << " from "
-       << (samples_file.empty() ? std::string("samples") : samples_file)
-       << " by local polynomial regression (Marschner et al. 1999); tables after Dupuy and Jakob 2018 (NDF from"
-          " retro-reflection). Of the "
-       << nodes << " BRDF nodes, " << classes.measured << " measured, " << classes.interpolated << " interpolated, "
-       << classes.unmeasured << " (" << percent(classes.unmeasured) << " %) unmeasured: ";
-  if (!classes.unmeasured) {
-    text << "none";
-  } else if (chosen) {
-    text << "filled with the " << chosen->ModelName() << " fit (invented values)";
-  } else {
-    text << filled_extrapolated << " filled with the regression's extrapolation (invented values), " << zero
-         << " set to 0 (no estimate, no fit)";
-  }
-  text << ". Spectra: a box-like upsampling of the RGB (not colour-exact); the rgb field is exact.";
-  file["description"] = TextField(text.str());
+  file["description"] = TextField(BsdfDescription(name, samples_file, classes, chosen, filled_extrapolated, zero));
   const std::string file_name = name + ".bsdf";
   WriteTensorFile(tmp + "/" + file_name, file);
   const double build_s = timer.ElapsedSeconds();
 
   // Read back as a reader does and compare with the table over its measured cells (theta <= 80).
   const RglBsdf written(tmp + "/" + file_name);
-  std::vector<size_t> cells;
-  for (size_t flat = 0; flat < domain.size(); ++flat) {
-    if (domain[flat] == uint8_t(DomainClass::kMeasured)) cells.push_back(flat);
-  }
-  const size_t stride = std::max<size_t>(1, cells.size() / 200000);
-  // Each checked cell's band (-1: beyond 80 degrees) and relative errors (-1: no positive table value),
-  // TBB-parallel; gathered in cell order after.
-  const size_t checked = (cells.size() + stride - 1) / stride;
-  std::vector<int8_t> cell_band(checked, -1);
-  std::vector<Eigen::Vector3d> cell_errors(checked);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, checked, 1024), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t m = range.begin(); m != range.end(); ++m) {
-      const size_t flat = cells[m * stride];
-      const int i_h = int(flat / (size_t(kMerlThetaD) * kMerlPhiD)), i_d = int(flat / kMerlPhiD % kMerlThetaD),
-                i_p = int(flat % kMerlPhiD);
-      Eigen::Vector3d wi, wo;
-      FromHalfDiff(MerlCellCentre(i_h, i_d, i_p), &wi, &wo);
-      const double theta_max = std::acos(std::min(wi.z(), wo.z())) * 180 / M_PI;
-      if (theta_max > 80.0) continue;
-      const Eigen::Vector3d t = table.Cell(flat), g = written.Eval(wi, wo);
-      cell_band[m] = static_cast<int8_t>(theta_max < 25.0 ? 0 : theta_max < 50.0 ? 1 : 2);
-      for (int c = 0; c < 3; ++c) cell_errors[m][c] = t[c] > 0.0 ? std::abs(g[c] - t[c]) / t[c] : -1.0;
-    }
-  });
   std::vector<double> errors;
-  std::vector<std::vector<double>> band_errors(3);  // theta_max 0-25, 25-50, 50-80 degrees
-  for (size_t m = 0; m < checked; ++m) {
-    if (cell_band[m] < 0) continue;
-    for (int c = 0; c < 3; ++c) {
-      if (cell_errors[m][c] < 0.0) continue;
-      errors.push_back(cell_errors[m][c]);
-      band_errors[cell_band[m]].push_back(errors.back());
-    }
-  }
-  // Each list sorted once (the bands beside the whole), then read at its quantiles.
-  tbb::parallel_for(0, 4, [&](int list) {
-    std::sort(list < 3 ? band_errors[list].begin() : errors.begin(), list < 3 ? band_errors[list].end() : errors.end());
-  });
+  std::vector<std::vector<double>> band_errors;
+  CompareWithTable(written, table, domain, &errors, &band_errors);
   auto quantile = [](const std::vector<double>& sorted, double q) {
     if (sorted.empty()) return 0.0;
     return sorted[std::min(sorted.size() - 1, size_t(q * double(sorted.size())))];

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/kind.h"
 
 namespace ibrdf {
 
@@ -16,9 +17,9 @@ const char* DomainClassName(DomainClass c) {
     case DomainClass::kInterpolated:
       return "interpolated";
     case DomainClass::kUnmeasured:
-      break;
+      return "unmeasured";
   }
-  return "unmeasured";
+  UnhandledKind("DomainClass", static_cast<int>(c));
 }
 
 bool DomainRules::Check(std::string* why) const {
@@ -47,9 +48,9 @@ const char* FillModeName(FillMode mode) {
     case FillMode::kExtrapolate:
       return "extrapolate";
     case FillMode::kNone:
-      break;
+      return "none";
   }
-  return "none";
+  UnhandledKind("FillMode", static_cast<int>(mode));
 }
 
 bool ParseFillMode(const std::string& text, FillMode* mode) {

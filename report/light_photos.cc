@@ -13,6 +13,7 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "core/light_json.h"
+#include "core/math.h"
 #include "core/sample_file.h"
 #include "core/session.h"
 #include "core/statistics.h"
@@ -24,8 +25,6 @@ namespace fs = std::filesystem;
 
 namespace ibrdf {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // The photo's samples' box (with a margin), linearized and shrunk by an integer box filter to at most
 // `size` pixels on a side, tone-mapped.
@@ -89,7 +88,7 @@ nlohmann::json WriteLightPhotos(const std::string& samples_path, const std::map<
     }
     entry["photos"] = photo_count;
     entry["samples"] = samples;
-    entry["phase_deg"] = phases.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(phases) / kDeg);
+    entry["phase_deg"] = phases.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(phases) / kDegree);
     entry["photo"] = best;
     entry["file"] = "";
     if (best >= 0) {

@@ -14,6 +14,7 @@
 #include "core/file_util.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "core/radiometry.h"
 #include "core/subprocess.h"
 #include "reconstruct/merl_table.h"
@@ -25,9 +26,6 @@ namespace fs = std::filesystem;
 
 namespace ibrdf {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
 
 std::string Absolute(const std::string& path) { return fs::absolute(path).lexically_normal().string(); }
 
@@ -143,7 +141,7 @@ nlohmann::json Overall(const nlohmann::json& value) {
 // The lit sphere of a MERL table, at one exposure for every material (LibraryOptions).
 void WriteSphere(const MerlTable& table, const LibraryOptions& options, const std::string& path) {
   const Image linear =
-      RenderSphere(options.sphere_size, options.sphere_phase_deg * kDeg,
+      RenderSphere(options.sphere_size, options.sphere_phase_deg * kDegree,
                    [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) { return table.Lookup(wi, wo); });
   const double scale = options.sphere_white_level * kPi;
   Image image(linear.width, linear.height, 3);
@@ -163,9 +161,9 @@ void WriteSphere(const MerlTable& table, const LibraryOptions& options, const st
 // light's side), RGB, null where the table has no value.
 nlohmann::json IncidencePlane(const MerlTable& table, double theta_i_deg) {
   nlohmann::json angles = nlohmann::json::array(), rgb = nlohmann::json::array();
-  const Eigen::Vector3d wi(std::sin(theta_i_deg * kDeg), 0.0, std::cos(theta_i_deg * kDeg));
+  const Eigen::Vector3d wi(std::sin(theta_i_deg * kDegree), 0.0, std::cos(theta_i_deg * kDegree));
   for (int t = -88; t <= 88; ++t) {
-    const Eigen::Vector3d wo(std::sin(t * kDeg), 0.0, std::cos(t * kDeg));
+    const Eigen::Vector3d wo(std::sin(t * kDegree), 0.0, std::cos(t * kDegree));
     const Eigen::Vector3d f = table.Lookup(wi, wo);
     angles.push_back(t);
     if (f.minCoeff() < 0.0) {

@@ -20,6 +20,7 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "core/npy.h"
 #include "core/output_guard.h"
 #include "core/sample_file.h"
@@ -44,8 +45,6 @@ namespace fs = std::filesystem;
 namespace ibrdf {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
 constexpr double kBandThetaDeg = 2.5;  // |theta - theta_0| for "fixed" incidence or exitance
 constexpr double kBandPhiDeg = 5.0;    // |delta_phi| or |180 - |delta_phi|| for "in the incidence plane"
 constexpr size_t kBandSamples = 3000;  // per band and kind, an even subset beyond that
@@ -243,7 +242,7 @@ void WritePhoto(const std::optional<Session>& session, const std::vector<BrdfSam
       for (const NamedModel& model : models.named) photo_models.push_back({model.name, model.eval, {}});
       nlohmann::json photo =
           RenderPhoto(*session, chosen.photo, p, PhotoSamples(samples, chosen.photo), photo_models, "photo", tmp);
-      photo["phase_deg"] = chosen.phase / kDeg;
+      photo["phase_deg"] = chosen.phase / kDegree;
       (*data)["photo"] = photo;
       result->photo_shown = true;
     } catch (const Error& e) {
@@ -323,7 +322,7 @@ void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector
       nlohmann::json photo =
           RenderPhoto(*session, image, photos[image], own, photo_models, "held-out-" + std::to_string(image), tmp);
       const std::vector<float>& phase = photos[image].phase;
-      photo["phase_deg"] = phase.empty() ? 0.0 : Percentile(phase, 0.5) / kDeg;
+      photo["phase_deg"] = phase.empty() ? 0.0 : Percentile(phase, 0.5) / kDegree;
       photo["fit_samples"] = fit_samples;
       photo["unsupported"] = unsupported;
       photo["seconds"] = timer.ElapsedSeconds();
@@ -348,7 +347,7 @@ void WriteSpheres(const RunModels& models, int size, double phase, const fs::pat
   for (const NamedModel& model : models.named) {
     const std::string file = "sphere-" + model.name + ".png";
     WriteReportPng((tmp / file).string(), ToneMap(RenderSphere(size, phase, model.eval), nullptr));
-    spheres.push_back({{"model", model.name}, {"file", file}, {"phase_deg", phase / kDeg}});
+    spheres.push_back({{"model", model.name}, {"file", file}, {"phase_deg", phase / kDegree}});
   }
   (*data)["spheres"] = spheres;
   if (models.truth) (*data)["truth"] = models.truth_path;
@@ -371,7 +370,7 @@ nlohmann::json IncidencePlanes(const std::vector<BrdfSample>& samples, const Run
     const double t0 = angles[k];
     std::vector<const BrdfSample*> band[2];
     for (const BrdfSample& s : samples) {
-      const double ti = s.theta_i / kDeg, te = s.theta_e / kDeg, dp = std::abs(s.delta_phi / kDeg);
+      const double ti = s.theta_i / kDegree, te = s.theta_e / kDegree, dp = std::abs(s.delta_phi / kDegree);
       if (!(dp <= kBandPhiDeg || dp >= 180.0 - kBandPhiDeg)) continue;
       if (std::abs(ti - t0) <= kBandThetaDeg) band[0].push_back(&s);
       if (std::abs(te - t0) <= kBandThetaDeg) band[1].push_back(&s);
@@ -383,8 +382,8 @@ nlohmann::json IncidencePlanes(const std::vector<BrdfSample>& samples, const Run
       const size_t step = std::max<size_t>(1, (band[kind].size() + kBandSamples - 1) / kBandSamples);
       for (size_t i = 0; i < band[kind].size(); i += step) {
         const BrdfSample& s = *band[kind][i];
-        const bool light_side = std::abs(s.delta_phi / kDeg) <= kBandPhiDeg;
-        const double other = (kind == 0 ? s.theta_e : s.theta_i) / kDeg;
+        const bool light_side = std::abs(s.delta_phi / kDegree) <= kBandPhiDeg;
+        const double other = (kind == 0 ? s.theta_e : s.theta_i) / kDegree;
         rows.push_back(float(kind));
         rows.push_back(float(light_side ? other : -other));
         // A channel the sample did not measure (clipped, under the noise floor: its `valid` flag) is NaN
@@ -409,8 +408,8 @@ nlohmann::json IncidencePlanes(const std::vector<BrdfSample>& samples, const Run
     for (const NamedModel& m : models.named) {
       nlohmann::json values = nlohmann::json::array();
       for (const double x : abscissa) {
-        const Eigen::Vector3d wi(std::sin(t0 * kDeg), 0.0, std::cos(t0 * kDeg));
-        const Eigen::Vector3d wo(std::sin(x * kDeg), 0.0, std::cos(x * kDeg));
+        const Eigen::Vector3d wi(std::sin(t0 * kDegree), 0.0, std::cos(t0 * kDegree));
+        const Eigen::Vector3d wo(std::sin(x * kDegree), 0.0, std::cos(x * kDegree));
         const Eigen::Vector3d f = m.eval(wi, wo);
         values.push_back({f[0], f[1], f[2]});
       }
@@ -464,8 +463,8 @@ nlohmann::json ExplorerGrids(const std::vector<BrdfSample>& samples, const RunMo
     for (int ti = 0; ti <= 85; ti += 5) {
       for (int phi = 0; phi <= 180; phi += 15) {
         for (int x = -89; x <= 89; ++x) {
-          const Eigen::Vector3d wi = FromSpherical(ti * kDeg, 0.0);
-          const Eigen::Vector3d wo = FromSpherical(std::abs(x) * kDeg, (x >= 0 ? phi : phi + 180) * kDeg);
+          const Eigen::Vector3d wi = FromSpherical(ti * kDegree, 0.0);
+          const Eigen::Vector3d wo = FromSpherical(std::abs(x) * kDegree, (x >= 0 ? phi : phi + 180) * kDegree);
           value(m.eval(wi, wo), &curves);
         }
       }
@@ -473,9 +472,9 @@ nlohmann::json ExplorerGrids(const std::vector<BrdfSample>& samples, const RunMo
     for (int h = 0; h < 90; ++h) {
       for (int d = 0; d < 90; ++d) {
         HalfDiffAngles a;
-        a.theta_h = (h + 0.5) * kDeg;
-        a.theta_d = (d + 0.5) * kDeg;
-        a.phi_d = 90.0 * kDeg;
+        a.theta_h = (h + 0.5) * kDegree;
+        a.theta_d = (d + 0.5) * kDegree;
+        a.phi_d = 90.0 * kDegree;
         Eigen::Vector3d wi, wo;
         FromHalfDiff(a, &wi, &wo);
         value(wi.z() > 0.0 && wo.z() > 0.0 ? m.eval(wi, wo) : Eigen::Vector3d(-1, -1, -1), &halfdiff);
@@ -508,8 +507,8 @@ nlohmann::json ExplorerGrids(const std::vector<BrdfSample>& samples, const RunMo
   size_t rows = 0;
   for (size_t i = 0; i < samples.size(); i += step, ++rows) {
     const BrdfSample& s = samples[i];
-    for (const float v : {float(s.theta_i / kDeg), float(s.theta_e / kDeg), float(s.delta_phi / kDeg), s.brdf[0],
-                          s.brdf[1], s.brdf[2]}) {
+    for (const float v : {float(s.theta_i / kDegree), float(s.theta_e / kDegree), float(s.delta_phi / kDegree),
+                          s.brdf[0], s.brdf[1], s.brdf[2]}) {
       subset.push_back(v);
     }
   }
@@ -608,7 +607,7 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   std::map<uint32_t, PhotoStats> photos = CollectPhotoStats(samples);
   const ChosenPhoto chosen = ChoosePhoto(photos, options.photo);
   result.photo = chosen.photo;
-  result.phase_deg = chosen.phase / kDeg;
+  result.phase_deg = chosen.phase / kDegree;
   result.reconstruction = models.table != nullptr;
   result.reconstruction_path = models.table_path;
   result.fits = models.fit_names;

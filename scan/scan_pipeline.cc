@@ -46,7 +46,7 @@ std::vector<ScanInputSpec> InputsFromConf(const std::string& conf_path, const st
 
 std::vector<ScanInputSpec> InputsFromSession(const Session& session) {
   const SampleSpec& sample = session.sample;
-  if (sample.kind != SampleSpec::Kind::kMesh) {
+  if (!IsMeshSample(sample.kind)) {
     ThrowError(session.manifest_path + ": /sample/kind",
                "the sample is a " + std::string(SampleKindName(sample.kind)) + ", not a scanned mesh");
   }

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/kind.h"
 #include "synth/synthetic.h"
 
 namespace ibrdf {
@@ -11,8 +12,15 @@ namespace {
 // The radius about the scene's origin within which the sample lies (the scene must be valid).
 double SampleBoundingRadius(const SynthSceneOptions& scene) {
   if (scene.shape != SynthShape::kNone) return MakeTrueShape(scene)->BoundingRadius();
-  return scene.sample == SampleSpec::Kind::kCylinder ? std::hypot(scene.sample_radius, 0.5 * scene.cylinder_length)
-                                                     : scene.sample_radius;
+  switch (scene.sample) {
+    case SampleSpec::Kind::kSphere:
+      return scene.sample_radius;
+    case SampleSpec::Kind::kCylinder:
+      return std::hypot(scene.sample_radius, 0.5 * scene.cylinder_length);
+    case SampleSpec::Kind::kMesh:
+      break;  // a scene's mesh is a shape (handled above); SynthSceneOptions::Check refuses kMesh
+  }
+  UnhandledKind("SampleSpec::Kind", static_cast<int>(scene.sample));
 }
 
 // A part's Check, its message prefixed with the part's name ("rig: num_photos >= 1 failed: ...").
@@ -36,7 +44,7 @@ const char* SynthShapeName(SynthShape shape) {
     case SynthShape::kDent:
       return "dent";
   }
-  return "none";
+  UnhandledKind("SynthShape", static_cast<int>(shape));
 }
 
 SynthShape SynthShapeFromName(const std::string& name) {
@@ -55,7 +63,7 @@ const char* SynthNoDataName(SynthNoData no_data) {
     case SynthNoData::kError:
       return "error";
   }
-  return "skip";
+  UnhandledKind("SynthNoData", static_cast<int>(no_data));
 }
 
 SynthNoData SynthNoDataFromName(const std::string& name) {
@@ -74,7 +82,7 @@ const char* SynthRigName(SynthRig rig) {
     case SynthRig::kTurntable:
       return "turntable";
   }
-  return "arc";
+  UnhandledKind("SynthRig", static_cast<int>(rig));
 }
 
 SynthRig SynthRigFromName(const std::string& name) {

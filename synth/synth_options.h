@@ -11,13 +11,13 @@
 #include <Eigen/Core>
 
 #include "core/session.h"
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 #include "synth/synthetic_shapes.h"
 
 namespace ibrdf {
 
 // The irregular true shapes synth renders instead of the analytic sphere or cylinder (kNone).
-enum class SynthShape { kNone, kSquash, kPot, kDent };
+enum class SynthShape { kNone, kSquash, kPot, kDent, IBRDF_DUMMY_KIND };
 
 // "none", "squash", "pot", "dent"; and back (throws Error naming the value otherwise).
 const char* SynthShapeName(SynthShape shape);

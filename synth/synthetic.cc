@@ -19,6 +19,7 @@
 #include "core/json_reader.h"
 #include "core/light.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "core/merl_brdf.h"
 #include "core/radiometry.h"
 #include "core/statistics.h"
@@ -35,7 +36,6 @@ namespace fs = std::filesystem;
 
 namespace ibrdf {
 namespace {
-constexpr double kDegree = M_PI / 180.0;
 
 // Where an irregular-shape session keeps its scan (relative to the session folder).
 constexpr char kScanMesh[] = "scan/mesh.ply";
@@ -223,9 +223,15 @@ Session BuildSession(const SynthOptions& options) {
     sample.kind = options.scene.sample;
     sample.center = options.scene.origin;
     sample.radius = options.scene.sample_radius;
-    if (sample.kind == SampleSpec::Kind::kCylinder) {
-      sample.axis = Eigen::Vector3d::UnitZ();
-      sample.length = options.scene.cylinder_length;
+    switch (sample.kind) {
+      case SampleSpec::Kind::kSphere:
+        break;
+      case SampleSpec::Kind::kCylinder:
+        sample.axis = Eigen::Vector3d::UnitZ();
+        sample.length = options.scene.cylinder_length;
+        break;
+      case SampleSpec::Kind::kMesh:
+        UnhandledKind("SampleSpec::Kind", static_cast<int>(sample.kind));  // a shape, handled above
     }
     bounding_radius = AnalyticSample::Create(sample)->BoundingRadius();
   }

@@ -13,14 +13,13 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "core/rigid3.h"
 
 namespace fs = std::filesystem;
 
 namespace ibrdf {
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 // The printed sheet: the board's texture with a white margin of half a square, on a darker table.
 class BoardTexture {

@@ -125,8 +125,7 @@ nlohmann::json WriteSynthColour(const SynthOptions& options, const std::string& 
     ChartFrame frame;
     frame.center = session->sample.center;
     const Eigen::Vector3d eye = first->camera_from_world->Inverse().translation;
-    const Eigen::Vector3d to_light =
-        light.kind == Light::Kind::kPoint ? (light.position - frame.center).normalized() : light.direction.normalized();
+    const Eigen::Vector3d to_light = DirectionToLight(light, frame.center);
     frame.normal = (to_light + (eye - frame.center).normalized()).normalized();
     // Columns along the camera's x axis as seen on the chart, rows down the print (right x down = -normal).
     const Eigen::Vector3d camera_x =

@@ -13,12 +13,12 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "core/light_json.h"
+#include "core/math.h"
 
 namespace ibrdf {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
 
 std::string LightId(int k) {
   char buffer[16];
@@ -65,8 +65,8 @@ bool SyntheticMirrorSphereOptions::Check(std::string* why) const {
 std::string SyntheticMirrorSphere::BriefReport() const {
   char buffer[256];
   std::snprintf(buffer, sizeof(buffer), "mirror sphere: %zu %s lights, %d x %d -> %s", lights.size(),
-                lights.empty() || lights[0].kind == Light::Kind::kDirectional ? "directional" : "point", camera.width,
-                camera.height, manifest.c_str());
+                lights.empty() ? "directional" : LightKindName(lights[0].kind), camera.width, camera.height,
+                manifest.c_str());
   return buffer;
 }
 
@@ -144,9 +144,15 @@ SyntheticMirrorSphere WriteSyntheticMirrorSphere(const SyntheticMirrorSphereOpti
             const Eigen::Vector3d p = camera_center + t * d;
             const Eigen::Vector3d n = (p - options.center) / options.radius;
             const Eigen::Vector3d reflected = d - 2.0 * n.dot(d) * n;
-            const Eigen::Vector3d to_light = light.kind == Light::Kind::kPoint
-                                                 ? Eigen::Vector3d((light.position - p).normalized())
-                                                 : light.direction;
+            Eigen::Vector3d to_light = Eigen::Vector3d::Zero();
+            switch (light.kind) {
+              case Light::Kind::kPoint:
+                to_light = (light.position - p).normalized();
+                break;
+              case Light::Kind::kDirectional:
+                to_light = light.direction;
+                break;
+            }
             const double angle = std::atan2(reflected.cross(to_light).norm(), reflected.dot(to_light));
             double radiance = options.environment;
             if (angle < 6.0 * sigma) radiance += options.source_peak * std::exp(-0.5 * angle * angle / (sigma * sigma));

@@ -280,8 +280,7 @@ void WriteSynthCalibration(const SynthOptions& options, const std::string& direc
     // The target faces between the camera and the lights' mean direction (the one light's, usually).
     Eigen::Vector3d to_lights = Eigen::Vector3d::Zero();
     for (const Light& light : session->lights) {
-      to_lights += light.kind == Light::Kind::kPoint ? (light.position - white.center).normalized()
-                                                     : light.direction.normalized();
+      to_lights += DirectionToLight(light, white.center);
     }
     white.normal = (to_lights.normalized() + (camera_center - white.center).normalized()).normalized();
     // The marker card stands on a post where the sample was, its x axis level, raised so that its

@@ -9,10 +9,10 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
+#include "core/math.h"
 
 namespace ibrdf {
 namespace {
-constexpr double kDegree = M_PI / 180.0;
 
 Eigen::Vector3d FromPolar(double theta, double phi) {
   return Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));

@@ -9,8 +9,15 @@ namespace ibrdf {
 
 double PlatformHeight(const SynthSceneOptions& scene) {
   if (scene.shape != SynthShape::kNone) return scene.origin.z() + MakeTrueShape(scene)->LowestZ();
-  const double below = scene.sample == SampleSpec::Kind::kCylinder ? 0.5 * scene.cylinder_length : scene.sample_radius;
-  return scene.origin.z() - below;
+  switch (scene.sample) {
+    case SampleSpec::Kind::kSphere:
+      return scene.origin.z() - scene.sample_radius;
+    case SampleSpec::Kind::kCylinder:
+      return scene.origin.z() - 0.5 * scene.cylinder_length;
+    case SampleSpec::Kind::kMesh:
+      break;  // a scene's mesh is a shape (handled above); SynthSceneOptions::Check refuses kMesh
+  }
+  UnhandledKind("SampleSpec::Kind", static_cast<int>(scene.sample));
 }
 
 std::vector<TargetSpec> TargetLayout(const SynthOptions& options) {

@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "core/logging.h"
+#include "core/version.h"
 #include "workflow/workflow_run.h"
 
 namespace ibrdf {
@@ -14,7 +15,7 @@ std::vector<BatchEntryPlan> PlanBatch(const BatchConfig& config, const std::stri
     BatchEntryPlan entry_plan{entry, ""};
     try {
       const MeasurementInput input = OpenMeasurementInput(entry.input, entry.run_dir);
-      WorkflowOptions options{entry.run_dir, build_id, "ibrdf 0.1.0", false, ""};
+      WorkflowOptions options{entry.run_dir, build_id, kIbrdfVersionLine, false, ""};
       options.dry_run = true;
       WorkflowRun run(options);
       // A dry run never calls the launcher: the first stage that would run stops the plan.

@@ -101,7 +101,7 @@ void Planner::Scan() {
   const std::optional<Session> session = SessionAt(manifest_path);
   Stage scan =
       MakeStage("scan", {}, {manifest_path}, {At("scan/mesh.ply"), At("scan/mesh.ply.json"), At("scan/session.json")});
-  if (!session || session->sample.kind != SampleSpec::Kind::kMesh) {
+  if (!session || !IsMeshSample(session->sample.kind)) {
     scan.not_applicable = "the sample is analytic, not a scanned mesh";
   } else if (session->sample.scan_inputs.empty()) {
     scan.not_applicable = "the session's mesh sample has no scan_inputs";

@@ -1,5 +1,7 @@
 #include "workflow/stage.h"
 
+#include "core/kind.h"
+
 namespace ibrdf {
 
 const char* StageStatusName(StageStatus status) {
@@ -11,7 +13,7 @@ const char* StageStatusName(StageStatus status) {
     case StageStatus::kNotApplicable:
       return "not_applicable";
   }
-  return "unknown";
+  UnhandledKind("StageStatus", static_cast<int>(status));
 }
 
 }  // namespace ibrdf

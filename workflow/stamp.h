@@ -32,7 +32,7 @@ FileFingerprint Fingerprint(const std::string& path);
 struct Stamp {
   std::string stage;                    // the stage's name
   std::string build_id;                 // the binary that ran it (ExecutableBuildId()); "" in older stamps
-  std::string version;                  // its version string, for the reader ("ibrdf 0.1.0")
+  std::string version;                  // its version string, for the reader (kIbrdfVersionLine, core/version.h)
   std::vector<std::string> arguments;   // the stage's options (its command line)
   std::vector<FileFingerprint> inputs;  // its inputs when it ran
   std::vector<std::string> outputs;     // what it left behind

@@ -15,7 +15,7 @@ namespace ibrdf {
 struct WorkflowOptions {
   std::string run_dir;     // the run folder (created, with stamps/); made absolute
   std::string build_id;    // the binary whose stages run (ExecutableBuildId()); a different one re-runs them
-  std::string version;     // recorded in stamps for the reader, e.g. "ibrdf 0.1.0"
+  std::string version;     // recorded in stamps for the reader, kIbrdfVersionLine (core/version.h)
   bool force = false;      // re-run every stage that applies, up to date or not
   std::string stop_after;  // the last stage to run ("": all); later ones are not applicable
   // Decide only (`ibrdf batch`'s plan): nothing is created, removed or run; the first stage that would

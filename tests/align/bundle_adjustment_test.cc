@@ -14,6 +14,7 @@
 #include "align/aligner.h"
 #include "core/error.h"
 #include "core/json_reader.h"
+#include "core/math.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -22,8 +23,6 @@ namespace {
 using testing::MakeSession;
 using testing::MaterialPath;
 using testing::ScratchDir;
-
-constexpr double kDegree = M_PI / 180.0;
 
 SynthOptions FreeLayoutOptions(int photos) {
   SynthOptions options;

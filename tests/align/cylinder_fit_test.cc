@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "align/aligner.h"
+#include "core/math.h"
 #include "derender/derenderer.h"
 #include "reconstruct/truth_comparison.h"
 #include "synth/synthetic_targets.h"
@@ -21,8 +22,6 @@ namespace {
 using testing::MakeSession;
 using testing::MaterialPath;
 using testing::ScratchDir;
-
-constexpr double kDegree = M_PI / 180.0;
 
 TEST(CylinderFit, DefaultOptionsAreValid) {
   std::string why;

@@ -12,6 +12,7 @@
 #include "align/aligner.h"
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/math.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {
@@ -19,8 +20,6 @@ namespace {
 
 using testing::MakeSession;
 using testing::ScratchDir;
-
-constexpr double kDegree = M_PI / 180.0;
 
 SynthOptions HardCaseOptions(int photos) {
   SynthOptions options;

@@ -8,11 +8,10 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/math.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 Rigid3d Pose(const Eigen::Vector3d& axis_angle_deg, const Eigen::Vector3d& translation) {
   const double angle = axis_angle_deg.norm() * kDegree;

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/version.h"
 #include "tests/run_ibrdf.h"
 #include "tests/scratch_dir.h"
 
@@ -30,7 +31,7 @@ std::string Ldd(const std::string& binary) { return testing::RunShell("ldd " + b
 TEST(FrontEnd, VersionAndHelpListEverySubcommand) {
   const RunResult version = RunRaw("--version");
   EXPECT_EQ(version.exit_code, 0);
-  EXPECT_NE(version.output.find("ibrdf 0."), std::string::npos) << version.output;
+  EXPECT_NE(version.output.find(kIbrdfVersionLine), std::string::npos) << version.output;
   const RunResult help = RunRaw("--help");
   EXPECT_EQ(help.exit_code, 0);
   for (const char* name : {"synth", "scan", "align", "derender", "reconstruct", "check", "report", "run", "compare"}) {

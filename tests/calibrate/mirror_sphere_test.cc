@@ -8,13 +8,12 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/math.h"
 #include "synth/synthetic_mirror_sphere.h"
 #include "tests/scratch_dir.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / kPi;

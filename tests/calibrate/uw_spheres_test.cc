@@ -14,11 +14,10 @@
 
 #include "calibrate/mirror_sphere.h"
 #include "core/image_io.h"
+#include "core/math.h"
 
 namespace ibrdf {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string DataDir() { return std::string(IBRDF_SHARED_DATA_DIR) + "/uw-photometric-spheres"; }
 

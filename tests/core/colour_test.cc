@@ -163,5 +163,17 @@ TEST_F(ColourChartBlockTest, BadBlocksNameTheField) {
   }
 }
 
+TEST(ColourSpace, MatricesIntoAndOutOfLinearSrgb) {
+  Eigen::Matrix3d m;
+  m << 1, 2, 3, 4, 5, 6, 7, 8, 10;
+  EXPECT_EQ(LinearSrgbFromSpace(ColourSpace::kLinearSrgb, m), m);
+  EXPECT_EQ(SpaceFromLinearSrgb(ColourSpace::kLinearSrgb, m), m);
+  EXPECT_EQ(LinearSrgbFromSpace(ColourSpace::kXyz, m), LinearSrgbFromXyz() * m);
+  EXPECT_EQ(SpaceFromLinearSrgb(ColourSpace::kXyz, m), XyzFromLinearSrgb() * m);
+  EXPECT_STREQ(ColourSpaceLabel(ColourSpace::kLinearSrgb), "linear sRGB (D65)");
+  EXPECT_STREQ(ColourSpaceLabel(ColourSpace::kXyz), "CIE XYZ (D65)");
+  EXPECT_THROW(ColourSpaceName(static_cast<ColourSpace>(99)), InternalError);
+}
+
 }  // namespace
 }  // namespace ibrdf

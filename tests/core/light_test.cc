@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
+
 namespace ibrdf {
 namespace {
 
@@ -114,6 +116,27 @@ TEST(Light, Defaults) {
   const Incidence unlit;
   EXPECT_FALSE(unlit.lit);
   EXPECT_EQ(unlit.irradiance, Eigen::Vector3d::Zero());
+}
+
+TEST(Light, KindNamesAndPlacement) {
+  Light point;
+  point.kind = Light::Kind::kPoint;
+  point.position = Eigen::Vector3d(1, 2, 3);
+  Light directional;
+  directional.kind = Light::Kind::kDirectional;
+  directional.direction = Eigen::Vector3d(0, 0, 2);
+  EXPECT_STREQ(LightKindName(Light::Kind::kPoint), "point");
+  EXPECT_STREQ(LightKindName(Light::Kind::kDirectional), "directional");
+  EXPECT_STREQ(LightPlacementKey(Light::Kind::kPoint), "position");
+  EXPECT_STREQ(LightPlacementKey(Light::Kind::kDirectional), "direction");
+  EXPECT_EQ(&LightPlacement(point), &point.position);
+  EXPECT_EQ(&LightPlacement(directional), &directional.direction);
+  EXPECT_EQ(DirectionToLight(point, Eigen::Vector3d(1, 2, 0)), Eigen::Vector3d(0, 0, 1));
+  EXPECT_EQ(DirectionToLight(directional, Eigen::Vector3d(5, 5, 5)), Eigen::Vector3d(0, 0, 1));
+}
+
+TEST(Light, KindOutsideTheEnumIsAnInternalError) {
+  EXPECT_THROW(LightKindName(static_cast<Light::Kind>(99)), InternalError);
 }
 
 }  // namespace

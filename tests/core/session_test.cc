@@ -490,6 +490,10 @@ TEST(SampleKindName, NamesEveryKind) {
   EXPECT_STREQ(SampleKindName(SampleSpec::Kind::kSphere), "sphere");
   EXPECT_STREQ(SampleKindName(SampleSpec::Kind::kCylinder), "cylinder");
   EXPECT_STREQ(SampleKindName(SampleSpec::Kind::kMesh), "mesh");
+  EXPECT_THROW(SampleKindName(static_cast<SampleSpec::Kind>(99)), InternalError);
+  EXPECT_FALSE(IsMeshSample(SampleSpec::Kind::kSphere));
+  EXPECT_FALSE(IsMeshSample(SampleSpec::Kind::kCylinder));
+  EXPECT_TRUE(IsMeshSample(SampleSpec::Kind::kMesh));
 }
 
 // ---- Version 2: several lights, a light per photo, masks.

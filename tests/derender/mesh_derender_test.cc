@@ -21,7 +21,7 @@
 #include "derender/analytic_sample.h"
 #include "derender/radiance_image.h"
 #include "scan/ply_io.h"
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 #include "tests/test_util.h"
 
 namespace ibrdf {

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 
 namespace ibrdf {
 namespace {

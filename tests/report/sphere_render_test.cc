@@ -7,10 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include "core/math.h"
+
 namespace ibrdf {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 TEST(SphereRender, LambertianShowsCosineOverPi) {
   const int size = 64;

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 
 namespace ibrdf {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 #include "scan/range_grid.h"
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 #include "tests/scan/scan_test_util.h"
 
 namespace ibrdf {

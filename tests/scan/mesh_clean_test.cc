@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 
 namespace ibrdf {
 namespace {

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "scan/ply_io.h"
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 #include "tests/scan/scan_test_util.h"
 
 namespace ibrdf {

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "scan/ply_io.h"
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 #include "tests/run_ibrdf.h"
 #include "tests/scan/scan_test_util.h"
 #include "tests/scratch_dir.h"

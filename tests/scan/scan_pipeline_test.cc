@@ -12,7 +12,7 @@
 #include "core/logging.h"
 #include "core/session.h"
 #include "scan/ply_io.h"
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 #include "tests/scan/scan_test_util.h"
 #include "tests/scratch_dir.h"
 

@@ -1,4 +1,4 @@
-#include "scan/synthetic_scan.h"
+#include "synth/synthetic_scan.h"
 
 #include <cmath>
 #include <fstream>
