@@ -66,8 +66,7 @@ void AddDerenderCommand(CLI::App& app) {
     inputs.push_back(session.manifest_path);
     inputs.push_back(session.directory);
     if (!session.sample.mesh_file.empty()) inputs.push_back(session.AbsolutePath(session.sample.mesh_file) + ".json");
-    RequireWritableOutput(args->out, args->overwrite, inputs);
-    RequireWritableOutput(SidecarPath(args->out), args->overwrite, inputs);
+    RequireWritableOutputs(args->out, {{SidecarPath(args->out), "ibrdf-samples"}}, args->overwrite, inputs);
     DerenderToFile(session, args->options, args->out);
     Log(1, "samples written to " + args->out);
   });

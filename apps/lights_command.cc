@@ -97,20 +97,23 @@ void AddCalibrate(CLI::App& group) {
     RequireValidOptions(args->probe, "--kind/--light-distance-m/--blob-fraction/--rim-margin-px");
     RequireValidOptions(args->diffuse_options, "--max-theta-deg");
     std::vector<Session> placements;
-    std::vector<std::string> inputs;
+    std::vector<std::string> inputs, photos;  // the manifests (recorded in the report), their photos
     for (const std::string& path : args->sessions) {
       placements.push_back(Session::Load(path));
       inputs.push_back(placements.back().manifest_path);
+      for (const std::string& file : placements.back().InputFiles()) photos.push_back(file);
     }
     std::optional<Session> diffuse;
     if (!args->diffuse.empty()) {
       diffuse = Session::Load(args->diffuse);
       inputs.push_back(diffuse->manifest_path);
+      for (const std::string& file : diffuse->InputFiles()) photos.push_back(file);
     }
     if (!args->albedo.empty() && !diffuse) ThrowError("--albedo", "needs --diffuse (the sphere it describes)");
     const std::string report_path = ReportPath(args->out);
-    RequireWritableOutput(args->out, args->overwrite, inputs);
-    RequireWritableOutput(report_path, args->overwrite, inputs);
+    photos.insert(photos.end(), inputs.begin(), inputs.end());
+    RequireWritableOutput(args->out, args->overwrite, photos);
+    RequireWritableOutput(report_path, args->overwrite, photos);
     std::optional<Session> target;
     if (!args->write_session.empty()) {
       if (!args->apply_to.empty()) {
@@ -120,9 +123,11 @@ void AddCalibrate(CLI::App& group) {
       } else {
         ThrowError("--write-session", "needs --apply-to SESSION or --diffuse SESSION (the session to give the lights)");
       }
-      if (fs::exists(args->write_session) && !args->overwrite) {
-        ThrowError(args->write_session, "exists (use --overwrite to replace it)");
-      }
+      // The folder written replaces --write-session whole: never the target's folder or its photos.
+      std::vector<std::string> target_files = target->InputFiles();
+      target_files.push_back(target->manifest_path);
+      target_files.push_back(target->directory);
+      RequireWritableOutput(args->write_session, args->overwrite, target_files);
     } else if (!args->apply_to.empty()) {
       ThrowError("--apply-to", "needs --write-session (where to write the session with the calibrated lights)");
     }

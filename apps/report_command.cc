@@ -68,13 +68,7 @@ void AddReportCommand(CLI::App& app) {
     RequireWritableOutput(args->out.empty() ? own_report.string() : args->out, args->options.overwrite, inputs);
     const ReportResult result = WriteReport(args->run_dir, args->options, args->out);
     Log(1, result.BriefReport());
-    for (const BandAgreement& band : result.bands) {
-      char line[200];
-      std::snprintf(line, sizeof(line),
-                    "incidence plane %g deg: median sample / reconstruction R G B %.3f %.3f %.3f over %zu samples",
-                    band.theta0_deg, band.ratio[0], band.ratio[1], band.ratio[2], band.samples);
-      Log(1, line);
-    }
+    for (const BandAgreement& band : result.bands) Log(1, band.BriefReport());
     if (!result.explorer_html.empty()) Log(1, "explorer: " + result.explorer_html);
   });
 }

@@ -48,8 +48,7 @@ void AddScanCommand(CLI::App& app) {
     StageLog stage("scan");
     std::vector<std::string> read;
     const std::vector<ScanInputSpec> inputs = ResolveScanInputs(args->sources, &read);
-    RequireWritableOutput(args->out, args->overwrite, read);
-    RequireWritableOutput(ScanSidecarPath(args->out), args->overwrite, read);
+    RequireWritableOutputs(args->out, {{ScanSidecarPath(args->out), "ibrdf scan 1"}}, args->overwrite, read);
     const ScanResult result = RunScan(inputs, args->options);
     WriteScanOutputs(args->out, result, args->options);
     if (Verbosity() >= 1) std::cout << result.summary.Table();
