@@ -91,7 +91,12 @@ CLI::Option* AddRenamedOption(CLI::App& app, const std::string& name, const std:
 class OptionValueError : public CLI::ValidationError {
  public:
   OptionValueError(const std::string& flags, const std::string& why)
-      : CLI::ValidationError(flags, "bad value: " + why) {}
+      : CLI::ValidationError(flags, "bad value: " + why), why_(why) {}
+  // The failed constraint as Check() wrote it, in the options' field names (main() names the flags).
+  const std::string& why() const { return why_; }
+
+ private:
+  std::string why_;
 };
 
 // Throws OptionValueError (a usage error, exit 2) unless `options.Check()` passes; `flags` names the

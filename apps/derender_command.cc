@@ -45,8 +45,7 @@ IBRDF_COMMAND(40, Derender) {
     const Session session = Session::Load(args->session);
     std::vector<std::string> inputs = SessionInputs(session);
     if (!session.sample.mesh_file.empty()) inputs.push_back(session.AbsolutePath(session.sample.mesh_file) + ".json");
-    RequireWritableOutput(args->out, args->overwrite, inputs);
-    RequireWritableOutput(SidecarPath(args->out), args->overwrite, inputs);
+    RequireWritableOutputs(args->out, {{SidecarPath(args->out), "ibrdf-samples"}}, args->overwrite, inputs);
     DerenderToFile(session, args->options, args->out);
     Log(1, "samples written to " + args->out);
   });

@@ -85,20 +85,23 @@ void RunCalibrate(CalibrateArgs& args) {
   RequireValidOptions(options.diffuse, "--max-theta-deg");
   if (!args.albedo.empty()) options.albedo = Vector3Option(args.albedo, "--albedo");
   std::vector<Session> placements;
-  std::vector<std::string> inputs;
+  std::vector<std::string> inputs, photos;  // the manifests (recorded in the report), their photos
   for (const std::string& path : args.sessions) {
     placements.push_back(Session::Load(path));
     inputs.push_back(placements.back().manifest_path);
+    for (const std::string& file : placements.back().InputFiles()) photos.push_back(file);
   }
   std::optional<Session> diffuse;
   if (!args.diffuse.empty()) {
     diffuse = Session::Load(args.diffuse);
     inputs.push_back(diffuse->manifest_path);
+    for (const std::string& file : diffuse->InputFiles()) photos.push_back(file);
   }
   if (options.albedo && !diffuse) ThrowError("--albedo", "needs --diffuse (the sphere it describes)");
   const std::string report_path = LightRigReportPath(args.out);
-  RequireWritableOutput(args.out, args.overwrite, inputs);
-  RequireWritableOutput(report_path, args.overwrite, inputs);
+  photos.insert(photos.end(), inputs.begin(), inputs.end());
+  RequireWritableOutput(args.out, args.overwrite, photos);
+  RequireWritableOutput(report_path, args.overwrite, photos);
   std::optional<Session> target;
   if (!args.write_session.empty()) {
     if (!args.apply_to.empty()) {
@@ -108,9 +111,11 @@ void RunCalibrate(CalibrateArgs& args) {
     } else {
       ThrowError("--write-session", "needs --apply-to SESSION or --diffuse SESSION (the session to give the lights)");
     }
-    if (fs::exists(args.write_session) && !args.overwrite) {
-      ThrowError(args.write_session, "exists (use --overwrite to replace it)");
-    }
+    // The folder written replaces --write-session whole: never the target's folder or its photos.
+    std::vector<std::string> target_files = target->InputFiles();
+    target_files.push_back(target->manifest_path);
+    target_files.push_back(target->directory);
+    RequireWritableOutput(args.write_session, args.overwrite, target_files);
   } else if (!args.apply_to.empty()) {
     ThrowError("--apply-to", "needs --write-session (where to write the session with the calibrated lights)");
   }

@@ -40,8 +40,7 @@ IBRDF_COMMAND(20, Scan) {
     StageLog stage("scan");
     std::vector<std::string> read;
     const std::vector<ScanInputSpec> inputs = ResolveScanInputs(args->sources, &read);
-    RequireWritableOutput(args->out, args->overwrite, read);
-    RequireWritableOutput(ScanSidecarPath(args->out), args->overwrite, read);
+    RequireWritableOutputs(args->out, {{ScanSidecarPath(args->out), "ibrdf scan 1"}}, args->overwrite, read);
     const ScanResult result = RunScan(inputs, args->o);
     WriteScanOutputs(args->out, result, args->o);
     if (Verbosity() >= 1) std::cout << result.summary.Table();

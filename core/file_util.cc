@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/interruption.h"
 #include "core/logging.h"
 
 namespace fs = std::filesystem;
@@ -32,12 +33,14 @@ AtomicFile::AtomicFile(std::string final_path) : final_path_(std::move(final_pat
       final.parent_path() / ("." + final.stem().string() + UniqueSuffix() + final.extension().string());
   temporary_path_ = temporary.string();
   RemoveStaleTemporariesOf(final_path_, false);
+  RegisterTemporary(temporary_path_);
 }
 
 AtomicFile::~AtomicFile() {
   if (!committed_) {
     std::error_code ignored;
     fs::remove(temporary_path_, ignored);
+    UnregisterTemporary(temporary_path_);
   }
 }
 
@@ -46,6 +49,7 @@ void AtomicFile::Commit() {
   fs::rename(temporary_path_, final_path_, error);
   if (error) ThrowError(final_path_, "cannot move the finished file into place: " + error.message());
   committed_ = true;
+  UnregisterTemporary(temporary_path_);
 }
 
 AtomicDirectory::AtomicDirectory(std::string final_path, bool replace_existing)
@@ -59,6 +63,7 @@ AtomicDirectory::AtomicDirectory(std::string final_path, bool replace_existing)
   if (!fs::is_directory(parent)) ThrowError(final_path_, "parent folder does not exist");
   temporary_path_ = (parent / ("." + final.filename().string() + UniqueSuffix())).string();
   RemoveStaleTemporariesOf(final_path_, true);
+  RegisterTemporary(temporary_path_);
   fs::create_directories(temporary_path_);
 }
 
@@ -66,6 +71,7 @@ AtomicDirectory::~AtomicDirectory() {
   if (!committed_) {
     std::error_code ignored;
     fs::remove_all(temporary_path_, ignored);
+    UnregisterTemporary(temporary_path_);
   }
 }
 
@@ -85,6 +91,7 @@ void AtomicDirectory::Commit() {
     ThrowError(final_path_, "cannot move the finished folder into place: " + error.message());
   }
   committed_ = true;
+  UnregisterTemporary(temporary_path_);
   if (!old_path.empty()) fs::remove_all(old_path, error);
 }
 

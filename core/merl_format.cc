@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <sstream>
 
 #include "core/error.h"
 #include "core/file_util.h"
@@ -105,8 +106,21 @@ MerlTable ReadMerl(const std::string& path) {
   in.read(reinterpret_cast<char*>(table.stored().data()),
           static_cast<std::streamsize>(3 * kMerlCells * sizeof(double)));
   if (!in) ThrowError(path, "read failed");
+  // A BRDF over 1e10 per steradian reflects no real surface; such values (a damaged or foreign file)
+  // overflow the lookups' weighted sums into inf and NaN.
+  constexpr double kMaxBrdf = 1e10;
+  static const char* const kChannel[3] = {"red", "green", "blue"};
   for (size_t i = 0; i < table.stored().size(); ++i) {
-    if (!std::isfinite(table.stored()[i])) ThrowError(path, "value " + std::to_string(i) + " is not finite");
+    const double stored = table.stored()[i];
+    if (!std::isfinite(stored)) ThrowError(path, "value " + std::to_string(i) + " is not finite");
+    const size_t channel = i / kMerlCells;
+    if (std::abs(stored * kMerlScale[channel]) > kMaxBrdf) {
+      std::ostringstream value;
+      value << stored;
+      ThrowError(path, "value " + std::to_string(i) + " (" + kChannel[channel] + ", cell " +
+                           std::to_string(i % kMerlCells) + ") is " + value.str() +
+                           ": no BRDF value (at most 1e10 per steradian; negative marks an unmeasured cell)");
+    }
   }
   return table;
 }

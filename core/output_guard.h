@@ -15,6 +15,20 @@ namespace ibrdf {
 // file the command reads (missing ones and "" are ignored), and every input folder.
 void RequireWritableOutput(const std::string& output, bool overwrite, const std::vector<std::string>& inputs);
 
+// A file a stage writes beside the output the user named (a sidecar <out>.json): `format` is the JSON
+// "format" of the file the stage writes there, which marks an existing one as the stage's own.
+struct CompanionFile {
+  std::string path;
+  std::string format;
+};
+
+// The output guard over every file a stage writes: RequireWritableOutput for `output` and for each
+// companion; an existing companion is replaced only when it is the stage's own (its "format" is the
+// companion's), --overwrite or not, since the user named only `output` (`--out mat` beside a material
+// file mat.json, `--out s1/truth` beside a session's truth.json).
+void RequireWritableOutputs(const std::string& output, const std::vector<CompanionFile>& companions, bool overwrite,
+                            const std::vector<std::string>& inputs);
+
 // The first half of RequireWritableOutput: `output` is no input and holds none (for `run`, whose folder
 // is resumed rather than replaced).
 void RequireOutputOutsideInputs(const std::string& output, const std::vector<std::string>& inputs);

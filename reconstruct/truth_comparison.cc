@@ -178,8 +178,10 @@ std::string TruthPathFromSidecar(const std::string& samples_path) {
   const std::string sidecar = SidecarPath(samples_path);
   if (!fs::exists(sidecar)) ThrowError(samples_path, "has no sidecar " + sidecar + "; pass --truth");
   const nlohmann::json json = ReadJsonFile(sidecar);
-  if (!json.contains("session") || !json["session"].is_string()) {
-    ThrowError(sidecar + ": /session", "missing; pass --truth");
+  if (!json.is_object() || !json.contains("session")) ThrowError(sidecar + ": /session", "missing; pass --truth");
+  if (!json["session"].is_string()) {
+    ThrowError(sidecar + ": /session", std::string("expected the session's path (a string), got ") +
+                                           json["session"].type_name() + "; pass --truth");
   }
   const std::string truth = (fs::path(json["session"].get<std::string>()).parent_path() / "truth.json").string();
   if (!fs::exists(truth)) {

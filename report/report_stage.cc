@@ -532,6 +532,29 @@ bool ReportOptions::Check(std::string* why) const {
   return true;
 }
 
+namespace {
+// `fraction` as a percentage, or "no data" where it is NaN (nothing to compare).
+std::string Percent(double fraction) {
+  if (!std::isfinite(fraction)) return "no data";
+  std::ostringstream out;
+  out << 100.0 * fraction << " %";
+  return out.str();
+}
+}  // namespace
+
+std::string BandAgreement::BriefReport() const {
+  std::ostringstream out;
+  out << "incidence plane " << theta0_deg << " deg: ";
+  if (samples == 0 || !std::isfinite(ratio[0]) || !std::isfinite(ratio[1]) || !std::isfinite(ratio[2])) {
+    out << "no samples to compare with the " << (model.empty() ? std::string("reconstruction") : model);
+    return out.str();
+  }
+  char line[160];
+  std::snprintf(line, sizeof(line), "median sample / reconstruction R G B %.3f %.3f %.3f over %zu samples", ratio[0],
+                ratio[1], ratio[2], samples);
+  return out.str() + line;
+}
+
 std::string ReportResult::BriefReport() const {
   std::ostringstream out;
   out << "report \"" << title << "\": " << (success ? index_html : "FAILED") << ", " << samples << " samples, photo "
@@ -539,21 +562,18 @@ std::string ReportResult::BriefReport() const {
       << (reconstruction ? ", reconstruction" : "") << (truth ? ", truth" : "");
   for (const std::string& fit : fits) out << ", " << fit << " fit";
   for (const HeldOutRender& h : held_out) {
-    out << "; held-out photo " << h.image << ": median |render - photo| / photo " << 100.0 * h.median_abs_difference
-        << " % (the reconstruction that saw it: " << 100.0 * h.in_sample_median_abs_difference << " %)";
+    out << "; held-out photo " << h.image << ": median |render - photo| / photo " << Percent(h.median_abs_difference)
+        << " (the reconstruction that saw it: "
+        << (std::isfinite(h.in_sample_median_abs_difference) ? Percent(h.in_sample_median_abs_difference)
+                                                              : std::string("none, the run has no brdf.binary"))
+        << ")";
   }
   return out.str();
 }
 
 std::vector<std::string> ReportResult::SummaryLines() const {
   std::vector<std::string> lines = {BriefReport()};
-  for (const BandAgreement& band : bands) {
-    char line[200];
-    std::snprintf(line, sizeof(line),
-                  "incidence plane %g deg: median sample / reconstruction R G B %.3f %.3f %.3f over %zu samples",
-                  band.theta0_deg, band.ratio[0], band.ratio[1], band.ratio[2], band.samples);
-    lines.push_back(line);
-  }
+  for (const BandAgreement& band : bands) lines.push_back(band.BriefReport());
   if (!explorer_html.empty()) lines.push_back("explorer: " + explorer_html);
   return lines;
 }

@@ -38,7 +38,10 @@ struct BandAgreement {
   double theta0_deg = 0.0;
   std::string model;
   size_t samples = 0;
-  double ratio[3] = {0, 0, 0};
+  double ratio[3] = {0, 0, 0};  // NaN where the band holds no sample
+  // "incidence plane 30 deg: median sample / reconstruction R G B 1.002 0.998 1.010 over 812 samples", or
+  // that the band holds no samples (never "nan").
+  std::string BriefReport() const;
 };
 
 // A held-out photo shown: the median |render - photo| / photo of the regression that never saw it, and

@@ -294,6 +294,9 @@ class BodyReader {
 
   bool ascii() const { return format_ == Format::kAscii; }
 
+  // The bytes after the current position.
+  size_t RemainingBytes() const { return data_.size() - std::min(pos_, data_.size()); }
+
  private:
   void SkipSpaces() {
     while (cursor_ < line_end_ && std::isspace(static_cast<unsigned char>(data_[cursor_]))) ++cursor_;
@@ -414,18 +417,20 @@ ElementLayout PrepareElement(const Element& element, const Header& header, const
 
 // Reads instance `i` of `element` into `values` (values of properties ReadPly does not keep are read
 // and dropped; `values` keeps those of the previous instance where this one has none).
+// `declared`: the header's element counts, as DeclaredCounts gives them, for the messages.
 void ReadInstance(const Element& element, const ElementLayout& layout, uint64_t i, const std::string& path,
-                  BodyReader* reader, InstanceValues* values) {
+                  const std::string& declared, BodyReader* reader, InstanceValues* values) {
   if (!reader->BeginInstance()) {
     ThrowError(path, "the file ends after " + std::to_string(i) + " of " + std::to_string(element.count) + " " +
-                         layout.what + " (truncated, or the header's count is wrong)");
+                         layout.what + " (truncated, or the header's count is wrong; the header declares " +
+                         declared + ")");
   }
   for (size_t p = 0; p < element.properties.size(); ++p) {
     const Property& property = element.properties[p];
     auto fail = [&] {
       ThrowError(path, "the file ends inside " + element.name + " " + std::to_string(i) + " of " +
-                           std::to_string(element.count) + " (truncated, or the header's count is wrong)" +
-                           reader->Context());
+                           std::to_string(element.count) + " (truncated, or the header's count is wrong; the header "
+                           "declares " + declared + ")" + reader->Context());
     };
     double value = 0.0;
     if (!property.is_list) {
@@ -563,6 +568,29 @@ void CheckCountsAgainstSize(const Header& header, size_t data_size, const std::s
 
 }  // namespace
 
+// The header's element counts, "vertex 3, face 1", for messages about counts that do not match the data.
+std::string DeclaredCounts(const Header& header) {
+  std::string counts;
+  for (const Element& element : header.elements) {
+    counts += (counts.empty() ? "" : ", ") + element.name + " " + std::to_string(element.count);
+  }
+  return counts;
+}
+
+// Each vertex of a range grid is in exactly one cell (the Stanford and Cyberware scans list the points
+// in cell order). A vertex count one off shifts the cells' bytes, and the cells after the first few
+// read in step again: the byte count can come out even while cells go empty, which this catches.
+void CheckGridHoldsEveryVertex(const ScanMesh& mesh, const std::string& path, const std::string& declared) {
+  const size_t held = static_cast<size_t>(
+      std::count_if(mesh.grid.cell_point.begin(), mesh.grid.cell_point.end(), [](int v) { return v >= 0; }));
+  if (held != mesh.points.size()) {
+    ThrowError(path, std::to_string(held) + " of the " + std::to_string(mesh.grid.cell_point.size()) +
+                         " range_grid cells hold a vertex, but there are " + std::to_string(mesh.points.size()) +
+                         " vertices (each is in one cell): the header declares " + declared +
+                         ", which the data does not match");
+  }
+}
+
 ScanMesh ReadPly(const std::string& path) {
   const std::string data = ReadWholeFile(path);
   const Header header = ParseHeader(data, path);
@@ -571,18 +599,22 @@ ScanMesh ReadPly(const std::string& path) {
   BodyReader reader(data, header, path);
   bool have_grid = false;
   std::vector<std::vector<int>> polygons;
+  const std::string declared = DeclaredCounts(header);
   for (const Element& element : header.elements) {
     if (element.name == "face") polygons.reserve(size_t(element.count));
     const ElementLayout layout = PrepareElement(element, header, path, &have_grid, &mesh);
     InstanceValues values;
     for (uint64_t i = 0; i < element.count; ++i) {
-      ReadInstance(element, layout, i, path, &reader, &values);
+      ReadInstance(element, layout, i, path, declared, &reader, &values);
       StoreInstance(layout, i, values, path, &polygons, &mesh);
     }
   }
   if (reader.HasTrailingData()) {
-    ThrowError(path, "data after the last element: the header's counts are wrong" + reader.Context());
+    ThrowError(path, (reader.ascii() ? std::string("data") : std::to_string(reader.RemainingBytes()) + " bytes") +
+                         " after the last element: the header's counts are wrong (the header declares " + declared +
+                         ")" + reader.Context());
   }
+  if (have_grid) CheckGridHoldsEveryVertex(mesh, path, declared);
   FinishMesh(polygons, path, &mesh);
   return mesh;
 }

@@ -1,6 +1,7 @@
 #include "scan/scan_mesh.h"
 
 #include <cmath>
+#include <sstream>
 
 #include <Eigen/Geometry>
 
@@ -105,6 +106,15 @@ void RequireFinitePoints(const ScanMesh& mesh, const std::string& where) {
   for (size_t i = 0; i < mesh.points.size(); ++i) {
     if (!mesh.points[i].allFinite()) {
       ThrowError(where, "vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
+    }
+    // Beyond this no scan of a sample lies (in metres, 1000 km; in millimetres, 1 km), and the later
+    // arithmetic (centroids, ray distances) would overflow into "no photo sees the sample".
+    constexpr double kMaxCoordinate = 1e6;
+    if (mesh.points[i].cwiseAbs().maxCoeff() > kMaxCoordinate) {
+      std::ostringstream point;
+      point << mesh.points[i].transpose();
+      ThrowError(where, "vertex " + std::to_string(i) + " lies at (" + point.str() +
+                            "), beyond 1e6 in a coordinate: no scan of a sample (lengths are metres)");
     }
   }
   const int n = static_cast<int>(mesh.points.size());

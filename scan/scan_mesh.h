@@ -60,8 +60,8 @@ size_t KeepPoints(const std::vector<bool>& keep, ScanMesh* mesh);
 // The mean of the points (zero for none); used to centre coordinates before any fit.
 Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& points);
 
-// Throws Error naming `where` if any point coordinate is NaN or infinite, or a face index is out of
-// range. (Repeated indices within a face are degenerate faces, which cleaning removes and counts.)
+// Throws Error naming `where` if any point coordinate is NaN, infinite or beyond 1e6 (metres), or a
+// face index is out of range. (Repeated indices within a face are degenerate faces, which cleaning removes and counts.)
 void RequireFinitePoints(const ScanMesh& mesh, const std::string& where);
 
 }  // namespace ibrdf

@@ -18,13 +18,16 @@ void AddSamples(const fs::path& dir, nlohmann::json* summary) {
   const std::optional<StageJson> side = StageJson::ReadIfExists((dir / "samples.npy.json").string());
   if (!side) return;
   side->Object("/counts");
+  // Each rejection count checked here, where a bad one is blamed on this file, not on summary.json.
+  const nlohmann::json rejected = side->ObjectOr("/counts/rejected", nlohmann::json::object());
+  for (const auto& [reason, count] : rejected.items()) side->Count("/counts/rejected/" + reason);
   (*summary)["session"] = side->String("/session", "");
   (*summary)["session_name"] = side->String("/session_name", "");
   (*summary)["samples"] = {{"file", (dir / "samples.npy").string()},
                            {"photos", side->Count("/counts/photos", 0)},
                            {"pixels_examined", side->Count("/counts/pixels_examined", 0)},
                            {"accepted", side->Count("/counts/accepted", 0)},
-                           {"rejected", side->ObjectOr("/counts/rejected", nlohmann::json::object())}};
+                           {"rejected", rejected}};
   // Exposure advice: the sentences of derender's warnings, when it had any.
   nlohmann::json warnings = nlohmann::json::array();
   const nlohmann::json list = side->ValueOr("/exposure/warnings", nlohmann::json::array());

@@ -2,6 +2,7 @@
 // a folder holding one, is refused even with --overwrite, with a one-line message naming the output,
 // and the input is left byte for byte as it was. Each case was a data-destroying run before (exit 0).
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -63,11 +64,11 @@ class OutputGuardTest : public ::testing::Test {
 
   // Runs `arguments`, which aim --out at an input; expects a refusal naming the output and every
   // input unchanged.
-  void ExpectRefused(const std::string& arguments) {
+  void ExpectRefused(const std::string& arguments, const std::string& why = "an input of this stage") {
     SCOPED_TRACE(arguments);
     const RunResult result = RunIbrdf(arguments);
     EXPECT_NE(result.exit_code, 0) << result.output;
-    EXPECT_TRUE(result.output.find("an input of this stage") != std::string::npos) << result.output;
+    EXPECT_TRUE(result.output.find(why) != std::string::npos) << result.output;
     EXPECT_LE(std::count(result.output.begin(), result.output.end(), '\n'), 1) << "one line: " << result.output;
     for (const auto& [path, bytes] : before_) {
       ASSERT_TRUE(fs::exists(path)) << path << " was destroyed";
@@ -102,6 +103,78 @@ TEST_F(OutputGuardTest, Derender) {
   ExpectRefused("derender " + session_ + " --out " + session_ + " --overwrite");
   // The sidecar <out>.json must not land on the manifest either.
   ExpectRefused("derender " + session_ + " --out " + session_ + "/session --overwrite");
+}
+
+// The sidecar <out>.json is a file the user did not name: with --out SESSION/truth it would fall on
+// the session's truth.json, which no --overwrite may replace.
+TEST_F(OutputGuardTest, DerenderSidecarOnTheSessionsTruthFile) {
+  ExpectRefused("derender " + session_ + " --out " + session_ + "/truth --overwrite", "not a file this stage wrote");
+  ExpectRefused("derender " + session_ + " --out " + material_.substr(0, material_.size() - 5) + " --overwrite",
+                "not a file this stage wrote");
+  // Its own earlier sidecar is replaced.
+  const std::string out = dir_ / "work/derendered.npy";
+  ASSERT_EQ(RunIbrdf("derender " + session_ + " --out " + out).exit_code, 0);
+  const RunResult again = RunIbrdf("derender " + session_ + " --out " + out + " --overwrite");
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+}
+
+// `scan X --out mat` writes mat and mat.json: beside a material file mat.json, refused.
+TEST_F(OutputGuardTest, ScanSidecarOnAnUnrelatedFile) {
+  const std::string material_stem = material_.substr(0, material_.size() - 5);
+  ExpectRefused("scan " + ply_ + " --out " + material_stem + " --overwrite", "not a file this stage wrote");
+  // Its own earlier sidecar is replaced (a patch of 8 x 8 points: enough for the scan to run).
+  const std::string patch = dir_ / "scan/patch.ply";
+  {
+    std::ofstream ply(patch);
+    ply << "ply\nformat ascii 1.0\nelement vertex 64\nproperty float x\nproperty float y\nproperty float z\n"
+           "element face 98\nproperty list uchar int vertex_indices\nend_header\n";
+    for (int i = 0; i < 8; ++i) {
+      for (int j = 0; j < 8; ++j) ply << 0.01 * i << " " << 0.01 * j << " " << 0.001 * std::sin(i + j) << "\n";
+    }
+    for (int i = 0; i < 7; ++i) {
+      for (int j = 0; j < 7; ++j) {
+        const int a = i * 8 + j;
+        ply << "3 " << a << " " << a + 1 << " " << a + 8 << "\n3 " << a + 1 << " " << a + 9 << " " << a + 8 << "\n";
+      }
+    }
+  }
+  const std::string out = dir_ / "scan/clean.ply";
+  const RunResult first = RunIbrdf("scan " + patch + " --out " + out);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  const RunResult again = RunIbrdf("scan " + patch + " --out " + out + " --overwrite");
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+}
+
+// An input named like a temporary of the output would be removed as a leftover of an interrupted write.
+TEST_F(OutputGuardTest, InputNamedLikeATemporaryOfTheOutput) {
+  const std::string hidden = dir_ / "work/.checked.tmp-999999-0.npy";
+  fs::copy_file(samples_, hidden);
+  fs::copy_file(SidecarPath(samples_), SidecarPath(hidden));
+  before_.emplace_back(SidecarPath(hidden), ReadBytes(SidecarPath(hidden)));
+  ExpectRefused("check " + hidden + " --out " + dir_ / "work/checked.json --overwrite",
+                "named like a temporary of this output");
+}
+
+// lights calibrate: --out and its report beside it on a placement's photo, and --write-session (a whole
+// folder, replaced) on the session it applies the lights to.
+TEST_F(OutputGuardTest, LightsCalibrate) {
+  const std::string mirror = dir_ / "mirror";
+  const RunResult synth = RunIbrdf("lights synth --out " + mirror + " --lights 4");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  std::string photo;
+  for (const auto& entry : fs::recursive_directory_iterator(mirror)) {
+    if (entry.is_regular_file() && entry.path().filename() != "session.json") photo = entry.path().string();
+  }
+  ASSERT_FALSE(photo.empty());
+  before_.emplace_back(photo, ReadBytes(photo));
+  before_.emplace_back(mirror + "/session.json", ReadBytes(mirror + "/session.json"));
+  ExpectRefused("lights calibrate " + mirror + " --out " + photo + " --overwrite");
+  const std::string lights = dir_ / "work/lights.json";
+  ExpectRefused("lights calibrate " + mirror + " --out " + lights + " --apply-to " + session_ + " --write-session " +
+                session_ + " --overwrite");
+  ExpectRefused("lights calibrate " + mirror + " --out " + lights + " --apply-to " + session_ + " --write-session " +
+                dir_.str() + " --overwrite");
+  EXPECT_FALSE(fs::exists(lights));
 }
 
 TEST_F(OutputGuardTest, Reconstruct) {

@@ -128,17 +128,17 @@ TEST(ReportCli, BadOptionValuesAreUsageErrors) {
   const struct {
     std::string arguments, named, output;
   } cases[] = {
-      {"derender " + dir / "none" + " --out " + dir / "x.npy" + " --stride 0", "pixel_stride", dir / "x.npy"},
-      {"derender " + dir / "none" + " --out " + dir / "x.npy" + " --max-theta-i-deg 95", "max_theta_i_deg",
+      {"derender " + dir / "none" + " --out " + dir / "x.npy" + " --stride 0", "--stride >= 1", dir / "x.npy"},
+      {"derender " + dir / "none" + " --out " + dir / "x.npy" + " --max-theta-i-deg 95", "--max-theta-i-deg",
        dir / "x.npy"},
       {"reconstruct " + dir / "none.npy" + " --out " + dir / "r" + " --lobes 7", "--lobes", dir / "r"},
       {"reconstruct " + dir / "none.npy" + " --out " + dir / "r" + " --fill sideways", "--fill", dir / "r"},
       {"reconstruct " + dir / "none.npy" + " --out " + dir / "r" + " --degree 5", "--degree", dir / "r"},
-      {"check " + dir / "none.npy" + " --out " + dir / "c.json" + " --phi-bin-deg 7", "phi_bin_deg", dir / "c.json"},
-      {"report " + dir.str() + " --out " + dir / "rep" + " --render-size-px 8", "render_size_px", dir / "rep"},
-      {"report " + dir.str() + " --out " + dir / "rep" + " --held-out 99", "held_out_photos", dir / "rep"},
+      {"check " + dir / "none.npy" + " --out " + dir / "c.json" + " --phi-bin-deg 7", "--phi-bin-deg", dir / "c.json"},
+      {"report " + dir.str() + " --out " + dir / "rep" + " --render-size-px 8", "--render-size-px", dir / "rep"},
+      {"report " + dir.str() + " --out " + dir / "rep" + " --held-out 99", "--held-out", dir / "rep"},
       {"run " + dir / "none" + " --out " + dir / "run" + " --stride 0", "--stride", dir / "run"},
-      {"synth --material " + material + " --out " + dir / "s" + " --photos 0", "ibrdf synth", dir / "s"},
+      {"synth --material " + material + " --out " + dir / "s" + " --photos 0", "--photos >= 1", dir / "s"},
   };
   for (const auto& c : cases) {
     const RunResult result = RunIbrdf(c.arguments);

@@ -366,6 +366,12 @@ TEST(MeshDerender, MissingCorruptOrNormalFreeMeshIsAClearError) {
     out << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n";
   }
   expect_error(WithMesh(analytic, "broken.ply"), "broken.ply");
+  // A vertex at 3e38 m: the mesh is named, not "no photo sees the sample" against session.json.
+  ScanMesh far = MakeUvEllipsoid(Eigen::Vector3d::Constant(0.04), 20, 40);
+  far.points[7].x() = 3e38;
+  WritePly(dir / "s/far.ply", far);
+  expect_error(WithMesh(analytic, "far.ply"), "far.ply");
+  expect_error(WithMesh(analytic, "far.ply"), "vertex 7 lies at");
   // Ten metres above the scene: no photo sees it.
   WritePly(dir / "s/sphere.ply", MakeUvEllipsoid(Eigen::Vector3d::Constant(0.04), 20, 40));
   const Sim3d away(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 10), 1.0);

@@ -279,5 +279,65 @@ TEST(PlyIo, NegativeIndicesAndNonFiniteValuesAreErrors) {
   ExpectPlyError(dir / "big.ply", "negative or too large");
 }
 
+// A binary range grid of 2 x 3 cells, each holding its vertex, with `declared` vertices in the header.
+std::string BinaryRangeGrid(int declared) {
+  std::string ply = "ply\nformat binary_little_endian 1.0\nobj_info num_cols 3\nobj_info num_rows 2\nelement vertex " +
+                    std::to_string(declared) +
+                    "\nproperty float x\nproperty float y\nproperty float z\nelement range_grid 6\n"
+                    "property list uchar int vertex_indices\nend_header\n";
+  for (int v = 0; v < 6; ++v) {
+    const float p[3] = {0.001f * (v % 3), 0.001f * (v / 3), 0.5f};
+    ply.append(reinterpret_cast<const char*>(p), sizeof(p));
+  }
+  for (int32_t v = 0; v < 6; ++v) {
+    ply.push_back('\1');
+    ply.append(reinterpret_cast<const char*>(&v), sizeof(v));
+  }
+  return ply;
+}
+
+// A vertex count one too high in a binary range grid: the extra vertex takes the first cells' bytes and
+// the cells after it re-synchronize, so the byte count comes out even and the grid loses three cells.
+// The data no longer matches the header, which must be an error naming the elements and counts.
+TEST(PlyIo, BinaryRangeGridWithWrongVertexCountIsAnError) {
+  ScratchDir dir;
+  WriteText(dir / "ok.ply", BinaryRangeGrid(6));
+  const ScanMesh mesh = ReadPly(dir / "ok.ply");
+  EXPECT_EQ(mesh.points.size(), 6u);
+  EXPECT_EQ(mesh.grid.At(1, 2), 5);
+  WriteText(dir / "plus1.ply", BinaryRangeGrid(7));
+  ExpectPlyError(dir / "plus1.ply", "3 of the 6 range_grid cells hold a vertex");
+  ExpectPlyError(dir / "plus1.ply", "the header declares vertex 7, range_grid 6");
+  WriteText(dir / "minus1.ply", BinaryRangeGrid(5));
+  ExpectPlyError(dir / "minus1.ply", "the header declares vertex 5, range_grid 6");
+}
+
+// A coordinate no scan of a sample has (3e38 m, finite as a float) is an error naming the vertex.
+TEST(PlyIo, AbsurdCoordinateIsAnError) {
+  ScratchDir dir;
+  std::string text = kTriangleAscii;
+  text.replace(text.find("1 0 0\n"), 6, "3e38 0 0\n");
+  WriteText(dir / "far.ply", text);
+  ExpectPlyError(dir / "far.ply", "vertex 1 lies at");
+}
+
+// Bytes left after the last element: the error names the elements and the counts the header declares.
+TEST(PlyIo, BinaryTrailingBytesNameTheElementsAndCounts) {
+  ScratchDir dir;
+  std::string ply =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  ply.append(reinterpret_cast<const char*>(p), sizeof(p));
+  const int32_t face[3] = {0, 1, 2};
+  ply.push_back('\3');
+  ply.append(reinterpret_cast<const char*>(face), sizeof(face));
+  WriteText(dir / "exact.ply", ply);
+  EXPECT_EQ(ReadPly(dir / "exact.ply").faces.size(), 1u);
+  WriteText(dir / "long.ply", ply + std::string(12, '\0'));
+  ExpectPlyError(dir / "long.ply", "12 bytes after");
+  ExpectPlyError(dir / "long.ply", "the header declares vertex 3, face 1");
+}
+
 }  // namespace
 }  // namespace ibrdf

@@ -170,6 +170,15 @@ TEST_F(SummaryTest, WronglyTypedKeyIsAnErrorNamingFileAndKey) {
   EXPECT_ERROR_NAMING(Build(), dir_ / "run/samples.npy.json", "/counts/accepted: expected a non-negative integer");
 }
 
+// A rejection count that is no count is blamed on the sidecar that holds it, not on summary.json.
+TEST_F(SummaryTest, WronglyTypedRejectionCountNamesTheSidecar) {
+  json sidecar = Sidecar();
+  sidecar["counts"]["rejected"]["mixed_pixel"] = "some";
+  WriteJson(dir_ / "run/samples.npy.json", sidecar);
+  EXPECT_ERROR_NAMING(Build(), dir_ / "run/samples.npy.json",
+                      "/counts/rejected/mixed_pixel: expected a non-negative integer");
+}
+
 // Optional keys absent take their defaults; files absent leave their section out.
 TEST_F(SummaryTest, AbsentOptionalKeysAndFiles) {
   json sidecar = Sidecar();
