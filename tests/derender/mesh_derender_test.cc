@@ -19,7 +19,7 @@
 #include "core/image_io.h"
 #include "core/json_reader.h"
 #include "derender/analytic_sample.h"
-#include "derender/radiance_image.h"
+#include "radiometry/radiance_image.h"
 #include "scan/ply_io.h"
 #include "synth/synthetic_scan.h"
 #include "tests/test_util.h"
