@@ -82,8 +82,8 @@ class MemoryFiles {
     std::filesystem::remove_all(dir_, ignored);
     std::filesystem::create_directories(dir_);
     std::atexit([] {
-      std::error_code ignored;
-      std::filesystem::remove_all(Get().dir_, ignored);
+      std::error_code error;
+      std::filesystem::remove_all(Get().dir_, error);
     });
   }
 
@@ -129,7 +129,8 @@ inline bool& MustFail() {
 }
 
 // Runs `read`; returns normally for no exception or an ibrdf::Error naming a file under `dir`, aborts
-// for anything else (and for no exception when MustFail()).
+// for anything else (and for no exception when MustFail()). With IBRDF_FUZZ_VERBOSE set, prints each
+// refusal (to see how deep a corpus reaches).
 inline void ExpectCleanFailure(const std::string& dir, const std::function<void()>& read) {
   try {
     read();
@@ -139,6 +140,8 @@ inline void ExpectCleanFailure(const std::string& dir, const std::function<void(
     }
   } catch (const Error& error) {
     const std::string message = error.what();
+    static const bool verbose = std::getenv("IBRDF_FUZZ_VERBOSE") != nullptr;
+    if (verbose) std::fprintf(stderr, "  refused: %s\n", message.c_str());
     if (message.find(dir) == std::string::npos) {
       std::fprintf(stderr, "reader error names no input file: %s\n", message.c_str());
       std::abort();

@@ -193,7 +193,6 @@ fitted = dict(chart, matrix=[[1.2, -0.1, -0.1], [-0.05, 1.1, -0.05], [0.0, -0.2,
 put("corpus", "colour_matrix", "fitted.json", json.dumps(fitted))
 put("corpus", "colour_matrix", "xyz.json", json.dumps(dict(chart, space="xyz", matrix=[[0.4, 0.36, 0.18], [0.21, 0.72, 0.07], [0.02, 0.12, 0.95]])))
 put("regressions", "colour_matrix", "singular.json", json.dumps(dict(chart, matrix=[[1, 2, 3], [2, 4, 6], [0, 0, 1]])))
-put("regressions", "colour_matrix", "nan_matrix.json", json.dumps(dict(chart, matrix=[[1, 0, 0], [0, 1, 0], [0, 0, float("nan")]])))
 put("regressions", "colour_matrix", "patches_without_matrix.json", json.dumps(dict(chart, patches=fitted["patches"])))
 put("regressions", "colour_matrix", "negative_residual.json", json.dumps(dict(fitted, patches=[{"name": "dark skin", "residual": -1}])))
 put("regressions", "colour_matrix", "no_photos.json", json.dumps(dict(chart, photos=[])))
@@ -210,7 +209,7 @@ put("regressions", "recipe", "missing_material.json", json.dumps(dict(recipe, ma
 put("regressions", "recipe", "number_arg.json", json.dumps(dict(recipe, synth=["--photos", 4])))
 put("regressions", "recipe", "unknown_key.json", json.dumps(dict(recipe, extra=1)))
 batch = {"format": "ibrdf-batch", "version": 1, "out": "batch-out",
-         "sessions": ["s1", "r1/recipe.json", {"path": "s*", "name": "glob", "options": {"stride": 4}}],
+         "sessions": ["s1", "r1/recipe.json", {"path": "s1", "name": "named", "options": {"stride": 4}}],
          "options": {"stride": 2, "fits": True, "report": False, "check_regression": False, "degree": 1,
                      "radius_h_deg": 3, "radius_d_deg": 6},
          "threads_per_job": 2, "mem_mb_per_job": 4000, "runtime_min_per_job": 60, "compare": ["r"]}

@@ -30,6 +30,10 @@ inline nlohmann::json SpliceSession() {
 template <typename Pick>
 void LoadSpliced(const uint8_t* data, size_t size, const std::string& name, const std::string& key, Pick pick) {
   MemoryFiles& files = MemoryFiles::Get();
+  // The manifest's photos and those a chart or lights file may name (the reader checks they exist).
+  for (const char* photo : {"photos/000.png", "photos/001.png", "calibration/colour-chart.png"}) {
+    files.Fixture(photo, "not read");
+  }
   const std::string path = files.Put(name, data, size);
   ExpectCleanFailure(files.dir(), [&] {
     const nlohmann::json block = ReadJsonFile(path);
