@@ -137,17 +137,19 @@ BASE = {
     ("derender",): (["--stride", "2"], ["s", "--out", "OUT.npy"]),
     ("reconstruct",): (["--no-fits", "--no-bsdf"], ["r/samples.npy", "--out", "OUT"]),
     ("check",): ([], ["r/samples.npy", "--out", "OUT.json"]),
-    ("report",): (["--render-size-px", "32", "--no-explorer"], ["r", "--out", "OUT"]),
+    ("report",): (["--render-size-px", "32", "--no-explorer"], ["r", "--out", "OUT", "--held-out", "0"]),
     ("run",): (["--no-report", "--no-fits", "--stride", "2"], ["s", "--out", "OUT"]),
     ("batch",): (["-n"], ["b.json"]),
     ("library",): (["--sphere-size-px", "16"], ["r", "--out", "OUT"]),
     ("compare",): ([], ["r/samples.npy", "--truth", "s/truth.json"]),
 }
-# Options whose random values would make a case run for minutes (a full batch, full-size renders).
+# Options whose random values would make a case run for minutes (a full batch, full-size renders,
+# the report's held-out refits).
 SLOW = {("batch",): {"--cores", "--slurm", "--profile", "--snakemake-args", "-n", "--dry-run"},
         ("synth",): {"--shape", "--scan-spacing-m", "--truth-mesh-spacing-m", "--exposure-target"},
         ("lights", "synth"): {"--focal-px", "--radius-m", "--distance-m"},
         ("targets",): {"--dpi"},
+        ("report",): {"--held-out"},
         ("compare",): {"--lookups"},
         ("reconstruct",): {"--fit-samples", "--fit-start-samples", "--bandwidth-samples"}}
 
@@ -216,7 +218,7 @@ def main():
     parser.add_argument("--runs", type=int, default=12, help="cases per subcommand")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--jobs", type=int, default=4)
-    parser.add_argument("--timeout", type=float, default=60, help="seconds one case may run (a hang)")
+    parser.add_argument("--timeout", type=float, default=120, help="seconds one case may run (a hang)")
     parser.add_argument("--keep", action="store_true", help="keep the temporary folder")
     a = parser.parse_args()
     binary = os.path.abspath(a.binary)
