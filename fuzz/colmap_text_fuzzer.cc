@@ -8,7 +8,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::vector<std::string> parts = ibrdf::fuzz::SplitParts(data, size, 3);
   const char* names[3] = {"cameras.txt", "images.txt", "points3D.txt"};
   for (int i = 0; i < 3; ++i) {
-    ibrdf::fuzz::WriteBytes(dir + "/" + names[i], reinterpret_cast<const uint8_t*>(parts[i].data()), parts[i].size());
+    ibrdf::fuzz::MemoryFiles::Get().Put(names[i], parts[i]);
   }
   ibrdf::fuzz::ExpectCleanFailure(dir, [&] { ibrdf::ColmapModel::ReadText(dir).Validate(dir); });
   return 0;

@@ -18,8 +18,9 @@ def put(kind, target, name, data):
         f.write(data if isinstance(data, bytes) else data.encode())
 
 
-for kind in ("corpus", "regressions"):
-    shutil.rmtree(os.path.join(here, kind), ignore_errors=True)
+# The regressions are all written here; the corpora also hold what fuzzing grew (merged with
+# libFuzzer's -merge=1, files named by their hash), which is kept.
+shutil.rmtree(os.path.join(here, "regressions"), ignore_errors=True)
 
 # PLY
 tri = ("ply\nformat ascii 1.0\ncomment a triangle\nelement vertex 3\nproperty float x\nproperty float y\n"
@@ -142,7 +143,6 @@ put("corpus", "merl", "header_only.binary", struct.pack("<3i", 90, 90, 180))
 put("corpus", "merl", "wrong_dims.binary", struct.pack("<3i", 90, 90, 360) + b"\0" * 64)
 put("regressions", "merl", "negative_dims.binary", struct.pack("<3i", -90, 90, 180))
 put("regressions", "merl", "short.binary", b"\x5a")
-print("seeds written under", here)
 
 # RGL .bsdf tensor files: header "tensor_file\0", version 1.0, field count, then per field
 # name length, name, rank, dtype, offset, shape; data at the offsets (core/tensor_file.cc).
@@ -166,3 +166,124 @@ put("corpus", "bsdf", "fields.bsdf",
 put("corpus", "bsdf", "empty_fields.bsdf", tensor_file([]))
 put("regressions", "bsdf", "version_2.bsdf", tensor_file([], version=(2, 0)))
 put("regressions", "bsdf", "past_the_end.bsdf", tensor_file([("theta_i", 10, [1 << 40], b"")]))
+
+
+# The lights file of `ibrdf lights calibrate` and a session's colour_chart block (fuzz/session_splice.h
+# reads them inside a valid session).
+lights = {"format": "ibrdf-lights", "version": 1, "intensity_reference": "relative: not measured",
+          "lights": [{"id": "L1", "kind": "directional", "direction": [0.1, 0.2, 0.97], "intensity": [1, 1, 1]},
+                     {"id": "L2", "kind": "point", "position": [0.5, 0.2, 0.8], "intensity": [2, 2, 2.5]}]}
+put("corpus", "lights", "two_lights.json", json.dumps(lights, indent=1))
+put("corpus", "lights", "point_light.json", json.dumps(
+    {"format": "ibrdf-lights", "version": 1, "lights": [{"id": "L1", "kind": "point", "position": [0, 0, 1]}]}))
+put("corpus", "lights", "lights_array.json", json.dumps(lights["lights"]))
+put("regressions", "lights", "zero_direction.json", json.dumps({"lights": [{"id": "L1", "kind": "directional", "direction": [0, 0, 0], "intensity": [1, 1, 1]}]}))
+put("regressions", "lights", "duplicate_id.json", json.dumps({"lights": [lights["lights"][0], lights["lights"][0]]}))
+put("regressions", "lights", "negative_intensity.json", json.dumps({"lights": [dict(lights["lights"][0], intensity=[-1, 1, 1])]}))
+put("regressions", "lights", "unknown_kind.json", json.dumps({"lights": [{"id": "L1", "kind": "area", "direction": [0, 0, 1], "intensity": [1, 1, 1]}]}))
+patch_names = ["dark skin", "light skin", "blue sky", "foliage", "blue flower", "bluish green", "orange",
+               "purplish blue", "moderate red", "purple", "yellow green", "orange yellow", "blue", "green", "red",
+               "yellow", "magenta", "cyan", "white", "neutral 8", "neutral 6.5", "neutral 5", "neutral 3.5", "black"]
+chart = {"chart": "colorchecker_classic_24", "space": "linear_srgb",
+         "photos": [{"file": "calibration/colour-chart.png", "exposure_s": 4.59, "gain": 1.0, "light": "L1"}],
+         "corners": [[178.6, 166.8], [623.0, 165.9], [623.1, 434.2], [178.6, 433.2]]}
+put("corpus", "colour_matrix", "corners.json", json.dumps(chart))
+fitted = dict(chart, matrix=[[1.2, -0.1, -0.1], [-0.05, 1.1, -0.05], [0.0, -0.2, 1.2]],
+              patches=[{"name": n, "residual": 0.01} for n in patch_names[:23]] + [{"name": "black", "excluded": "too dark"}])
+put("corpus", "colour_matrix", "fitted.json", json.dumps(fitted))
+put("corpus", "colour_matrix", "xyz.json", json.dumps(dict(chart, space="xyz", matrix=[[0.4, 0.36, 0.18], [0.21, 0.72, 0.07], [0.02, 0.12, 0.95]])))
+put("regressions", "colour_matrix", "singular.json", json.dumps(dict(chart, matrix=[[1, 2, 3], [2, 4, 6], [0, 0, 1]])))
+put("regressions", "colour_matrix", "patches_without_matrix.json", json.dumps(dict(chart, patches=fitted["patches"])))
+put("regressions", "colour_matrix", "negative_residual.json", json.dumps(dict(fitted, patches=[{"name": "dark skin", "residual": -1}])))
+put("regressions", "colour_matrix", "no_photos.json", json.dumps(dict(chart, photos=[])))
+
+# Recipes (the fuzz folder holds material.json) and batch configs (it holds s1/session.json and
+# r1/recipe.json).
+recipe = {"format": "ibrdf-recipe", "version": 1, "name": "r", "description": "d", "paper": "p",
+          "material": "material.json", "synth": ["--sample", "sphere", "--photos", "4", "--seed", "1"]}
+put("corpus", "recipe", "recipe.json", json.dumps(recipe, indent=1))
+put("corpus", "recipe", "minimal.json", json.dumps({"format": "ibrdf-recipe", "version": 1, "name": "m",
+                                                    "material": "material.json", "synth": []}))
+put("regressions", "recipe", "sets_out.json", json.dumps(dict(recipe, synth=["--out", "x"])))
+put("regressions", "recipe", "missing_material.json", json.dumps(dict(recipe, material="absent.json")))
+put("regressions", "recipe", "number_arg.json", json.dumps(dict(recipe, synth=["--photos", 4])))
+put("regressions", "recipe", "unknown_key.json", json.dumps(dict(recipe, extra=1)))
+batch = {"format": "ibrdf-batch", "version": 1, "out": "batch-out",
+         "sessions": ["s1", "r1/recipe.json", {"path": "s1", "name": "named", "options": {"stride": 4}}],
+         "options": {"stride": 2, "fits": True, "report": False, "check_regression": False, "degree": 1,
+                     "radius_h_deg": 3, "radius_d_deg": 6},
+         "threads_per_job": 2, "mem_mb_per_job": 4000, "runtime_min_per_job": 60, "compare": ["r"]}
+put("corpus", "batch_config", "batch.json", json.dumps(batch, indent=1))
+put("corpus", "batch_config", "minimal.json", json.dumps({"format": "ibrdf-batch", "version": 1, "out": "o", "sessions": ["?1"]}))
+put("regressions", "batch_config", "duplicate_name.json", json.dumps(dict(batch, sessions=["s1", "s1"])))
+put("regressions", "batch_config", "no_match.json", json.dumps(dict(batch, sessions=["nothing*"])))
+put("regressions", "batch_config", "bad_name.json", json.dumps(dict(batch, sessions=[{"path": "s1", "name": "a/b"}])))
+put("regressions", "batch_config", "zero_threads.json", json.dumps(dict(batch, threads_per_job=0)))
+put("regressions", "batch_config", "negative_stride.json", json.dumps(dict(batch, options={"stride": -1})))
+
+# TIFF and DNG headers: a 4 x 2 8-bit grey strip with Make, Model and an EXIF IFD (ExposureTime,
+# FNumber, ISO); the DNG adds DNGVersion and a CFA layout for LibRaw.
+def tiff(extra_ifd0=(), width=4, height=2, spp=1, bps=8, exif=True):
+    entries, blobs = [], []
+    def ascii_tag(tag, text):
+        entries.append((tag, 2, len(text) + 1, text.encode() + b"\0"))
+    pixels = bytes(range(width * height * spp))
+    entries += [(256, 3, 1, width), (257, 3, 1, height), (258, 3, 1, bps), (259, 3, 1, 1), (262, 3, 1, 1 if spp == 1 else 2),
+                (273, 4, 1, "PIXELS"), (277, 3, 1, spp), (278, 3, 1, height), (279, 4, 1, len(pixels))]
+    ascii_tag(271, "ibrdf"); ascii_tag(272, "fuzz camera")
+    if exif:
+        entries.append((34665, 4, 1, "EXIF"))
+    entries += list(extra_ifd0)
+    entries.sort(key=lambda e: e[0])
+    exif_entries = [(33434, 5, 1, struct.pack("<II", 1, 125)), (33437, 5, 1, struct.pack("<II", 8, 1)), (34855, 3, 1, 200)]
+    def ifd_size(n):
+        return 2 + 12 * n + 4
+    offset = 8 + ifd_size(len(entries))
+    data = bytearray()
+    def place(blob):
+        nonlocal data
+        at = offset + len(data)
+        data += blob + (b"\0" if len(blob) % 2 else b"")
+        return at
+    out_entries = []
+    sizes = {1: 1, 2: 1, 3: 2, 4: 4, 5: 8, 7: 1}
+    pix_at = exif_at = None
+    for tag, typ, count, value in entries:
+        out_entries.append([tag, typ, count, value])
+    pix_at = place(pixels)
+    exif_at = offset + len(data)
+    exif_blob_base = exif_at + ifd_size(len(exif_entries))
+    exif_data = bytearray()
+    exif_ifd = struct.pack("<H", len(exif_entries))
+    for tag, typ, count, value in exif_entries:
+        if isinstance(value, bytes):
+            exif_ifd += struct.pack("<HHII", tag, typ, count, exif_blob_base + len(exif_data))
+            exif_data += value
+        else:
+            exif_ifd += struct.pack("<HHIHH", tag, typ, count, value, 0)
+    exif_ifd += struct.pack("<I", 0)
+    data += exif_ifd + exif_data
+    ifd = struct.pack("<H", len(out_entries))
+    for tag, typ, count, value in out_entries:
+        if value == "PIXELS":
+            value = pix_at
+        elif value == "EXIF":
+            value = exif_at
+        if isinstance(value, bytes):
+            if len(value) <= 4:
+                ifd += struct.pack("<HHI", tag, typ, count) + value.ljust(4, b"\0")
+            else:
+                ifd += struct.pack("<HHII", tag, typ, count, place(value))
+        elif typ == 3:
+            ifd += struct.pack("<HHIHH", tag, typ, count, value, 0)
+        else:
+            ifd += struct.pack("<HHII", tag, typ, count, value)
+    ifd += struct.pack("<I", 0)
+    return b"II*\0" + struct.pack("<I", 8) + ifd + bytes(data)
+put("corpus", "image_header", "grey.tif", tiff())
+put("corpus", "image_header", "rgb16.tif", tiff(spp=3, bps=16, exif=False))
+put("corpus", "image_header", "cfa.dng", tiff([(50706, 1, 4, bytes([1, 4, 0, 0])), (33421, 3, 2, struct.pack("<HH", 2, 2)),
+                                              (33422, 1, 4, bytes([0, 1, 1, 2])), (50708, 2, 5, b"fuzz\0")], width=4, height=2))
+put("regressions", "image_header", "truncated.tif", tiff()[:20])
+put("regressions", "image_header", "zero_width.tif", tiff(width=0))
+print("seeds written under", here)

@@ -7,8 +7,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string dir = ibrdf::fuzz::ScratchDir();
-  const std::string path = dir + "/material.json";
-  ibrdf::fuzz::WriteBytes(path, data, size);
+  const std::string path = ibrdf::fuzz::PutFile("material.json", data, size);
   ibrdf::fuzz::ExpectCleanFailure(dir, [&] { ibrdf::LoadMaterial(path); });
   return 0;
 }

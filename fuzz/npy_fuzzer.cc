@@ -6,8 +6,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string dir = ibrdf::fuzz::ScratchDir();
-  const std::string path = dir + "/input.npy";
-  ibrdf::fuzz::WriteBytes(path, data, size);
+  const std::string path = ibrdf::fuzz::PutFile("input.npy", data, size);
   ibrdf::fuzz::ExpectCleanFailure(dir, [&] { ibrdf::ReadSamples(path); });
   std::vector<size_t> shape;
   ibrdf::fuzz::ExpectCleanFailure(dir, [&] { ibrdf::ReadNpyArray(path, &shape, true); });

@@ -5,8 +5,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string dir = ibrdf::fuzz::ScratchDir();
-  const std::string path = dir + "/session.json";
-  ibrdf::fuzz::WriteBytes(path, data, size);
+  const std::string path = ibrdf::fuzz::PutFile("session.json", data, size);
   ibrdf::fuzz::ExpectCleanFailure(dir, [&] { ibrdf::Session::Load(path); });
   return 0;
 }

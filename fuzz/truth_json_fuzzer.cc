@@ -4,8 +4,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string dir = ibrdf::fuzz::ScratchDir();
-  const std::string path = dir + "/truth.json";
-  ibrdf::fuzz::WriteBytes(path, data, size);
+  const std::string path = ibrdf::fuzz::PutFile("truth.json", data, size);
   ibrdf::fuzz::ExpectCleanFailure(dir, [&] { ibrdf::LoadTruthMaterial(path); });
   return 0;
 }
