@@ -59,16 +59,23 @@ nlohmann::json ReadJsonFile(const std::string& path) {
     }
     return true;
   };
+  // The library's message without its "[json.exception.parse_error.101] " tag, which means nothing to
+  // the user: "parse error at line 1, column 1: syntax error while parsing value ...".
+  const auto message = [](const nlohmann::json::exception& e) {
+    const std::string what = e.what();
+    const size_t tag_end = what.rfind("] ", what.find(' '));
+    return what.rfind("[json.exception.", 0) == 0 && tag_end != std::string::npos ? what.substr(tag_end + 2) : what;
+  };
   try {
     return nlohmann::json::parse(text, callback);
   } catch (const nlohmann::json::parse_error& e) {
     // Turn the byte offset into a line number.
     const size_t offset = std::min<size_t>(e.byte, text.size());
     const long line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(offset), '\n');
-    ThrowError(path + ":" + std::to_string(line), std::string("invalid JSON: ") + e.what());
+    ThrowError(path + ":" + std::to_string(line), "invalid JSON: " + message(e));
   } catch (const nlohmann::json::exception& e) {
     // E.g. a number out of range ("1e400"): the library's message names no file.
-    ThrowError(path, std::string("invalid JSON: ") + e.what());
+    ThrowError(path, "invalid JSON: " + message(e));
   }
 }
 

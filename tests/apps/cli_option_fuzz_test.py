@@ -29,7 +29,7 @@ FORBIDDEN = ["Check failed", "assert", "terminate called", "what():", "Segmentat
 
 # Values a user would give (so that cases get past the parser into the stage) and hostile ones.
 PLAUSIBLE = {"int": ["1", "2", "3"], "float": ["0.25", "1", "3", "30"],
-             "text": ["s", "s/session.json", "r/samples.npy", "m.json", "r", "mirror", "s/truth.json"],
+             "text": ["s", "s/session.json", "r/samples.npy", "m.json", "r", "mirror", "s/truth.json", "w"],
              "args": ["--stride 2", ""]}
 INT_VALUES = ["-1", "0", "1", "2", "3", "-2147483649", "2147483648", "99999999999999999999", "1.5", "x", ""]
 FLOAT_VALUES = ["-1", "0", "1e-9", "0.25", "1", "3", "90", "1e300", "-1e300", "nan", "inf", "-inf", "x", "1e", ""]
@@ -108,6 +108,9 @@ def make_fixtures(binary, source, tmp):
     shutil.copy(os.path.join(source, "samples", "materials", "lambertian50.json"), os.path.join(tmp, "m.json"))
     must(["synth", "--material", "m.json", "--out", "s", "--width", "32", "--height", "24", "--photos", "3"])
     must(["run", "s", "--out", "r", "--no-report", "--no-fits"])
+    # A session whose light intensity comes from a white reference (`lights white`'s input).
+    must(["synth", "--material", "m.json", "--out", "w", "--width", "32", "--height", "24", "--photos", "3",
+          "--light-unknown"])
     must(["lights", "synth", "--out", "mirror", "--lights", "2", "--focal-px", "300"])
     os.makedirs(os.path.join(tmp, "rec"))
     with open(os.path.join(tmp, "rec", "recipe.json"), "w") as f:
@@ -131,6 +134,7 @@ BASE = {
     ("synth",): (["--width", "32", "--height", "24", "--photos", "3"], ["--material", "m.json", "--out", "OUT"]),
     ("scan",): ([], ["tri.ply", "--out", "OUT.ply"]),
     ("lights", "calibrate"): ([], ["mirror", "--out", "OUT.json"]),
+    ("lights", "white"): ([], ["w", "--out", "OUT"]),
     ("lights", "synth"): (["--lights", "2", "--focal-px", "300"], ["--out", "OUT"]),
     ("align",): ([], ["s", "--out", "OUT"]),
     ("colour",): ([], ["s", "--out", "OUT"]),

@@ -235,6 +235,22 @@ TEST_F(JsonFileTest, NumberOverflowNamesTheFile) {
   ExpectError([&] { ReadJsonFile(path); }, {path, "invalid JSON"});
 }
 
+// A file that is not JSON at all (a PNG given where a JSON file was asked for): the line and the
+// parser's reason, without the library's "[json.exception.parse_error.101]" tag.
+TEST_F(JsonFileTest, NotJsonGivesTheReasonWithoutTheLibrarysTag) {
+  const std::string path = Path("photo.png");
+  std::ofstream(path) << "\x89PNG\r\n";
+  try {
+    ReadJsonFile(path);
+    ADD_FAILURE() << "expected an Error for " << path;
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(path + ":1"), std::string::npos) << message;
+    EXPECT_NE(message.find("invalid JSON: parse error at line 1"), std::string::npos) << message;
+    EXPECT_EQ(message.find("json.exception"), std::string::npos) << message;
+  }
+}
+
 // WriteJsonFile round-trips through ReadJsonFile and leaves no temporary file behind.
 TEST_F(JsonFileTest, WriteReadRoundTrip) {
   const std::string path = Path("out.json");
