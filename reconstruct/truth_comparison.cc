@@ -16,7 +16,6 @@
 #include "core/rgl_bsdf.h"
 #include "core/sample_file.h"
 #include "core/statistics.h"
-#include "reconstruct/reconstruction_error.h"
 
 namespace ibrdf {
 namespace {
@@ -208,25 +207,6 @@ std::string ComparisonTable(const TruthComparison& comparison) {
   }
   row("all", comparison.overall);
   return table;
-}
-
-CompareOutcome CompareFileWithTruth(const std::string& input, const std::string& truth_path, size_t lookups) {
-  const std::unique_ptr<BrdfModel> truth = LoadTruthFile(truth_path);
-  CompareOutcome outcome;
-  if (IsMerlPath(input)) {
-    const MerlLookupCheck check = CheckMerlLookups(ReadMerl(input), *truth, lookups);
-    outcome.text = check.Brief() + "\n";
-    outcome.json = ToJson(check);
-    outcome.json["table"] = input;
-  } else {
-    const TruthComparison comparison = CompareWithTruth(ReadSamples(input), *truth);
-    outcome.text = ComparisonTable(comparison);
-    outcome.brief = comparison.BriefReport();
-    outcome.json = ToJson(comparison);
-    outcome.json["samples"] = input;
-  }
-  outcome.json["truth"] = truth_path;
-  return outcome;
 }
 
 }  // namespace ibrdf
