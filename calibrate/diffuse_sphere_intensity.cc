@@ -6,6 +6,7 @@
 #include <map>
 
 #include "calibrate/lambertian.h"
+#include "calibrate/report_format.h"
 #include "calibrate/sphere_silhouettes.h"
 #include "core/error.h"
 #include "core/json_reader.h"
@@ -15,12 +16,6 @@
 
 namespace ibrdf {
 namespace {
-
-std::string Fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof(buffer), format, a, b, c, d);
-  return buffer;
-}
 
 double MedianOf(std::vector<double> values) {
   if (values.empty()) return 0.0;
@@ -60,10 +55,10 @@ std::string DiffuseSphereIntensities::BriefReport() const {
                                : std::abs(k - 1 / 2.2) < 0.1 ? "looks gamma-encoded (sRGB-like)"
                                                              : "neither linear nor sRGB-like";
   return "diffuse sphere: " + std::to_string(lights.size()) + " lights, " +
-         (absolute ? Fmt("intensities from albedo (%.3f, %.3f, %.3f)", albedo.x(), albedo.y(), albedo.z())
+         (absolute ? FormatNumbers("intensities from albedo (%.3f, %.3f, %.3f)", albedo.x(), albedo.y(), albedo.z())
                    : std::string("relative intensities (no albedo: mean 1)")) +
-         ", " + std::to_string(pixels) + " pixels; cosine exponent " + Fmt("%.3f", k) + " (" + response + ")" +
-         Fmt("; spread %.2f %% (calibrated directions) / %.2f %% (nominal)", 100 * median_spread,
+         ", " + std::to_string(pixels) + " pixels; cosine exponent " + FormatNumbers("%.3f", k) + " (" + response + ")" +
+         FormatNumbers("; spread %.2f %% (calibrated directions) / %.2f %% (nominal)", 100 * median_spread,
              100 * median_nominal_spread);
 }
 

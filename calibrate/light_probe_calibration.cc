@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "calibrate/report_format.h"
 #include "calibrate/sphere_silhouettes.h"
 #include "core/error.h"
 #include "core/json_reader.h"
@@ -18,12 +19,6 @@
 
 namespace ibrdf {
 namespace {
-
-std::string Fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof(buffer), format, a, b, c, d);
-  return buffer;
-}
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b)) * kDegreesPerRadian;
@@ -70,7 +65,7 @@ std::string LightProbeCalibration::BriefReport() const {
   const char* kind = lights.empty() ? "directional" : LightKindName(lights[0].light.kind);
   return "light probe: " + std::to_string(lights.size()) + " " + kind + " lights from " +
          std::to_string(silhouettes.size()) + " placement" + (silhouettes.size() == 1 ? "" : "s") +
-         Fmt(", uncertainty median %.3f / max %.3f deg; from the nominal: median %.3f / max %.3f deg", median_sigma_deg,
+         FormatNumbers(", uncertainty median %.3f / max %.3f deg; from the nominal: median %.3f / max %.3f deg", median_sigma_deg,
              max_sigma_deg, median_angle_from_nominal_deg, max_angle_from_nominal_deg) +
          "; intensities " + intensity_reference;
 }
@@ -201,7 +196,7 @@ void ObservePlacement(const Session& session, size_t p, const LightProbeOptions&
     observations->rays[id].push_back(ray);
     observations->highlights[id].push_back(highlight);
     observations->files[id].push_back(photo_path);
-    Log(2, id + ": " + highlight.BriefReport() + Fmt(" -> +- %.3f deg", direction.sigma_deg));
+    Log(2, id + ": " + highlight.BriefReport() + FormatNumbers(" -> +- %.3f deg", direction.sigma_deg));
     any = true;
   }
   if (!any) ThrowError(manifest, "no measurement photo of the mirror sphere");
@@ -295,7 +290,7 @@ CalibratedLight CalibrateLight(const Session& first, const Light& nominal, const
       point ? Eigen::Vector3d((c.light.position - center0).normalized()) : c.light.direction;
   c.angle_from_nominal_deg = AngleDeg(NominalDirection(nominal, center0), calibrated_direction);
   if (c.sigma_deg > options.warn_sigma_deg) {
-    Log(1, "warning: " + id + Fmt(" is uncertain: +- %.2f deg (over %.2f deg)", c.sigma_deg, options.warn_sigma_deg));
+    Log(1, "warning: " + id + FormatNumbers(" is uncertain: +- %.2f deg (over %.2f deg)", c.sigma_deg, options.warn_sigma_deg));
   }
   return c;
 }
