@@ -178,6 +178,10 @@ int main(int argc, char** argv) {
     const std::string extras = ExtrasInOrder(app, argc, argv);
     PrintUsageError(app, extras.empty() ? std::string(e.what()) : "unexpected arguments: " + extras);
     return ibrdf::kUsageErrorExitCode;
+  } catch (const CLI::RuntimeError& e) {
+    // A command that has said why it stops (`session init` on an incomplete draft) and asks for this
+    // exit code: no second message.
+    return e.get_exit_code();
   } catch (const CLI::ParseError& e) {
     PrintUsageError(app, e.what());
     return ibrdf::kUsageErrorExitCode;

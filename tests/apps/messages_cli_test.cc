@@ -36,6 +36,20 @@ void WriteSmallSamples(const std::string& path) {
   WriteSamples(path, std::vector<BrdfSample>(8, s));
 }
 
+// `session init` on photos without poses writes its draft, lists what is missing and exits 2, with no
+// second, meaningless line ("ibrdf: error: session: Runtime error").
+TEST(MessagesCli, IncompleteSessionDraftEndsWithItsOwnWords) {
+  ScratchDir dir;
+  const RunResult synth = RunIbrdf("synth --out " + dir / "s" + " --material " + std::string(IBRDF_SAMPLES_DIR) +
+                                   "/materials/lambertian50.json --photos 2 --width 48 --height 36 --effects none");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const RunResult result = RunIbrdf("session init " + dir / "s/photos/000.exr" + " --out " + dir / "draft");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("incomplete: supply the missing items"), std::string::npos) << result.output;
+  EXPECT_EQ(result.output.find("Runtime error"), std::string::npos) << result.output;
+  EXPECT_TRUE(fs::exists(dir / "draft/session.draft.json")) << result.output;
+}
+
 TEST(MessagesCli, MissingRequiredFlagSaysIbrdfError) {
   ScratchDir dir;
   ExpectMessage("synth --out " + dir / "s", 2, {"synth: ", "--material is required"}, {});
