@@ -209,6 +209,22 @@ TEST_F(OutputGuardTest, Report) {
   ExpectRefused("report " + dir_ / "run" + " --out " + dir_ / "run/samples.npy --overwrite");
 }
 
+TEST_F(OutputGuardTest, Colour) {
+  const std::string chart = dir_ / "chart";
+  const RunResult synth = RunIbrdf("synth --out " + chart + " --material " + MaterialPath("lambertian50") +
+                                   " --photos 2 --width 64 --height 48 --colour-chart");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const std::string manifest = ReadBytes(chart + "/session.json");
+  ExpectRefused("colour " + chart + " --out " + chart + " --overwrite");
+  ExpectRefused("colour " + chart + " --out " + dir_.str() + " --overwrite");
+  EXPECT_EQ(ReadBytes(chart + "/session.json"), manifest);
+}
+
+TEST_F(OutputGuardTest, Library) {
+  ExpectRefused("library " + dir_ / "run" + " --out " + dir_ / "run" + " --overwrite", "contain one another");
+  ExpectRefused("library " + dir_ / "run" + " --out " + dir_.str() + " --overwrite", "contain one another");
+}
+
 TEST_F(OutputGuardTest, Run) {
   ExpectRefused("run " + session_ + " --out " + session_);
   ExpectRefused("run " + session_ + " --out " + dir_.str());
