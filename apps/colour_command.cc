@@ -44,10 +44,7 @@ void AddColourCommand(CLI::App& app) {
     if (!session.colour_chart) {
       ThrowError(session.manifest_path, "has no colour_chart block (docs/session-format.md): nothing to fit");
     }
-    std::vector<std::string> inputs = session.InputFiles();
-    inputs.push_back(session.manifest_path);
-    inputs.push_back(session.directory);
-    RequireWritableOutput(args->out, args->overwrite, inputs);
+    RequireWritableOutput(args->out, args->overwrite, SessionInputs(session));
     const ColourChartFit fit = LocateAndFitColourChart(session, args->options, args->detect);
     Log(1, fit.BriefReport());
     for (const ColourPatch& patch : fit.patches) {

@@ -112,10 +112,7 @@ void RunCalibrate(CalibrateArgs& args) {
       ThrowError("--write-session", "needs --apply-to SESSION or --diffuse SESSION (the session to give the lights)");
     }
     // The folder written replaces --write-session whole: never the target's folder or its photos.
-    std::vector<std::string> target_files = target->InputFiles();
-    target_files.push_back(target->manifest_path);
-    target_files.push_back(target->directory);
-    RequireWritableOutput(args.write_session, args.overwrite, target_files);
+    RequireWritableOutput(args.write_session, args.overwrite, SessionInputs(*target));
   } else if (!args.apply_to.empty()) {
     ThrowError("--apply-to", "needs --write-session (where to write the session with the calibrated lights)");
   }
@@ -175,10 +172,7 @@ void AddWhite(CLI::App& group) {
     StageLog stage("lights white");
     RequireValidOptions(args->options, "--min-signal");
     const Session session = Session::Load(args->session);
-    std::vector<std::string> inputs = session.InputFiles();
-    inputs.push_back(session.manifest_path);
-    inputs.push_back(session.directory);
-    RequireWritableOutput(args->out, args->overwrite, inputs);
+    RequireWritableOutput(args->out, args->overwrite, SessionInputs(session));
     const LightCalibrationReport report = WriteLightCalibrationStage(session, args->options, args->out, args->overwrite);
     Log(1, report.BriefReport());
     Log(1, "session with the calibrated lights written to " + args->out + "/session.json");
