@@ -14,6 +14,7 @@
 #include "core/file_util.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "core/output_guard.h"
 #include "core/session.h"
 
 namespace fs = std::filesystem;
@@ -392,12 +393,22 @@ nlohmann::json WhiteReferenceJson(const SessionInitOptions& options, const nlohm
 // Writes session.json when the manifest validates, else session.draft.json with the missing list.
 void WriteManifest(const SessionInitOptions& options, const std::string& out_dir, nlohmann::json json,
                    SessionInitResult* result) {
-  fs::create_directories(out_dir);
   const std::string session_path = (fs::path(out_dir) / "session.json").string();
   const std::string draft_path = (fs::path(out_dir) / "session.draft.json").string();
+  // The manifest lands beside the photos when --out is their folder; never on one of the inputs (a
+  // camera or targets file named session.json), --overwrite or not.
+  std::vector<std::string> inputs = {options.camera_file, options.targets_file};
+  for (const auto* files : {&options.photos, &options.target_photos, &options.white_photos, &options.chart_photos}) {
+    inputs.insert(inputs.end(), files->begin(), files->end());
+  }
+  if (fs::exists(out_dir) && !fs::is_directory(out_dir)) {
+    ThrowError(out_dir, "is a file (--out: the folder to write session.json in)");
+  }
   for (const std::string& path : {session_path, draft_path}) {
+    RequireOutputOutsideInputs(path, inputs);
     if (fs::exists(path) && !options.overwrite) ThrowError(path, "exists; pass --overwrite to replace it");
   }
+  fs::create_directories(out_dir);
   if (result->missing.empty()) {
     const std::string trial = (fs::path(out_dir) / ".session.init.json").string();
     WriteJsonFile(trial, json);

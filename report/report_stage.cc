@@ -21,6 +21,7 @@
 #include "core/json_reader.h"
 #include "core/logging.h"
 #include "core/math.h"
+#include "core/merl_brdf.h"
 #include "core/npy.h"
 #include "core/output_guard.h"
 #include "core/sample_file.h"
@@ -37,7 +38,6 @@
 #include "report/report_png.h"
 #include "report/report_script.h"
 #include "report/sphere_render.h"
-#include "report/table_interpolation.h"
 #include "report/tone_map.h"
 
 namespace fs = std::filesystem;
@@ -57,7 +57,9 @@ struct NamedModel {
 
 // The reconstruction, the fits beside it and the truth, when the run has them.
 struct RunModels {
-  std::unique_ptr<MerlTable> table;
+  // The reconstruction as the report reads it: trilinear between cells (core/merl_brdf.h), whose
+  // staircase of nearest cells would read as structure in a plot.
+  std::unique_ptr<MerlBrdf> table;
   std::string table_path;
   std::vector<std::unique_ptr<BrdfModel>> fits;
   std::vector<std::string> fit_names;
@@ -87,7 +89,7 @@ RunModels LoadRunModels(const fs::path& run_dir, const std::string& reconstructi
   RunModels models;
   models.table_path = ReconstructionTable(run_dir, reconstruction);
   if (!models.table_path.empty()) {
-    models.table = std::make_unique<MerlTable>(ReadMerl(models.table_path));
+    models.table = std::make_unique<MerlBrdf>(models.table_path, MerlLookup::kLinear);
     const fs::path dir = fs::path(models.table_path).parent_path();
     for (const char* fit : {"lafortune", "ggx"}) {
       const fs::path path = dir / (std::string(fit) + ".json");
@@ -105,9 +107,10 @@ RunModels LoadRunModels(const fs::path& run_dir, const std::string& reconstructi
     }
   }
   if (models.table) {
-    const MerlTable* table = models.table.get();
+    const MerlBrdf* table = models.table.get();
     models.named.push_back({"reconstruction", [table](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) {
-                              return InterpolateMerl(*table, wi, wo);
+                              if (wi.z() <= 0.0 || wo.z() <= 0.0) return Eigen::Vector3d(-1.0, -1.0, -1.0);
+                              return table->Lookup(wi, wo);
                             }});
   }
   for (size_t i = 0; i < models.fits.size(); ++i) {

@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "core/output_guard.h"
 #include "core/subprocess.h"
 #include "workflow/build_id.h"
 #include "workflow/workflow_run.h"
@@ -25,6 +26,16 @@ std::string Join(const std::vector<std::string>& words) {
 }  // namespace
 
 void RunBatch(const BatchConfig& config, const std::vector<BatchEntryPlan>& plan, SnakemakeRunOptions run) {
+  // Each run resumes its own folder rather than replacing it, and the library replaces its folder: an
+  // input inside any of them would be lost, so none may hold one (the runs' own guards would stop only
+  // that job, after others had run).
+  std::vector<std::string> inputs = {config.path};
+  for (const BatchEntry& entry : config.entries) inputs.push_back(entry.input);
+  for (const BatchEntry& entry : config.entries) {
+    RequireOutputOutsideInputs(entry.run_dir, inputs);
+    RequireOutputOutsideInputs(entry.log_path, inputs);
+  }
+  RequireOutputOutsideInputs(config.LibraryDir(), inputs);
   int pending = 0;
   for (const BatchEntryPlan& p : plan) {
     if (p.pending.empty()) {

@@ -177,6 +177,59 @@ TEST_F(OutputGuardTest, LightsCalibrate) {
   EXPECT_FALSE(fs::exists(lights));
 }
 
+// lights white: the session's folder (or one holding it) is no place for the calibrated session.
+TEST_F(OutputGuardTest, LightsWhite) {
+  ExpectRefused("lights white " + session_ + " --out " + session_ + " --overwrite");
+  ExpectRefused("lights white " + session_ + " --out " + dir_.str() + " --overwrite");
+}
+
+// session init writes OUT/session.json (or OUT/session.draft.json) beside the photos when OUT is their
+// folder, but never onto an input: here the camera file is that session.json.
+TEST_F(OutputGuardTest, SessionInit) {
+  std::string photo;
+  for (const auto& entry : fs::recursive_directory_iterator(session_)) {
+    if (entry.path().extension() == ".exr") photo = entry.path().string();
+  }
+  ASSERT_FALSE(photo.empty());
+  before_.emplace_back(photo, ReadBytes(photo));
+  ExpectRefused("session init " + photo + " --camera " + session_ + "/session.json --out " + session_ + " --overwrite");
+  ExpectRefused("session init " + photo + " --out " + photo + " --overwrite", "is a file");
+}
+
+// targets and lights synth read nothing: their one rule is that an existing output is replaced only
+// with --overwrite (and then by their own whole folder).
+TEST_F(OutputGuardTest, TargetsAndLightsSynthReadNoInputs) {
+  for (const std::string command : {"targets --no-charuco --dpi 72", "lights synth --lights 2"}) {
+    const std::string out = dir_ / ("made-by-" + command.substr(0, command.find(' ')));
+    ASSERT_EQ(RunIbrdf(command + " --out " + out).exit_code, 0) << command;
+    const std::string marker = out + "/mine.txt";
+    std::ofstream(marker) << "kept\n";
+    before_.emplace_back(marker, ReadBytes(marker));
+    ExpectRefused(command + " --out " + out, "already exists");
+    before_.pop_back();
+    const RunResult again = RunIbrdf(command + " --out " + out + " --overwrite");
+    EXPECT_EQ(again.exit_code, 0) << again.output;
+    EXPECT_FALSE(fs::exists(marker)) << "--overwrite replaces the folder whole";
+  }
+}
+
+// batch writes OUT/runs/NAME, OUT/logs/NAME.log and OUT/library: a session inside any of them is
+// refused before any job runs.
+TEST_F(OutputGuardTest, Batch) {
+  const fs::path batch = dir_ / "batch";
+  for (const char* inside : {"library/s1", "runs/s1"}) {
+    SCOPED_TRACE(inside);
+    fs::remove_all(batch);
+    fs::create_directories(batch / inside);
+    fs::copy(session_, batch / inside, fs::copy_options::recursive);
+    const std::string copy = ReadBytes((batch / inside / "session.json").string());
+    std::ofstream(batch / "batch.json") << "{\"format\": \"ibrdf-batch\", \"version\": 1, \"out\": \".\", "
+                                           "\"sessions\": [{\"path\": \"" << inside << "\", \"name\": \"s1\"}]}\n";
+    ExpectRefused("batch " + (batch / "batch.json").string(), "an input of this stage");
+    EXPECT_EQ(ReadBytes((batch / inside / "session.json").string()), copy);
+  }
+}
+
 TEST_F(OutputGuardTest, Reconstruct) {
   ExpectRefused("reconstruct " + samples_ + " --out " + dir_ / "work" + " --overwrite");
   ExpectRefused("reconstruct " + samples_ + " --out " + samples_ + " --overwrite");
