@@ -91,9 +91,8 @@ std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::
   }
   // Samples left with no measured channel carry nothing: removed and counted.
   const size_t before = samples->size();
-  samples->erase(std::remove_if(samples->begin(), samples->end(),
-                                [](const BrdfSample& s) { return s.valid[0] == 0 && s.valid[1] == 0 && s.valid[2] == 0; }),
-                 samples->end());
+  const auto unmeasured = [](const BrdfSample& s) { return s.valid[0] == 0 && s.valid[1] == 0 && s.valid[2] == 0; };
+  samples->erase(std::remove_if(samples->begin(), samples->end(), unmeasured), samples->end());
   tally.dropped = before - samples->size();
   if (counts != nullptr) *counts = tally;
   return matrices;
