@@ -282,6 +282,15 @@ TEST(Cli, SynthCharucoPhotosBesideTheChartAndTheWhiteReference) {
   EXPECT_EQ(calibration["views"].size(), 14u);  // the chart and the white reference, left out
 }
 
+// A session folder given to `ibrdf library` (no run done): refused, naming it and the remedy.
+TEST_F(CliTest, LibraryOfASessionFolderSaysToRunItFirst) {
+  const RunResult library = RunIbrdf("library " + session_ + " --out " + dir_ / "library");
+  EXPECT_EQ(library.exit_code, 1) << library.output;
+  EXPECT_NE(library.output.find(session_ + ": is a session folder"), std::string::npos) << library.output;
+  EXPECT_NE(library.output.find("ibrdf run"), std::string::npos) << library.output;
+  EXPECT_FALSE(fs::exists(dir_ / "library"));
+}
+
 TEST(Cli, ReportOnAFolderWithoutSamplesIsOneClearLine) {
   ScratchDir dir;
   const RunResult result = RunIbrdf("report " + dir.str());
