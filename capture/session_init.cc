@@ -56,9 +56,21 @@ Camera CameraFromFile(const std::string& path) {
 // The "targets" block of a JSON file (what `ibrdf targets` writes, a session, or the block itself).
 nlohmann::json TargetsFromFile(const std::string& path) {
   const nlohmann::json json = ReadJsonFile(path);
+  // `ibrdf targets` writes the ChArUco board's board.json beside targets.json; it has a "dictionary"
+  // too, so it would pass for a targets block and fail only in `ibrdf align`.
+  if (json.is_object() && json.value("format", "") == "ibrdf-charuco-board") {
+    ThrowError(path,
+               "is a ChArUco board file (format ibrdf-charuco-board), which calibrates the camera (`ibrdf align "
+               "--calibrate DIR`, DIR holding the board's photos and this file), not the markers' layout: pass "
+               "--targets the targets.json that `ibrdf targets` wrote beside it");
+  }
   const nlohmann::json block = json.contains("targets") ? json["targets"] : json;
   if (!block.is_object() || !block.contains("dictionary")) {
     ThrowError(path, "holds no targets block (an object with \"dictionary\"; `ibrdf targets` writes one)");
+  }
+  if (!block.contains("reference") && !block.contains("unknown_layout")) {
+    ThrowError(path, "holds a targets block without markers (neither \"reference\" nor \"unknown_layout\"); pass "
+                     "the targets.json that `ibrdf targets` writes");
   }
   return block;
 }
@@ -86,6 +98,8 @@ bool SessionInitOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION(!white_size || *white_size > 0.0);
   IBRDF_CHECK_OPTION(!white_reflectance ||
                      ((white_reflectance->array() > 0.0).all() && (white_reflectance->array() <= 1.0).all()));
+  IBRDF_CHECK_OPTION(std::all_of(exposure_s.begin(), exposure_s.end(),
+                                 [](double t) { return std::isfinite(t) && t > 0.0; }));
   IBRDF_CHECK_OPTION(!chart_corners || !chart_photos.empty());
   IBRDF_CHECK_OPTION(!chart_corners || std::all_of(chart_corners->begin(), chart_corners->end(),
                                                    [](const Eigen::Vector2d& p) { return p.allFinite(); }));
@@ -147,7 +161,9 @@ int GroupBrackets(const SessionInitOptions& options, std::vector<InitPhoto>* pho
       const std::optional<double> t0 = CaptureSeconds(previous->metadata.date_time);
       const std::optional<double> t1 = CaptureSeconds(photo.metadata.date_time);
       const bool burst = !t0 || !t1 || std::abs(*t1 - *t0) <= options.bracket_gap_s;
-      join = step != 0 && burst && (direction == 0 || step == direction);
+      // A photo without EXIF has no capture time either: nothing says it shares the previous one's pose.
+      const bool exif = !previous->exposure_given && !photo.exposure_given;
+      join = step != 0 && burst && exif && (direction == 0 || step == direction);
       if (join) direction = step;
     }
     if (join) {
@@ -203,16 +219,44 @@ void ReadPhotos(const SessionInitOptions& options, SessionInitResult* result) {
                                  std::to_string(first.metadata.width) + "x" + std::to_string(first.metadata.height) +
                                  ": one session, one camera");
     }
-    if (!photo.metadata.exposure_s) no_exposure.push_back(photo.file);
   }
-  if (!no_exposure.empty()) {
+  const size_t given = options.exposure_s.size();
+  if (given > 1 && given != result->photos.size()) {
+    ThrowError("--exposure-s", "has " + std::to_string(given) + " values; give one (every photo without an EXIF "
+                               "exposure time) or one per photo (" + std::to_string(result->photos.size()) +
+                               ": the photos, then --target-photos, --white-photos, --chart-photos, in that order)");
+  }
+  // The exposure time: EXIF's, else --exposure-s (stated as assumed, since nothing checks it).
+  std::vector<std::string> assumed;
+  for (size_t k = 0; k < result->photos.size(); ++k) {
+    InitPhoto& photo = result->photos[k];
+    if (photo.metadata.exposure_s) continue;
+    if (given == 0) {
+      no_exposure.push_back(photo.file);
+    } else {
+      photo.metadata.exposure_s = options.exposure_s[given == 1 ? 0 : k];
+      photo.exposure_given = true;
+      assumed.push_back(photo.file);
+    }
+  }
+  const auto listed = [](const std::vector<std::string>& files) {
     std::string list;
-    for (size_t i = 0; i < no_exposure.size() && i < 5; ++i) list += (i ? ", " : "") + no_exposure[i];
-    if (no_exposure.size() > 5) list += ", ...";
-    ThrowError(no_exposure.front(), std::to_string(no_exposure.size()) + " photo(s) carry no EXIF exposure time (" +
-                                        list +
-                                        "); session init reads exposures from the photos, so state them in "
-                                        "session.json by hand (docs/session-format.md)");
+    for (size_t i = 0; i < files.size() && i < 5; ++i) list += (i ? ", " : "") + files[i];
+    if (files.size() > 5) list += ", ...";
+    return list;
+  };
+  if (!no_exposure.empty()) {
+    ThrowError(no_exposure.front(),
+               std::to_string(no_exposure.size()) + " photo(s) carry no EXIF exposure time (" + listed(no_exposure) +
+                   "); pass --exposure-s S (seconds, every photo without one) or S1,S2,... (one per photo)");
+  }
+  if (!assumed.empty()) {
+    result->assumptions.push_back(
+        (given == 1 ? "exposure time " + Format("%g s", options.exposure_s[0]) + " (--exposure-s, as given)"
+                    : std::string("exposure times one per photo (--exposure-s, as given)")) +
+        " for " + std::to_string(assumed.size()) + " photo(s) without an EXIF exposure time: " + listed(assumed) +
+        (assumed.size() < result->photos.size() ? "; the others' come from their EXIF" : "") +
+        "; these photos form exposure brackets only with --bracket-size");
   }
 }
 

@@ -51,7 +51,12 @@ struct SessionInitOptions {
   int bracket_size = 0;
   double bracket_gap_s = 3.0;
   double bracket_min_ratio = 1.5;
-  // The targets block: a JSON file holding "targets" (what `ibrdf targets` writes) or the block itself.
+  // Exposure times (seconds) for photos whose metadata has none; EXIF's always wins. Empty: a photo
+  // without one is an error; one value: every such photo's; one per photo: in the manifest's order
+  // (photos, target_photos, white_photos, chart_photos). Stated as an assumption.
+  std::vector<double> exposure_s;
+  // The targets block: a JSON file holding "targets" (what `ibrdf targets` writes) or the block itself;
+  // a ChArUco board file (board.json) is refused.
   std::string targets_file;
   // The scene, which no photo records. Absent: listed as missing (the light's position not, when the
   // targets carry light markers: `ibrdf align` finds it).
@@ -76,6 +81,7 @@ struct InitPhoto {
   bool target = false;  // role "targets"
   bool white = false;   // a white-reference photo
   bool chart = false;   // a colour-chart photo
+  bool exposure_given = false;  // the exposure time came from SessionInitOptions::exposure_s, not EXIF
   int bracket = -1;     // bracket id, -1: none
   double gain = 1.0;    // ISO / base ISO
 };
@@ -97,10 +103,13 @@ struct SessionInitResult {
 
 // Reads the photos' metadata and writes `out_dir`/session.json (complete) or session.draft.json (with
 // a "missing" list) there; the photos stay where they are (the manifest names them relative to
-// out_dir). Throws Error for unreadable photos, photos of different sizes, bad options or files.
+// out_dir). Throws Error for unreadable photos, photos of different sizes, a photo without an exposure
+// time (EXIF's or exposure_s), bad options or files (a board.json given as the targets).
 SessionInitResult InitSession(const SessionInitOptions& options, const std::string& out_dir);
 
-// Groups measurement photos into brackets (InitPhoto::bracket) by the rule of SessionInitOptions.
+// Groups measurement photos into brackets (InitPhoto::bracket) by the rule of SessionInitOptions;
+// automatically only photos with EXIF exposure times (a time typed for a photo without EXIF says
+// nothing about its pose).
 // Returns the number of brackets of more than one exposure.
 int GroupBrackets(const SessionInitOptions& options, std::vector<InitPhoto>* photos);
 

@@ -36,8 +36,9 @@ Eigen::Matrix3d SampleColourMatrix(const ColourChartSpec& chart, const Eigen::Ve
 }
 
 std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples,
-                                                   size_t* dropped) {
-  if (dropped != nullptr) *dropped = 0;
+                                                   ColourCorrectionCounts* counts) {
+  ColourCorrectionCounts tally;
+  if (counts != nullptr) *counts = tally;
   if (!session.colour_chart) return {};
   const ColourChartSpec& chart = *session.colour_chart;
   if (!chart.matrix) {
@@ -75,17 +76,25 @@ std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::
       }
     }
     for (int c = 0; c < 3; ++c) {
-      sample.brdf[c] = brdf[c];
+      // A matrix with negative terms takes a noisy dark channel below 0: that value is no measurement
+      // of a BRDF (which is never negative), so the channel is unmeasured, like one below the floor;
+      // the sample keeps its other channels.
+      const bool usable = std::isfinite(brdf[c]) && brdf[c] >= 0.0f;
+      if (valid[c] && !usable) {
+        valid[c] = 0;
+        ++tally.negative[c];
+      }
+      sample.brdf[c] = usable ? brdf[c] : 0.0f;
       sample.sigma[c] = valid[c] ? std::sqrt(variance[c]) : 0.0f;
       sample.valid[c] = valid[c];
     }
   }
-  // Samples left with no measured channel carry nothing: dropped and counted.
+  // Samples left with no measured channel carry nothing: removed and counted.
   const size_t before = samples->size();
-  samples->erase(std::remove_if(samples->begin(), samples->end(),
-                                [](const BrdfSample& s) { return s.valid[0] == 0 && s.valid[1] == 0 && s.valid[2] == 0; }),
-                 samples->end());
-  if (dropped != nullptr) *dropped = before - samples->size();
+  const auto unmeasured = [](const BrdfSample& s) { return s.valid[0] == 0 && s.valid[1] == 0 && s.valid[2] == 0; };
+  samples->erase(std::remove_if(samples->begin(), samples->end(), unmeasured), samples->end());
+  tally.dropped = before - samples->size();
+  if (counts != nullptr) *counts = tally;
   return matrices;
 }
 

@@ -4,6 +4,8 @@
 // it in the samples' sidecar and the log.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,13 +25,25 @@ namespace ibrdf {
 // colour the chart saw, whatever its tint) removes: a white diffuser reads 1/pi in every channel.
 Eigen::Matrix3d SampleColourMatrix(const ColourChartSpec& chart, const Eigen::Vector3d& light_intensity);
 
+// What ApplyColourCorrection did to the samples' channels (each count over the samples it was given).
+struct ColourCorrectionCounts {
+  // Channels (R, G, B) that came out of the matrix measured but negative or not finite (a noisy dark
+  // channel, or a matrix with negative terms over a saturated hue): marked unmeasured (valid 0) with
+  // brdf and sigma 0, so no file ever holds a value its readers refuse.
+  std::array<uint64_t, 3> negative{};
+  // Samples left with no measured channel: removed.
+  uint64_t dropped = 0;
+};
+
 // Applies SampleColourMatrix of each sample's photo's light to its brdf and (propagated, channels
 // taken as independent) sigma; returns the matrices used, one per light. Nothing without a fitted
-// colour_chart. A corrected channel is valid only when every camera channel it mixes is; samples left
-// with no valid channel are removed, their count in `dropped`. Throws Error naming the manifest for a
-// colour_chart without a matrix (run `ibrdf colour`).
+// colour_chart. A corrected channel is measured only when every camera channel it mixes is, and when its
+// value is finite and not negative; an unmeasured channel's brdf is clamped to 0 or more (it is no
+// measurement, but the file's readers refuse negative values). Samples left with no measured channel are
+// removed. `counts` (optional) gets the channels marked unmeasured for their sign and the samples removed.
+// Throws Error naming the manifest for a colour_chart without a matrix (run `ibrdf colour`).
 std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples,
-                                                   size_t* dropped = nullptr);
+                                                   ColourCorrectionCounts* counts = nullptr);
 
 // The sidecar's "colour" entry: space, reference source, the chart's matrix and per-patch fit, and the
 // matrices applied per light. Null without a colour_chart.

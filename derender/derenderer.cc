@@ -44,6 +44,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // Rejection reasons in RejectionReasons() order; each pixel counts once, under the first that applies.
+// The per-pixel kernel tests all but the last, kColourUnmeasured, which the colour correction counts
+// on the accepted samples (Derender).
 enum Reason {
   kOff,
   kMasked,
@@ -59,6 +61,7 @@ enum Reason {
   kNonFinite,
   kSaturated,
   kBelow,
+  kColourUnmeasured,
   kNumReasons
 };
 using ReasonCounts = std::array<uint64_t, kNumReasons>;
@@ -968,6 +971,8 @@ const std::vector<std::pair<std::string, std::string>>& RejectionReasons() {
       {"non_finite", "a pixel value is NaN or infinite"},
       {"saturated", "every channel is unmeasured and one reaches the saturation level"},
       {"below_signal", "every channel's expected linear signal is below min_signal"},
+      {"colour_unmeasured",
+       "colour chart: the corrected channels all mix an unmeasured one or come out negative (after the pixel tests)"},
   };
   return kReasons;
 }
@@ -978,9 +983,14 @@ std::string DerenderSummary::BriefReport() const {
                 static_cast<unsigned long long>(accepted), static_cast<unsigned long long>(photos),
                 static_cast<unsigned long long>(pixels_examined), total_s);
   std::string brief = buffer + FormatCounts(rejected);
+  const auto triple = [](const std::array<uint64_t, 3>& n) {
+    return std::to_string(n[0]) + ", " + std::to_string(n[1]) + ", " + std::to_string(n[2]);
+  };
   if (channels_not_measured[0] + channels_not_measured[1] + channels_not_measured[2] > 0) {
-    brief += "; samples with a channel not measured (R, G, B): " + std::to_string(channels_not_measured[0]) + ", " +
-             std::to_string(channels_not_measured[1]) + ", " + std::to_string(channels_not_measured[2]);
+    brief += "; samples with a channel not measured (R, G, B): " + triple(channels_not_measured);
+  }
+  if (colour_negative[0] + colour_negative[1] + colour_negative[2] > 0) {
+    brief += "; channels negative after the colour correction, so not measured (R, G, B): " + triple(colour_negative);
   }
   return brief;
 }
@@ -1012,13 +1022,25 @@ DerenderResult Derender(const Session& session, const DerenderOptions& options) 
                "session and derender the session it writes (`ibrdf run` does both)");
   }
   DerenderResult result = DerenderSetup(session, options).DerenderAll();
-  // The colour chart's matrix, per sample by its photo's light (colour_correction.h).
-  size_t colour_dropped = 0;
-  result.summary.colour_matrices = ApplyColourCorrection(session, &result.samples, &colour_dropped);
-  if (!result.summary.colour_matrices.empty()) Log(1, ColourCorrectionReport(session, result.summary.colour_matrices));
-  if (colour_dropped > 0) {
-    Log(1, "warning: colour: " + std::to_string(colour_dropped) +
-               " samples dropped: the colour matrix mixes channels and none of theirs stayed measured");
+  // The colour chart's matrix, per sample by its photo's light (colour_correction.h). Its channels'
+  // validity is what the file holds, so the counts are taken again after it.
+  ColourCorrectionCounts colour;
+  DerenderSummary& summary = result.summary;
+  summary.colour_matrices = ApplyColourCorrection(session, &result.samples, &colour);
+  if (!summary.colour_matrices.empty()) {
+    Log(1, ColourCorrectionReport(session, summary.colour_matrices));
+    summary.rejected["colour_unmeasured"] += colour.dropped;
+    summary.accepted = result.samples.size();
+    summary.colour_negative = colour.negative;
+    summary.channels_not_measured = {};
+    for (const BrdfSample& s : result.samples) {
+      for (int c = 0; c < 3; ++c) summary.channels_not_measured[c] += s.valid[c] == 0;
+    }
+  }
+  if (colour.dropped > 0) {
+    Log(1, "warning: colour: " + std::to_string(colour.dropped) +
+               " samples removed: after the colour matrix none of their channels is measured (each mixes an "
+               "unmeasured camera channel or came out negative)");
   }
   return result;
 }
@@ -1048,11 +1070,13 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
         {"pixels_examined", summary.pixels_examined},
         {"accepted", summary.accepted},
         {"rejected", rejected},
-        {"channels_not_measured", summary.channels_not_measured}}},
+        {"channels_not_measured", summary.channels_not_measured},
+        {"colour_negative", summary.colour_negative}}},
       {"validity",
        "per channel, in the samples' `valid` field: 1 measured, 0 clipped, below the signal floor (tested on the "
        "expected signal, the mean of the ring of 16 neighbours at distance 2) or not finite; a pixel is kept while "
-       "any channel is measured"},
+       "any channel is measured; with a colour chart, a corrected channel is measured when every camera channel it "
+       "mixes is and its value is not negative (counts.colour_negative: those marked unmeasured for their sign)"},
       {"exposure", ExposureJson(summary.exposure, summary.exposure_warnings)},
       {"options",
        {{"max_theta_i_deg", options.max_theta_i_deg},

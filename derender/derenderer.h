@@ -86,8 +86,12 @@ struct DerenderSummary {
   double mesh_setup_s = 0.0;          // mesh: reading it, the ray-tracing scene, the convexity verdict
   // With a colour chart: the matrix applied to the samples' brdf, per light (colour_correction.h).
   std::vector<Eigen::Matrix3d> colour_matrices;
-  // Accepted samples whose channel c (R, G, B) is not measured (valid 0).
+  // Accepted samples whose channel c (R, G, B) is not measured (valid 0), counted after the colour
+  // correction where there is one.
   std::array<uint64_t, 3> channels_not_measured{};
+  // With a colour chart: the channels the correction made negative, marked unmeasured
+  // (colour_correction.h); samples it left with none measured are rejected as colour_unmeasured.
+  std::array<uint64_t, 3> colour_negative{};
   ExposureTally exposure;                          // per theta_h band and channel, what was lost
   std::vector<ExposureWarning> exposure_warnings;  // AdviseExposure of `exposure`
   // "derender: 1234567 samples from 20 photos in 2.1 s; rejected: off_sample 10, saturated 3"

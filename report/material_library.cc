@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -475,6 +476,17 @@ std::vector<LibraryEntry> LibraryEntriesOfRuns(const std::vector<std::string>& r
   std::vector<LibraryEntry> entries;
   for (const std::string& run : run_dirs) {
     if (!fs::is_directory(run)) ThrowError(run, "is not a folder (expected an `ibrdf run` folder)");
+    // A session (or recipe) folder has no run's outputs: it would be a card that says only "no summary".
+    const fs::path dir(run);
+    const bool run_outputs = fs::exists(dir / "summary.json") || fs::exists(dir / "reconstruction");
+    const std::pair<const char*, const char*> kInputs[] = {{"session.json", "session"}, {"recipe.json", "recipe"}};
+    for (const auto& [manifest, kind] : kInputs) {
+      if (!run_outputs && fs::is_regular_file(dir / manifest)) {
+        ThrowError(run, std::string("is a ") + kind + " folder (it holds " + manifest +
+                            "), not an `ibrdf run` folder: run `ibrdf run " + run +
+                            " --out RUN_DIR` first and give the library RUN_DIR");
+      }
+    }
     entries.push_back({fs::absolute(run).lexically_normal().filename().string(), run, "", ""});
   }
   return entries;

@@ -51,7 +51,8 @@ struct LibraryResult {
 LibraryResult BuildLibrary(const std::vector<LibraryEntry>& entries, const LibraryOptions& options);
 
 // The entries of `ibrdf run` folders, each material named after its folder. Throws Error naming a run
-// that is not a folder.
+// that is not a folder, or that is a session or recipe folder (a session.json or recipe.json and no
+// run outputs: summary.json, reconstruction/).
 std::vector<LibraryEntry> LibraryEntriesOfRuns(const std::vector<std::string>& run_dirs);
 
 // The entry's state as the index records it: {"name", "status": "ok" | "failed" | "incomplete",

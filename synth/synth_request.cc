@@ -1,11 +1,16 @@
 #include "synth/synth_request.h"
 
+#include <filesystem>
+#include <vector>
+
 #include "core/colour.h"
 #include "core/error.h"
 #include "core/merl_brdf.h"
 #include "core/session.h"
 
 namespace ibrdf {
+
+namespace fs = std::filesystem;
 
 SynthOptions SynthOptionsFromRequest(const SynthRequest& request) {
   SynthOptions options = request.options;
@@ -68,8 +73,24 @@ CharucoPhotosSummary WriteSessionCharucoPhotos(const std::string& session_dir, i
   CharucoPhotoOptions board;
   board.num_photos = num_photos;
   board.seed = session_seed + 1000;
-  return WriteCharucoPhotos(Session::Load(session_dir).camera, board, session_dir + "/calibration",
-                            /*overwrite=*/false);
+  const Camera camera = Session::Load(session_dir).camera;
+  const fs::path calibration = fs::path(session_dir) / "calibration";
+  if (!fs::exists(calibration)) return WriteCharucoPhotos(camera, board, calibration.string(), /*overwrite=*/false);
+  // The session's own calibration photos (colour chart, white reference) are there already: the board's
+  // files are written whole beside them, then join them; none of their names is one of the session's.
+  const fs::path staging = fs::path(session_dir) / ".calibration-charuco";
+  const CharucoPhotosSummary summary = WriteCharucoPhotos(camera, board, staging.string(), /*overwrite=*/true);
+  std::vector<fs::path> files;
+  for (const fs::directory_entry& entry : fs::directory_iterator(staging)) files.push_back(entry.path());
+  for (const fs::path& file : files) {
+    if (fs::exists(calibration / file.filename())) {
+      fs::remove_all(staging);
+      ThrowError((calibration / file.filename()).string(), "exists: the ChArUco photos' file would replace it");
+    }
+  }
+  for (const fs::path& file : files) fs::rename(file, calibration / file.filename());
+  fs::remove(staging);
+  return summary;
 }
 
 }  // namespace ibrdf

@@ -51,7 +51,8 @@ std::unique_ptr<BrdfModel> LoadRequestedMaterial(const SynthRequest& request, co
 
 // Writes `num_photos` photos of the default ChArUco board (CharucoPhotoOptions) taken with the camera
 // of the session in `session_dir` into `session_dir`/calibration (for `ibrdf align --calibrate`),
-// seeded from the session's seed + 1000.
+// seeded from the session's seed + 1000, beside the session's own calibration photos (colour chart,
+// white reference) when it has them (the calibration reads only the photos that show the board).
 CharucoPhotosSummary WriteSessionCharucoPhotos(const std::string& session_dir, int num_photos, uint64_t session_seed);
 
 }  // namespace ibrdf

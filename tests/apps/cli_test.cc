@@ -255,6 +255,42 @@ TEST_F(CliTest, ReconstructUnknownBandwidthCriterionIsAClearError) {
 }
 
 // `ibrdf report` on a folder that is not a run folder: one line naming the missing samples.npy, exit 1.
+// ChArUco photos with a colour chart and a white reference: all three write into OUT/calibration, and
+// the board's files join the session's calibration photos there; `align --calibrate` on that folder
+// uses the board photos and leaves the other two out.
+TEST(Cli, SynthCharucoPhotosBesideTheChartAndTheWhiteReference) {
+  ScratchDir dir;
+  const RunResult synth = RunIbrdf("synth --out " + dir / "s" + " --material " + MaterialPath("bluepaint") +
+                                   " --photos 4 --targets --light-photos 0 --colour-chart --light-unknown"
+                                   " --charuco-photos 12");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const Session session = Session::Load(dir / "s");
+  ASSERT_TRUE(session.colour_chart);
+  ASSERT_TRUE(session.calibration && session.calibration->white_reference);
+  EXPECT_TRUE(fs::is_regular_file(fs::path(session.directory) / session.colour_chart->photos[0].file));
+  EXPECT_TRUE(fs::is_regular_file(fs::path(session.directory) / session.calibration->white_reference->photos[0].file));
+  for (const char* file : {"board.json", "truth.json", "charuco-000.png", "charuco-011.png"}) {
+    EXPECT_TRUE(fs::is_regular_file(dir / "s/calibration/" + file)) << file;
+  }
+  EXPECT_FALSE(fs::exists(dir / "s/.calibration-charuco"));
+  const RunResult align =
+      RunIbrdf("align " + dir / "s" + " --calibrate " + dir / "s/calibration" + " --out " + dir / "aligned");
+  ASSERT_EQ(align.exit_code, 0) << align.output;
+  const nlohmann::json calibration = ReadJson(dir / "aligned/alignment.json")["intrinsic_calibration"];
+  EXPECT_EQ(calibration["views_used"].get<int>(), 12);
+  EXPECT_LT(calibration["rms_px"].get<double>(), 0.2);
+  EXPECT_EQ(calibration["views"].size(), 14u);  // the chart and the white reference, left out
+}
+
+// A session folder given to `ibrdf library` (no run done): refused, naming it and the remedy.
+TEST_F(CliTest, LibraryOfASessionFolderSaysToRunItFirst) {
+  const RunResult library = RunIbrdf("library " + session_ + " --out " + dir_ / "library");
+  EXPECT_EQ(library.exit_code, 1) << library.output;
+  EXPECT_NE(library.output.find(session_ + ": is a session folder"), std::string::npos) << library.output;
+  EXPECT_NE(library.output.find("ibrdf run"), std::string::npos) << library.output;
+  EXPECT_FALSE(fs::exists(dir_ / "library"));
+}
+
 TEST(Cli, ReportOnAFolderWithoutSamplesIsOneClearLine) {
   ScratchDir dir;
   const RunResult result = RunIbrdf("report " + dir.str());

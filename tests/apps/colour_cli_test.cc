@@ -62,6 +62,26 @@ TEST(ColourCliTest, FitsByCornersAndByDetectionThenDerenderApplies) {
   EXPECT_EQ(sidecar.at("colour").at("applied").size(), 1u);
 }
 
+// A dim gold paint seen by a camera whose channels mix strongly: the chart's matrix has large negative
+// terms and takes the noisy blue (and some green) below zero. Those channels are unmeasured and counted
+// in the sidecar and the summary line; `ibrdf check` reads every sample (it refused a negative one).
+TEST(ColourCliTest, NegativeCorrectedChannelsAreUnmeasuredAndCheckReadsTheFile) {
+  testing::ScratchDir scratch;
+  const auto synth = RunIbrdf("synth --out " + scratch / "s" + " --material " + testing::MaterialPath("gold-paint") +
+                              " --photos 2 --width 400 --height 300 --light-intensity 1 0.8 0.55"
+                              " --camera-matrix 0.45 0.4 0.15 0.3 0.5 0.2 0.15 0.35 0.5 --colour-chart");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  ASSERT_EQ(RunIbrdf("colour " + scratch / "s" + " --out " + scratch / "c").exit_code, 0);
+  const auto derender = RunIbrdf("derender " + scratch / "c" + " --out " + scratch / "samples.npy", true);
+  ASSERT_EQ(derender.exit_code, 0) << derender.output;
+  EXPECT_NE(derender.output.find("negative after the colour correction"), std::string::npos) << derender.output;
+  const nlohmann::json counts = ReadJsonFile(scratch / "samples.npy.json").at("counts");
+  EXPECT_GT(counts.at("colour_negative")[2].get<uint64_t>(), 1000u) << counts.dump();
+  EXPECT_TRUE(counts.at("rejected").contains("colour_unmeasured"));
+  const auto check = RunIbrdf("check " + scratch / "samples.npy" + " --out " + scratch / "check");
+  EXPECT_EQ(check.exit_code, 0) << check.output;
+}
+
 TEST(ColourCliTest, BadInputIsAClearErrorAndWritesNothing) {
   testing::ScratchDir scratch;
   ASSERT_EQ(RunIbrdf(SynthArgs(scratch / "s")).exit_code, 0);

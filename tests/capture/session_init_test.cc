@@ -210,6 +210,76 @@ TEST(SessionInit, PhotoWithoutExposureIsAnErrorNamingIt) {
   EXPECT_FALSE(fs::exists(dir / "out/session.json"));
 }
 
+// Photos without EXIF exposure: --exposure-s, one value for every such photo or one per photo (the
+// manifest's order); EXIF's wins where present; stated as assumed; a wrong count is an error naming it.
+TEST(SessionInit, ExposureTimesGivenWhereExifHasNone) {
+  ScratchDir dir;
+  Image image(40, 30, 3);
+  WriteImage(dir / "plain1.png", image, PixelFormat::kUint16);
+  WriteImage(dir / "plain2.png", image, PixelFormat::kUint16);
+  SessionInitOptions options;
+  options.photos = {dir / "plain1.png", Photo(dir, "a.png", 0.02, 100, 0), dir / "plain2.png"};
+  options.exposure_s = {0.5};
+  const SessionInitResult one = InitSession(options, dir / "one");
+  ASSERT_TRUE(one.written);
+  const nlohmann::json photos = ReadJsonFile(one.path)["photos"];
+  ASSERT_EQ(photos.size(), 3u);
+  EXPECT_EQ(photos[0]["exposure_s"].get<double>(), 0.5);
+  EXPECT_NEAR(photos[1]["exposure_s"].get<double>(), 0.02, 1e-7);  // EXIF's
+  EXPECT_EQ(photos[2]["exposure_s"].get<double>(), 0.5);
+  std::string assumed;
+  for (const std::string& line : one.assumptions) assumed += line + "\n";
+  EXPECT_NE(assumed.find("exposure time 0.5 s (--exposure-s, as given) for 2 photo(s)"), std::string::npos) << assumed;
+
+  options.exposure_s = {0.25, 0.3, 0.125};
+  const SessionInitResult each = InitSession(options, dir / "each");
+  const nlohmann::json each_photos = ReadJsonFile(each.path)["photos"];
+  EXPECT_EQ(each_photos[0]["exposure_s"].get<double>(), 0.25);
+  EXPECT_NEAR(each_photos[1]["exposure_s"].get<double>(), 0.02, 1e-7);
+  EXPECT_EQ(each_photos[2]["exposure_s"].get<double>(), 0.125);
+
+  options.exposure_s = {0.25, 0.125};
+  try {
+    InitSession(options, dir / "bad");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--exposure-s"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+  options.exposure_s = {-1.0};
+  std::string why;
+  EXPECT_FALSE(options.Check(&why));
+  options.exposure_s.clear();
+  try {
+    InitSession(options, dir / "none");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--exposure-s"), std::string::npos) << e.what();  // the remedy
+  }
+}
+
+// `ibrdf targets` writes board.json beside targets.json; given as the targets it is refused at once,
+// naming the file, what it is and what to pass; nothing is written.
+TEST(SessionInit, BoardFileAsTargetsIsRefused) {
+  ScratchDir dir;
+  const nlohmann::json board = {{"format", "ibrdf-charuco-board"}, {"version", 1}, {"dictionary", "DICT_5X5_100"},
+                                {"squares_x", 9},  {"squares_y", 7}, {"square_size", 0.025}, {"marker_size", 0.018}};
+  WriteJsonFile(dir / "board.json", board);
+  SessionInitOptions options;
+  options.photos = {Photo(dir, "a.png", 0.02, 100, 0)};
+  options.targets_file = dir / "board.json";
+  try {
+    InitSession(options, dir / "out");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(dir / "board.json"), std::string::npos) << message;
+    EXPECT_NE(message.find("ChArUco board"), std::string::npos) << message;
+    EXPECT_NE(message.find("targets.json"), std::string::npos) << message;
+  }
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 TEST(SessionInit, PhotosOfAnotherSizeAreAnError) {
   ScratchDir dir;
   SessionInitOptions options;

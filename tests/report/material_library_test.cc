@@ -1,6 +1,7 @@
 // The material library (report/material_library.h) on hand-made run folders: a finished run's figures,
 // a failed run's error from its log (also after an earlier success), an incomplete run, absent
-// optional files, and the folder rules (only a library is replaced; never a folder holding a run).
+// optional files, and the folder rules (only a library is replaced; never a folder holding a run; a
+// session folder is no run).
 #include "report/material_library.h"
 
 #include <filesystem>
@@ -41,6 +42,22 @@ TEST(MaterialLibrary, RunFoldersAreNamedAfterTheirFolder) {
   EXPECT_EQ(entries[0].name, "felt");
   EXPECT_EQ(entries[0].run_dir, dir / "runs/felt");
   EXPECT_THROW(LibraryEntriesOfRuns({dir / "runs/none"}), Error);
+}
+
+// A session folder given as a run (the user forgot `ibrdf run`) is refused by name, with the remedy;
+// a run folder that happens to hold a session.json beside its outputs is still a run.
+TEST(MaterialLibrary, ASessionFolderIsNoRunFolder) {
+  ScratchDir dir;
+  Write(dir / "hat/session.json", "{}");
+  const std::string message = testing::ErrorOf([&] { LibraryEntriesOfRuns({dir / "hat"}); });
+  EXPECT_NE(message.find(dir / "hat"), std::string::npos) << message;
+  EXPECT_NE(message.find("is a session folder"), std::string::npos) << message;
+  EXPECT_NE(message.find("ibrdf run"), std::string::npos) << message;
+  Write(dir / "recipe/recipe.json", "{}");
+  EXPECT_NE(testing::ErrorOf([&] { LibraryEntriesOfRuns({dir / "recipe"}); }).find("is a recipe folder"),
+            std::string::npos);
+  Write(dir / "hat/summary.json", kSummary);
+  EXPECT_EQ(LibraryEntriesOfRuns({dir / "hat"}).size(), 1u);
 }
 
 TEST(MaterialLibrary, AFinishedRunsFiguresComeFromItsSummary) {
