@@ -2,15 +2,12 @@
 // intensities from a diffuse sphere (calibrate/light_rig.h); a session's light intensities from its
 // white reference (calibrate/white_reference_intensity.h); and synthetic mirror-sphere sessions with
 // known lights to check the first (synth/synthetic_mirror_sphere.h).
-#include <filesystem>
 #include <memory>
-#include <optional>
 
 #include "apps/commands.h"
 #include "calibrate/light_rig.h"
 #include "calibrate/white_reference_intensity.h"
 #include "core/error.h"
-#include "core/file_util.h"
 #include "core/logging.h"
 #include "core/session.h"
 #include "synth/synthetic_mirror_sphere.h"
@@ -18,29 +15,25 @@
 namespace ibrdf {
 namespace {
 
-namespace fs = std::filesystem;
-
 Eigen::Vector3d Vector3Option(const std::vector<double>& values, const std::string& flag) {
   if (values.size() != 3) ThrowError(flag, "expected three numbers R,G,B (or x,y,z)");
   return Eigen::Vector3d(values[0], values[1], values[2]);
 }
 
 struct CalibrateArgs {
-  std::vector<std::string> sessions;
-  std::string out, diffuse, apply_to, write_session;
+  LightRigStageRequest request;
   std::vector<double> albedo;
   LightRigOptions options;
-  bool known_sphere = false, overwrite = false;
 };
 
 void AddCalibrateFlags(CLI::App* command, CalibrateArgs* args) {
   LightProbeOptions& probe = args->options.probe;
   command
-      ->add_option("sessions", args->sessions,
+      ->add_option("sessions", args->request.placements,
                    "Mirror-sphere session(s): one for directional lights; two placements of the sphere\n"
                    "triangulate point lights")
       ->required();
-  command->add_option("--out", args->out, "The calibrated lights (.json)")->required();
+  command->add_option("--out", args->request.out, "The calibrated lights (.json)")->required();
   command->add_option("--kind", probe.kind, "What the lights are: directional or point")
       ->check(CLI::IsMember({"directional", "point"}))
       ->capture_default_str();
@@ -48,9 +41,9 @@ void AddCalibrateFlags(CLI::App* command, CalibrateArgs* args) {
                      command->add_option("--light-distance-m", probe.light_distance,
                                          "Point lights from one placement: their distance from the sphere's centre"),
                      "--light-distance", probe.light_distance);
-  command->add_flag("--known-sphere", args->known_sphere,
+  command->add_flag("--known-sphere", args->request.known_sphere,
                     "Take the session's sphere centre and radius as exact (no silhouette fit)");
-  command->add_option("--diffuse", args->diffuse,
+  command->add_option("--diffuse", args->request.diffuse,
                       "A session of a diffuse (Lambertian) sphere under the same lights: measures their intensities");
   command->add_option("--albedo", args->albedo, "The diffuse sphere's albedo R,G,B (absent: relative intensities)")
       ->delimiter(',')
@@ -67,71 +60,24 @@ void AddCalibrateFlags(CLI::App* command, CalibrateArgs* args) {
       ->add_option("--rim-margin-px", probe.highlight.rim_margin_px,
                    "Highlight: not searched this close to the silhouette")
       ->capture_default_str();
-  command->add_option("--apply-to", args->apply_to,
+  command->add_option("--apply-to", args->request.apply_to,
                       "With --write-session: the session to give the calibrated lights (default: the --diffuse one)");
-  command->add_option("--write-session", args->write_session,
+  command->add_option("--write-session", args->request.write_session,
                       "Write a copy of that session (new folder, its files referenced in place) with the calibrated\n"
                       "lights; for the --diffuse session, also the sphere's fitted centre");
-  command->add_flag("--overwrite", args->overwrite, "Replace existing outputs");
+  command->add_flag("--overwrite", args->request.overwrite, "Replace existing outputs");
 }
 
 void RunCalibrate(CalibrateArgs& args) {
   StageLog stage("lights calibrate");
   LightRigOptions& options = args.options;
   options.diffuse.max_theta_e_deg = options.diffuse.max_theta_i_deg;
-  options.probe.fit_silhouette = !args.known_sphere;
-  options.diffuse.fit_silhouette = !args.known_sphere;
+  options.probe.fit_silhouette = !args.request.known_sphere;
+  options.diffuse.fit_silhouette = !args.request.known_sphere;
   RequireValidOptions(options.probe, "--kind/--light-distance-m/--blob-fraction/--rim-margin-px");
   RequireValidOptions(options.diffuse, "--max-theta-deg");
   if (!args.albedo.empty()) options.albedo = Vector3Option(args.albedo, "--albedo");
-  std::vector<Session> placements;
-  std::vector<std::string> inputs, photos;  // the manifests (recorded in the report), their photos
-  for (const std::string& path : args.sessions) {
-    placements.push_back(Session::Load(path));
-    inputs.push_back(placements.back().manifest_path);
-    for (const std::string& file : placements.back().InputFiles()) photos.push_back(file);
-  }
-  std::optional<Session> diffuse;
-  if (!args.diffuse.empty()) {
-    diffuse = Session::Load(args.diffuse);
-    inputs.push_back(diffuse->manifest_path);
-    for (const std::string& file : diffuse->InputFiles()) photos.push_back(file);
-  }
-  if (options.albedo && !diffuse) ThrowError("--albedo", "needs --diffuse (the sphere it describes)");
-  const std::string report_path = LightRigReportPath(args.out);
-  photos.insert(photos.end(), inputs.begin(), inputs.end());
-  RequireWritableOutput(args.out, args.overwrite, photos);
-  RequireWritableOutput(report_path, args.overwrite, photos);
-  std::optional<Session> target;
-  if (!args.write_session.empty()) {
-    if (!args.apply_to.empty()) {
-      target = Session::Load(args.apply_to);
-    } else if (diffuse) {
-      target = diffuse;
-    } else {
-      ThrowError("--write-session", "needs --apply-to SESSION or --diffuse SESSION (the session to give the lights)");
-    }
-    // The folder written replaces --write-session whole: never the target's folder or its photos.
-    RequireWritableOutput(args.write_session, args.overwrite, SessionInputs(*target));
-  } else if (!args.apply_to.empty()) {
-    ThrowError("--apply-to", "needs --write-session (where to write the session with the calibrated lights)");
-  }
-
-  const LightRigCalibration calibration = CalibrateLightRig(placements, diffuse ? &*diffuse : nullptr, options);
-  if (calibration.intensities) Log(1, calibration.intensities->BriefReport());
-  WriteLightRig(calibration, args.out);
-  Log(1, calibration.probe.BriefReport());
-  for (const std::string& line : calibration.LightLines()) Log(1, line);
-  Log(1, "lights written to " + args.out + " (report: " + report_path + ")");
-  if (target) {
-    const Session copy = WithCalibratedLights(*target, calibration, args.out,
-                                              /*diffuse_center=*/args.apply_to.empty() && !args.known_sphere);
-    AtomicDirectory directory(args.write_session, args.overwrite);
-    copy.Rebased(args.write_session, Session::PathStyle::kAbsolute)
-        .Save((fs::path(directory.temporary_path()) / "session.json").string());
-    directory.Commit();
-    Log(1, "session with the calibrated lights written to " + args.write_session + "/session.json");
-  }
+  RunLightRigStage(args.request, options);
 }
 
 void AddCalibrate(CLI::App& group) {

@@ -1,7 +1,6 @@
 // ibrdf synth: writes a synthetic session with known truth; the flags fill a SynthRequest (synth/synth_request.h).
 #include "apps/commands.h"
 #include "synth/synth_request.h"
-#include "synth/synthetic.h"
 
 namespace ibrdf {
 namespace {
@@ -21,20 +20,7 @@ void RunSynth(SynthArgs& args) {
   const SynthOptions options = SynthOptionsFromRequest(request);
   RequireValidOptions(options, "ibrdf synth");
   StageLog stage("synth");
-  RequireWritableOutput(args.out, args.overwrite, {args.material});
-  const std::unique_ptr<BrdfModel> material = LoadRequestedMaterial(request, args.material);
-  const SynthSummary summary = WriteSyntheticSession(options, *material, args.material, args.out, args.overwrite);
-  Log(1, summary.BriefReport());
-  if (!summary.NoDataReport().empty()) {
-    const bool invented = summary.no_data == SynthNoData::kZero;  // zero-valued samples: a warning
-    Log(invented ? 0 : 1, std::string(invented ? "warning: " : "") + args.material + ": " + summary.NoDataReport() +
-                              " (truth.json generator.material_no_data)");
-  }
-  Log(1, "session written to " + args.out + "/session.json (truth in " + args.out + "/truth.json)");
-  if (request.charuco_photos > 0) {
-    const CharucoPhotosSummary photos = WriteSessionCharucoPhotos(args.out, request.charuco_photos, options.seed);
-    Log(1, photos.BriefReport() + ", written to " + args.out + "/calibration");
-  }
+  WriteSynthStage(request, options, args.material, args.out, args.overwrite);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include "core/file_util.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "core/output_guard.h"
 
 namespace fs = std::filesystem;
 
@@ -113,6 +114,66 @@ Session WithCalibratedLights(const Session& target, const LightRigCalibration& c
   copy.description = (copy.description.empty() ? "" : copy.description + " ") +
                      "Lights calibrated by `ibrdf lights calibrate` (" + lights_path + ").";
   return copy;
+}
+
+namespace {
+// A session's inputs for the output guard: its files, its manifest and its folder.
+void AddSessionInputs(const Session& session, std::vector<std::string>* inputs) {
+  for (const std::string& file : session.InputFiles()) inputs->push_back(file);
+  inputs->push_back(session.manifest_path);
+  inputs->push_back(session.directory);
+}
+}  // namespace
+
+LightRigCalibration RunLightRigStage(const LightRigStageRequest& request, const LightRigOptions& options) {
+  std::vector<Session> placements;
+  std::vector<std::string> inputs;
+  for (const std::string& path : request.placements) {
+    placements.push_back(Session::Load(path));
+    AddSessionInputs(placements.back(), &inputs);
+  }
+  std::optional<Session> diffuse;
+  if (!request.diffuse.empty()) {
+    diffuse = Session::Load(request.diffuse);
+    AddSessionInputs(*diffuse, &inputs);
+  }
+  if (options.albedo && !diffuse) ThrowError("--albedo", "needs --diffuse (the sphere it describes)");
+  const std::string report_path = LightRigReportPath(request.out);
+  RequireWritableOutput(request.out, request.overwrite, inputs);
+  RequireWritableOutput(report_path, request.overwrite, inputs);
+  std::optional<Session> target;
+  if (!request.write_session.empty()) {
+    if (!request.apply_to.empty()) {
+      target = Session::Load(request.apply_to);
+    } else if (diffuse) {
+      target = diffuse;
+    } else {
+      ThrowError("--write-session", "needs --apply-to SESSION or --diffuse SESSION (the session to give the lights)");
+    }
+    // The folder written replaces --write-session whole: never the target's folder or its photos.
+    std::vector<std::string> target_inputs;
+    AddSessionInputs(*target, &target_inputs);
+    RequireWritableOutput(request.write_session, request.overwrite, target_inputs);
+  } else if (!request.apply_to.empty()) {
+    ThrowError("--apply-to", "needs --write-session (where to write the session with the calibrated lights)");
+  }
+
+  const LightRigCalibration calibration = CalibrateLightRig(placements, diffuse ? &*diffuse : nullptr, options);
+  if (calibration.intensities) Log(1, calibration.intensities->BriefReport());
+  WriteLightRig(calibration, request.out);
+  Log(1, calibration.probe.BriefReport());
+  for (const std::string& line : calibration.LightLines()) Log(1, line);
+  Log(1, "lights written to " + request.out + " (report: " + report_path + ")");
+  if (target) {
+    const bool diffuse_center = request.apply_to.empty() && !request.known_sphere;
+    const Session copy = WithCalibratedLights(*target, calibration, request.out, diffuse_center);
+    AtomicDirectory directory(request.write_session, request.overwrite);
+    copy.Rebased(request.write_session, Session::PathStyle::kAbsolute)
+        .Save((fs::path(directory.temporary_path()) / "session.json").string());
+    directory.Commit();
+    Log(1, "session with the calibrated lights written to " + request.write_session + "/session.json");
+  }
+  return calibration;
 }
 
 }  // namespace ibrdf

@@ -58,4 +58,23 @@ void WriteLightRig(const LightRigCalibration& calibration, const std::string& li
 Session WithCalibratedLights(const Session& target, const LightRigCalibration& calibration,
                              const std::string& lights_path, bool diffuse_center);
 
+// `ibrdf lights calibrate` as a stage: the files it reads and writes, as the command line names them.
+struct LightRigStageRequest {
+  std::vector<std::string> placements;  // the mirror-sphere sessions
+  std::string diffuse;                  // a diffuse-sphere session under the same lights ("": none)
+  std::string out;                      // the lights file; its report beside it (LightRigReportPath)
+  std::string write_session;            // a folder for a session given the lights ("": none)
+  std::string apply_to;                 // that session ("": the diffuse one)
+  bool known_sphere = false;            // the sessions' spheres are exact: no silhouette fit, no new centre
+  bool overwrite = false;
+};
+
+// Loads the sessions, checks every output against every input before anything is read or written
+// (core/output_guard.h: the lights, their report and the session folder, which is replaced whole),
+// calibrates, writes the lights and their report and, with write_session, the session with the
+// calibrated lights (for the diffuse session, its fitted centre too). Logs each result's brief report.
+// Throws Error naming the flag for an inconsistent request (--albedo without --diffuse, --apply-to
+// without --write-session).
+LightRigCalibration RunLightRigStage(const LightRigStageRequest& request, const LightRigOptions& options);
+
 }  // namespace ibrdf

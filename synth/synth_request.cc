@@ -5,8 +5,11 @@
 
 #include "core/colour.h"
 #include "core/error.h"
+#include "core/logging.h"
 #include "core/merl_brdf.h"
+#include "core/output_guard.h"
 #include "core/session.h"
+#include "synth/synthetic.h"
 
 namespace ibrdf {
 
@@ -91,6 +94,24 @@ CharucoPhotosSummary WriteSessionCharucoPhotos(const std::string& session_dir, i
   for (const fs::path& file : files) fs::rename(file, calibration / file.filename());
   fs::remove(staging);
   return summary;
+}
+
+void WriteSynthStage(const SynthRequest& request, const SynthOptions& options, const std::string& material_path,
+                     const std::string& out, bool overwrite) {
+  RequireWritableOutput(out, overwrite, {material_path});
+  const std::unique_ptr<BrdfModel> material = LoadRequestedMaterial(request, material_path);
+  const SynthSummary summary = WriteSyntheticSession(options, *material, material_path, out, overwrite);
+  Log(1, summary.BriefReport());
+  if (!summary.NoDataReport().empty()) {
+    const bool invented = summary.no_data == SynthNoData::kZero;  // zero-valued samples: a warning
+    Log(invented ? 0 : 1, std::string(invented ? "warning: " : "") + material_path + ": " + summary.NoDataReport() +
+                              " (truth.json generator.material_no_data)");
+  }
+  Log(1, "session written to " + out + "/session.json (truth in " + out + "/truth.json)");
+  if (request.charuco_photos > 0) {
+    const CharucoPhotosSummary photos = WriteSessionCharucoPhotos(out, request.charuco_photos, options.seed);
+    Log(1, photos.BriefReport() + ", written to " + out + "/calibration");
+  }
 }
 
 }  // namespace ibrdf

@@ -55,4 +55,11 @@ std::unique_ptr<BrdfModel> LoadRequestedMaterial(const SynthRequest& request, co
 // white reference) when it has them (the calibration reads only the photos that show the board).
 CharucoPhotosSummary WriteSessionCharucoPhotos(const std::string& session_dir, int num_photos, uint64_t session_seed);
 
+// `ibrdf synth` as a stage, once `options` (SynthOptionsFromRequest) passed their Check(): the output
+// guard (`out` is not the material and holds it not), the material, the session written to `out`
+// (synthetic.h) and its ChArUco photos when the request asks for them; logs what was written and warns
+// when a MERL table's cells without data were rendered as zero.
+void WriteSynthStage(const SynthRequest& request, const SynthOptions& options, const std::string& material_path,
+                     const std::string& out, bool overwrite);
+
 }  // namespace ibrdf
