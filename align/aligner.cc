@@ -282,7 +282,11 @@ Session AlignedSession(const Session& session, const AlignResult& result, const 
     photo.camera_from_world = result.images[i].camera_from_world;
     aligned.photos.push_back(photo);
   }
-  if (result.light.fitted) aligned.lights.at(session.targets->light->light).position = result.light.position;
+  if (result.light.fitted) {
+    Light& light = aligned.lights.at(session.targets->light->light);
+    light.position = result.light.position;
+    light.placement_known = true;
+  }
   const TargetsSpec& targets = *session.targets;
   if (targets.unknown_layout) {
     TargetsSpec& aligned_targets = *aligned.targets;
@@ -361,6 +365,25 @@ AlignResult AlignSession(const Session& session, const AlignOptions& options) {
       Log(1, "dropped photo " + session.photos[image.photo].file + ": " + image.dropped_reason);
     }
     ThrowError(session.manifest_path, "no photo could be aligned (see the reasons above)");
+  }
+  // A light the session could not place must come from its markers: no stage may use its placeholder.
+  for (const Light& light : result.session.lights) {
+    if (light.placement_known) continue;
+    int light_photos = 0, posed = 0;
+    for (const ImageAlignment& image : result.images) {
+      if (session.photos[image.photo].role != PhotoRole::kTargets) continue;
+      ++light_photos;
+      posed += image.used;
+      if (!image.used) Log(1, "dropped photo " + session.photos[image.photo].file + ": " + image.dropped_reason);
+    }
+    std::string cause = result.light.reason.empty() ? "its markers gave no position" : result.light.reason;
+    if (!options.fit_light) cause = "the light fit is switched off";
+    ThrowError(session.manifest_path,
+               "light fit failed: " + LightLabel(light) + "'s position is unknown and " + cause + " (" +
+                   std::to_string(posed) + " of " + std::to_string(light_photos) +
+                   " light photos posed; at least one must see the light's markers): photograph the light's "
+                   "card closer or at a higher resolution, or state the position (session init "
+                   "--light-position-m)");
   }
 
   // The white reference from its card's markers: its photos' poses, its centre and normal.

@@ -158,7 +158,7 @@ bool LightFitOptions::Check(std::string* why) const {
 }
 
 std::string LightFit::BriefReport() const {
-  if (!fitted) return reason.empty() ? "light as given" : reason;
+  if (!fitted) return reason.empty() ? "light as given" : reason + "; the light stays as given";
   char buffer[200];
   std::snprintf(buffer, sizeof(buffer), "light at (%.5f, %.5f, %.5f) m from %zu markers (spread %.3f mm)", position.x(),
                 position.y(), position.z(), markers.size(), 1e3 * spread_m);
@@ -182,7 +182,7 @@ LightFit FitLightToMarkers(const Camera& camera, const LightTargetsSpec& spec, c
   std::string message;
   const bool solved = problem.Solve(options.tolerance, &message);
   if (!solved) {
-    fit.reason = "the light markers' refinement failed (" + message + "); the light stays as given";
+    fit.reason = "the light markers' refinement failed (" + message + ")";
   } else {
     for (const auto& [i, pose] : problem.cameras()) {
       fit.refined_camera_from_world[i] = PoseFromAngleAxis(pose.data(), pose.data() + 3);
@@ -208,7 +208,7 @@ LightFit FitLightToMarkers(const Camera& camera, const LightTargetsSpec& spec, c
     fit.markers.push_back(marker);
   }
   if (estimated == 0) {
-    if (fit.reason.empty()) fit.reason = "no marker of the light was seen in a posed photo; the light stays as given";
+    if (fit.reason.empty()) fit.reason = "no marker of the light was seen in a posed photo";
     return fit;
   }
   fit.fitted = true;

@@ -326,9 +326,8 @@ nlohmann::json LightJson(const SessionInitOptions& options, bool light_markers, 
   if (options.light_position) {
     light["position"] = ToJson(*options.light_position);
   } else if (light_markers) {
-    light["position"] = {0.0, 0.0, 1.0};
-    result->assumptions.push_back(
-        "light position: a placeholder (0, 0, 1); `ibrdf align` finds the light from its markers");
+    light["position"] = "unknown";
+    result->assumptions.push_back("light position: unknown; `ibrdf align` finds the light from its markers");
   } else {
     light["position"] = nullptr;
     result->missing.push_back(

@@ -28,6 +28,10 @@ struct Light {
   // calibrate/white_reference_intensity.h) must measure it before the light is used; `intensity` is then a
   // placeholder (ones).
   bool has_intensity = true;
+  // False where the session states the placement as "unknown": a light on the targets' light card,
+  // whose position `ibrdf align` finds from its markers. `position` (or `direction`) is then a
+  // placeholder that no stage may use: align fails when it cannot find the light, derender refuses it.
+  bool placement_known = true;
 };
 
 // "point", "directional": the kind's name in the session format.

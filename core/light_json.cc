@@ -10,7 +10,11 @@ nlohmann::json LightJson(const Light& light) {
   nlohmann::json l;
   if (!light.id.empty()) l["id"] = light.id;
   l["kind"] = LightKindName(light.kind);
-  l[LightPlacementKey(light.kind)] = ToJson(LightPlacement(light));
+  if (light.placement_known) {
+    l[LightPlacementKey(light.kind)] = ToJson(LightPlacement(light));
+  } else {
+    l[LightPlacementKey(light.kind)] = "unknown";
+  }
   if (light.has_intensity) l["intensity"] = ToJson(light.intensity);
   return l;
 }

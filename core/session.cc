@@ -73,7 +73,11 @@ Light ParseLight(JsonObject object, int version, bool needs_id) {
   const std::string kind = object.String("kind");
   if (kind == "point") {
     light.kind = Light::Kind::kPoint;
-    light.position = object.Vector3("position");
+    if (object.Has("position") && object.Raw("position") == "unknown") {
+      light.placement_known = false;
+    } else {
+      light.position = object.Vector3("position");
+    }
   } else if (kind == "directional") {
     light.kind = Light::Kind::kDirectional;
     light.direction = object.Vector3("direction");
@@ -822,6 +826,17 @@ Session Session::Load(const std::string& path) {
     session.photos.push_back(ParsePhoto(photo, session.directory, context));
   }
   if (session.photos.empty()) ThrowError(root.Where("photos"), "a session needs at least one photo");
+  // A light of unknown position needs the markers that let align find it.
+  for (size_t k = 0; k < session.lights.size(); ++k) {
+    if (session.lights[k].placement_known) continue;
+    if (!session.targets || !session.targets->light || session.targets->light->light != k) {
+      const std::string pointer = root.Has("lights") ? "/lights/" + std::to_string(k) : "/light";
+      ThrowError(session.manifest_path + ": " + pointer + "/position",
+                 LightLabel(session.lights[k]) +
+                     "'s position is \"unknown\", but no light markers (targets.light) let `ibrdf align` find it: "
+                     "give the position in metres");
+    }
+  }
   // A light without a stated intensity needs a calibration that measures it.
   for (size_t k = 0; k < session.lights.size(); ++k) {
     const Light& light = session.lights[k];

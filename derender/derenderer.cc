@@ -682,6 +682,11 @@ void CheckPhotoPoses(const Session& session, const SampleSurface& sample) {
     if (sample.Contains(photo.camera_from_world->Inverse().translation)) {
       ThrowError(where, "the camera centre is inside the sample");
     }
+    if (photo.role == PhotoRole::kMeasurement && !session.PhotoLight(i).placement_known) {
+      ThrowError(where, "photo " + photo.file + " was taken under " + LightLabel(session.PhotoLight(i)) +
+                            ", whose position is unknown (run `ibrdf align`, which finds it from the light's "
+                            "markers, or state it)");
+    }
     if (photo.role == PhotoRole::kMeasurement && !session.PhotoLight(i).has_intensity) {
       ThrowError(where, "photo " + photo.file + " was taken under " + LightLabel(session.PhotoLight(i)) +
                             ", which has no intensity and no calibration measures it (give the light's "

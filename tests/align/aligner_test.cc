@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
+#include "core/light_json.h"
 #include "derender/derenderer.h"
 #include "reconstruct/truth_comparison.h"
 #include "tests/test_util.h"
@@ -169,6 +170,50 @@ TEST(Align, LightUnseenStaysAsGivenWithAReason) {
   EXPECT_FALSE(result.light.fitted);
   EXPECT_NE(result.light.reason.find("no marker of the light"), std::string::npos) << result.light.reason;
   EXPECT_EQ(result.session.lights[0].position, session.lights[0].position);
+}
+
+// A light the session could not place ("position": "unknown", as session init writes it for a light
+// with markers) and whose markers no photo sees: align stops with what it measured and the remedy,
+// rather than keep the placeholder.
+TEST(Align, UnknownLightUnseenIsAVerdictNotAPlaceholder) {
+  ScratchDir dir;
+  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
+  Session session = Session::Load(MakeSession(dir / "s", TargetOptions(2), material));
+  std::vector<PhotoSpec> measurement;
+  for (const PhotoSpec& photo : session.photos) {
+    if (photo.role == PhotoRole::kMeasurement) measurement.push_back(photo);
+  }
+  session.photos = measurement;
+  session.lights[0].placement_known = false;
+  AlignOptions options;
+  options.fit_sphere = false;
+  try {
+    AlignSession(session, options);
+    ADD_FAILURE() << "align kept an unknown light";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("light fit failed"), std::string::npos) << message;
+    EXPECT_NE(message.find("0 of 0 light photos posed"), std::string::npos) << message;
+    EXPECT_NE(message.find("--light-position-m"), std::string::npos) << message;
+  }
+}
+
+// With its light photos, the same unknown light is found and the aligned session states it.
+TEST(Align, UnknownLightIsFoundFromItsMarkers) {
+  ScratchDir dir;
+  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
+  Session session = Session::Load(MakeSession(dir / "s", TargetOptions(2), material));
+  const Eigen::Vector3d truth = session.lights[0].position;
+  session.lights[0].placement_known = false;
+  session.lights[0].position = Eigen::Vector3d::Zero();
+  AlignOptions options;
+  options.fit_sphere = false;
+  // The session format writes the unknown position as "unknown" (the one light writer).
+  EXPECT_EQ(LightJson(session.lights[0]).at("position"), "unknown");
+  const AlignResult result = AlignSession(session, options);
+  ASSERT_TRUE(result.light.fitted) << result.light.reason;
+  EXPECT_TRUE(result.session.lights[0].placement_known);
+  EXPECT_LT((result.session.lights[0].position - truth).norm(), 5e-3);
 }
 
 // The light block and photo roles round-trip; an unknown key in the light block, an id on both the

@@ -693,6 +693,17 @@ TEST_F(SessionV2Test, LightWithoutIntensityAndNoCalibrationIsAnError) {
   ExpectLoadError(manifest, "/light");
 }
 
+// "position": "unknown" (session init's light on a marker card) needs the light's markers; without them
+// it is an error naming the field.
+TEST_F(SessionV2Test, UnknownLightPositionNeedsTheLightsMarkers) {
+  json manifest = ValidManifest();
+  manifest["light"]["position"] = "unknown";
+  ExpectLoadError(manifest, "/light/position");
+  WriteManifest(manifest);
+  const std::string message = testing::ErrorOf([&] { Session::Load(ManifestPath()); });
+  EXPECT_NE(message.find("no light markers"), std::string::npos) << message;
+}
+
 // Masks: missing files are errors at load; masks on white-reference and targets photos are refused.
 TEST_F(SessionV2Test, MaskKeysAreChecked) {
   json manifest = ManifestV2();
