@@ -110,5 +110,37 @@ TEST(CaptureCli, SessionInitFromSyntheticPhotos) {
   EXPECT_FALSE(session.radiometry.saturation_stated);
 }
 
+// A camera's card at 640x480 (photos with EXIF only): session init leaves the light's position
+// "unknown" for align to find from the light's card, whose markers are too small there to pose any
+// light photo. align stops with the verdict (what it posed, the remedy); nothing uses a placeholder.
+TEST(CaptureCli, LowResolutionLightCardStopsAlignWithAVerdict) {
+  ScratchDir dir;
+  const RunResult synth = RunIbrdf("synth --out " + dir / "synth" + " --material " + MaterialPath("bluepaint") +
+                                   " --targets --light-photos 3 --photos 4 --width 640 --height 480");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const Session truth = Session::Load(dir / "synth");
+  std::string photos, light_photos;
+  for (size_t i = 0; i < truth.photos.size(); ++i) {
+    (truth.photos[i].role == PhotoRole::kTargets ? light_photos : photos) += " " + truth.PhotoPath(i);
+  }
+  ASSERT_EQ(RunIbrdf("targets --out " + dir / "targets" + " --no-charuco --dpi 72").exit_code, 0);
+  const RunResult init = RunIbrdf("session init" + photos + " --target-photos" + light_photos + " --targets " +
+                                  dir / "targets/targets.json" +
+                                  " --sample-radius-m 0.04 --radius-known --light-intensity 1,1,1 --out " + dir / "s");
+  ASSERT_EQ(init.exit_code, 0) << init.output;
+  EXPECT_NE(init.output.find("light position: unknown"), std::string::npos) << init.output;
+  EXPECT_EQ(ReadJsonFile(dir / "s/session.json").at("light").at("position"), "unknown");
+  const RunResult align = RunIbrdf("align " + dir / "s" + " --out " + dir / "aligned");
+  EXPECT_EQ(align.exit_code, 1) << align.output;
+  EXPECT_NE(align.output.find("light fit failed"), std::string::npos) << align.output;
+  EXPECT_NE(align.output.find("0 of 3 light photos posed"), std::string::npos) << align.output;
+  EXPECT_FALSE(fs::exists(dir / "aligned"));
+  // run stops at the same place: no stage after align runs with the placeholder.
+  const RunResult run = RunIbrdf("run " + dir / "s" + " --out " + dir / "run" + " --no-report");
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("light fit failed"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir / "run/samples.npy"));
+}
+
 }  // namespace
 }  // namespace ibrdf
