@@ -557,50 +557,12 @@ GgxParameters ReadGgx(const BrdfModel& model) {
   p.fresnel = object.String("fresnel", "schlick");
   return p;
 }
-// The real IOR with the given normal-incidence reflectance, F0 = ((eta - 1) / (eta + 1))^2, kept within
-// 1.02 to 1.99 for the snippets (a coating needs an IOR above 1).
-double SnippetIor(double f0) {
-  const double r = std::sqrt(std::clamp(f0, 1e-4, 0.99));
-  return (1.0 + r) / (1.0 - r);
-}
-// Unpolarized Fresnel reflectance of a smooth dielectric boundary (exterior 1, interior eta).
-double SmoothDielectricFresnel(double cos_i, double eta) {
-  const double sin_t2 = (1.0 - cos_i * cos_i) / (eta * eta);
-  if (sin_t2 >= 1.0) return 1.0;
-  const double cos_t = std::sqrt(1.0 - sin_t2);
-  const double rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-  const double rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-  return 0.5 * (rs * rs + rp * rp);
-}
 std::string Rgb(const Eigen::Vector3d& v, const char* separator) {
   char buffer[128];
   std::snprintf(buffer, sizeof(buffer), "%.6g%s%.6g%s%.6g", v[0], separator, v[1], separator, v[2]);
   return buffer;
 }
 }  // namespace
-
-double FresnelDiffuseReflectance(double eta) {
-  if (eta < 1.0) return -1.4399 * eta * eta + 0.7099 * eta + 0.6681 + 0.0636 / eta;  // Egan and Hilgeman
-  const double e = 1.0 / eta;                                                        // d'Eon and Irving
-  return 0.919317 + e * (-3.4793 + e * (6.75335 + e * (-7.80989 + e * (4.98554 + e * -1.36881))));
-}
-
-PlasticParameters PlasticFromGgx(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& f0, double alpha) {
-  PlasticParameters p;
-  p.eta = SnippetIor(f0.mean());
-  p.alpha = alpha;
-  // A diffuse base under a dielectric coating, with the inter-reflections between them (roughplastic
-  // with nonlinear = true): f_d = rho / (1 - rho Fdr_int) / eta^2 t(cos_i) t(cos_o) / pi, t = 1 - F.
-  // Solved for rho so that f_d = d / pi at 35 degrees (the middle of 0 to 70) on both sides.
-  const double t = 1.0 - SmoothDielectricFresnel(std::cos(35.0 * M_PI / 180.0), p.eta);
-  const double fdr = FresnelDiffuseReflectance(1.0 / p.eta);
-  const double e2 = p.eta * p.eta;
-  for (int c = 0; c < 3; ++c) {
-    const double d = diffuse_albedo[c];
-    p.base_albedo[c] = std::min(1.0, d * e2 / (t * t + d * e2 * fdr));
-  }
-  return p;
-}
 
 double ComplexFresnel(double cos_theta_i, double eta, double k) {
   using Complex = std::complex<double>;
@@ -734,8 +696,7 @@ RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::str
             << "    <rgb name=\"k\" value=\"" << Rgb(k, ", ") << "\"/>\n"
             << "</bsdf>\n";
   } else {
-    out.kind = "plastic";
-    const PlasticParameters plastic = PlasticFromGgx(p.diffuse, p.f0, p.alpha);
+    out.kind = "mix";
     const PbrtMixParameters mix = PbrtMixFromGgx(p.diffuse, p.f0, p.alpha, p.fresnel == "dielectric");
     char amount[32], fresnel_rms[160];
     std::snprintf(amount, sizeof(amount), "%.6g", mix.amount);
@@ -762,15 +723,31 @@ RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::str
          << "    \"string type\" \"mix\"\n"
          << "    \"string materials\" [ \"" << name << "-diffuse\" \"" << name << "-specular\" ]\n"
          << "    \"float amount\" " << amount << "\n";
-    mitsuba << "<!-- Mitsuba 3: " << header << ". A rough plastic: the diffuse reflectance is the fitted\n"
-            << "     diffuse (" << Rgb(p.diffuse, " ") << ") inverted for the coating, one IOR from the mean F0. -->\n"
-            << colour_xml << "<bsdf type=\"roughplastic\" id=\"" << name << "\">\n"
-            << "    <string name=\"distribution\" value=\"ggx\"/>\n"
-            << "    <float name=\"alpha\" value=\"" << p.alpha << "\"/>\n"
-            << "    <float name=\"int_ior\" value=\"" << plastic.eta << "\"/>\n"
-            << "    <float name=\"ext_ior\" value=\"1.0\"/>\n"
-            << "    <boolean name=\"nonlinear\" value=\"true\"/>\n"
-            << "    <rgb name=\"diffuse_reflectance\" value=\"" << Rgb(plastic.base_albedo, ", ") << "\"/>\n"
+    // Mitsuba 3's blendbsdf evaluates (1 - weight) f(first nested BSDF) + weight f(second), the order
+    // being that of the nested elements (src/bsdfs/blendbsdf.cpp eval), so the diffuse comes first and
+    // weight is the mix's amount. roughconductor's GGX uses the separable Smith G, as the fit does, and
+    // the conductor Fresnel of dot(wi, h), as pbrt-v4's conductor. twosided renders both faces alike.
+    mitsuba << "<!-- Mitsuba 3: " << header << ".\n"
+            << "     A blend: blendbsdf renders (1 - weight) x its first BSDF + weight x its second, the fitted\n"
+            << "     diffuse (" << Rgb(p.diffuse, " ") << ") / pi plus its GGX specular term (alpha " << p.alpha
+            << ", " << (p.fresnel == "dielectric" ? "dielectric" : "Schlick") << " Fresnel of F0 " << Rgb(p.f0, " ")
+            << ").\n"
+            << "     The conductor's eta + i k make weight x Fresnel the fitted Fresnel over 0 to 70 degrees\n"
+            << "     (relative RMS " << fresnel_rms << " for R, G, B); its Fresnel rises to 1 at grazing.\n"
+            << "     twosided: both faces render the same. -->\n"
+            << colour_xml << "<bsdf type=\"twosided\" id=\"" << name << "\">\n"
+            << "    <bsdf type=\"blendbsdf\">\n"
+            << "        <float name=\"weight\" value=\"" << amount << "\"/>\n"
+            << "        <bsdf type=\"diffuse\" id=\"" << name << "-diffuse\">\n"
+            << "            <rgb name=\"reflectance\" value=\"" << Rgb(mix.reflectance, ", ") << "\"/>\n"
+            << "        </bsdf>\n"
+            << "        <bsdf type=\"roughconductor\" id=\"" << name << "-specular\">\n"
+            << "            <string name=\"distribution\" value=\"ggx\"/>\n"
+            << "            <float name=\"alpha\" value=\"" << p.alpha << "\"/>\n"
+            << "            <rgb name=\"eta\" value=\"" << Rgb(mix.eta, ", ") << "\"/>\n"
+            << "            <rgb name=\"k\" value=\"" << Rgb(mix.k, ", ") << "\"/>\n"
+            << "        </bsdf>\n"
+            << "    </bsdf>\n"
             << "</bsdf>\n";
   }
   out.pbrt = pbrt.str();

@@ -98,14 +98,14 @@ nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& nam
 
 // Renderer materials for a GGX fit, named `name`: a metal (F0 above 0.2 with a diffuse albedo under a
 // tenth of it) as a rough conductor keeping its colour (pbrt-v4 "conductor" with "reflectance", Mitsuba
-// 3 "roughconductor" with eta = 1 and k from F0); anything else for pbrt-v4 as a "mix" of a "diffuse"
-// and a "conductor" whose expectation is the fitted sum (PbrtMixFromGgx), and for Mitsuba 3 as a
-// "roughplastic" with nonlinear inter-reflection, one IOR from the mean F0 and the base albedo inverted
-// for the coating (roughplastic's closed form), so the rendered diffuse term is the fitted one at 35
-// degrees. `colour_space` is the samples' (their sidecar's "colour_space"), stated in both snippets,
-// with a warning where it is not linear sRGB (renderers read "rgb" values as linear sRGB).
+// 3 "roughconductor" with eta = 1 and k from F0); anything else as the expectation of a diffuse and a
+// rough conductor whose sum is the fitted one (PbrtMixFromGgx): for pbrt-v4 a "mix" of a "diffuse" and a
+// "conductor", for Mitsuba 3 a "twosided" "blendbsdf" of a "diffuse" and a "roughconductor" with the
+// same parameters (blendbsdf's weight, the second BSDF's share, is the mix's amount). `colour_space` is
+// the samples' (their sidecar's "colour_space"), stated in both snippets, with a warning where it is not
+// linear sRGB (renderers read "rgb" values as linear sRGB).
 struct RendererSnippets {
-  std::string kind;                     // "conductor" or "plastic"
+  std::string kind;                     // "conductor" or "mix"
   std::string pbrt, mitsuba;            // the snippets' text
   std::string pbrt_file, mitsuba_file;  // suggested file names: NAME.pbrt, NAME.xml
 };
@@ -113,12 +113,12 @@ RendererSnippets RendererMaterials(const ModelFitResult& ggx_fit, const std::str
                                    const std::string& colour_space = "");
 
 // pbrt-v4's MixMaterial picks its second material with probability `amount` at each shading point, so
-// its rendered BRDF is the expectation (1 - amount) f_diffuse + amount f_conductor. For a GGX fit
-// f = d / pi + F(cos_d) D G / (4 cos_i cos_o): a "diffuse" of reflectance d / (1 - amount) (at most 1:
-// amount = 1 - max d) and a "conductor" of the fitted roughness whose complex IOR eta + i k per channel
-// makes amount * FrComplex(cos_d; eta + i k) closest to the fitted Fresnel F (relative least squares
-// over theta_d 0 to 70 degrees, 1-degree steps; a conductor's Fresnel rises to 1 at grazing, so the
-// match is approximate where amount is small).
+// its rendered BRDF is the expectation (1 - amount) f_diffuse + amount f_conductor; Mitsuba 3's blendbsdf
+// evaluates that same sum with weight = amount. For a GGX fit f = d / pi + F(cos_d) D G / (4 cos_i cos_o):
+// a "diffuse" of reflectance d / (1 - amount) (at most 1: amount = 1 - max d) and a conductor of the
+// fitted roughness whose complex IOR eta + i k per channel makes amount * FrComplex(cos_d; eta + i k)
+// closest to the fitted Fresnel F (relative least squares over theta_d 0 to 70 degrees, 1-degree steps; a
+// conductor's Fresnel rises to 1 at grazing, so the match is approximate where amount is small).
 struct PbrtMixParameters {
   double amount = 1.0;                                    // probability of the conductor, in [0, 1]
   Eigen::Vector3d reflectance = Eigen::Vector3d::Zero();  // the diffuse material's, in [0, 1]
@@ -135,17 +135,5 @@ PbrtMixParameters PbrtMixFromGgx(const Eigen::Vector3d& diffuse_albedo, const Ei
 // The unpolarized Fresnel reflectance of a conductor of complex IOR eta + i k for light at cos_theta_i
 // (pbrt-v4's FrComplex); with k = 0 and eta >= 1 the dielectric one.
 double ComplexFresnel(double cos_theta_i, double eta, double k);
-
-// The snippets' parameters, for tests that evaluate them as the renderers do.
-struct PlasticParameters {
-  double eta = 1.5;                                       // interior IOR (exterior 1)
-  double alpha = 0.1;                                     // GGX roughness, not remapped
-  Eigen::Vector3d base_albedo = Eigen::Vector3d::Zero();  // under the coating (inverted)
-};
-PlasticParameters PlasticFromGgx(const Eigen::Vector3d& diffuse_albedo, const Eigen::Vector3d& f0, double alpha);
-// The diffuse Fresnel reflectance of a dielectric boundary of relative IOR eta, as Mitsuba 3's
-// fresnel_diffuse_reflectance (Egan and Hilgeman's fit below 1, d'Eon and Irving's above); the
-// coating's internal reflectance is FresnelDiffuseReflectance(1 / eta).
-double FresnelDiffuseReflectance(double eta);
 
 }  // namespace ibrdf

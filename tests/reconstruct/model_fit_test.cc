@@ -246,7 +246,8 @@ TEST(ModelFit, GgxRecoversGgxMaterialAndWritesSnippets) {
   EXPECT_LT(RelativeRmsAgainst(*fit.brdf, *material, samples), 0.01) << fit.BriefReport();
   const RendererSnippets snippets = RendererMaterials(fit, "m");
   EXPECT_NE(snippets.pbrt.find("\"string type\" \"mix\""), std::string::npos) << snippets.pbrt;
-  EXPECT_NE(snippets.mitsuba.find("roughplastic"), std::string::npos);
+  EXPECT_NE(snippets.mitsuba.find("<bsdf type=\"twosided\" id=\"m\">"), std::string::npos) << snippets.mitsuba;
+  EXPECT_NE(snippets.mitsuba.find("<bsdf type=\"blendbsdf\">"), std::string::npos) << snippets.mitsuba;
 }
 
 }  // namespace
