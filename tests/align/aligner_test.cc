@@ -153,17 +153,23 @@ TEST(Align, LightFromItsMarkers) {
   }
 }
 
-// Without target photos nothing sees the light's card: the light stays as given, and the result says
-// why (never a guess).
-TEST(Align, LightUnseenStaysAsGivenWithAReason) {
-  ScratchDir dir;
+// A two-photo session on the marker platform without its target photos: nothing sees the light's card.
+Session WithoutTargetPhotos(const std::string& dir) {
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
-  Session session = Session::Load(MakeSession(dir / "s", TargetOptions(2), material));
+  Session session = Session::Load(MakeSession(dir, TargetOptions(2), material));
   std::vector<PhotoSpec> measurement;
   for (const PhotoSpec& photo : session.photos) {
     if (photo.role == PhotoRole::kMeasurement) measurement.push_back(photo);
   }
   session.photos = measurement;
+  return session;
+}
+
+// Without target photos nothing sees the light's card: the light stays as given, and the result says
+// why (never a guess).
+TEST(Align, LightUnseenStaysAsGivenWithAReason) {
+  ScratchDir dir;
+  Session session = WithoutTargetPhotos(dir / "s");
   AlignOptions options;
   options.fit_sphere = false;
   const AlignResult result = AlignSession(session, options);
@@ -177,13 +183,7 @@ TEST(Align, LightUnseenStaysAsGivenWithAReason) {
 // rather than keep the placeholder.
 TEST(Align, UnknownLightUnseenIsAVerdictNotAPlaceholder) {
   ScratchDir dir;
-  const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
-  Session session = Session::Load(MakeSession(dir / "s", TargetOptions(2), material));
-  std::vector<PhotoSpec> measurement;
-  for (const PhotoSpec& photo : session.photos) {
-    if (photo.role == PhotoRole::kMeasurement) measurement.push_back(photo);
-  }
-  session.photos = measurement;
+  Session session = WithoutTargetPhotos(dir / "s");
   session.lights[0].placement_known = false;
   AlignOptions options;
   options.fit_sphere = false;
