@@ -46,16 +46,6 @@ CLI::Option* AddClearingFlag(CLI::App& app, const std::string& name, bool& value
 // A length kept in metres and given in millimetres (--marker-mm); --help shows its default in millimetres.
 CLI::Option* AddMillimetres(CLI::App& app, const std::string& name, double& metres, const std::string& help);
 
-// The inputs of a command that reads a session (core/session.h): its files, its manifest and its folder.
-// A template, so that a binary whose command reads no session does not link the session code.
-template <typename SessionType>
-std::vector<std::string> SessionInputs(const SessionType& session) {
-  std::vector<std::string> inputs = session.InputFiles();
-  inputs.push_back(session.manifest_path);
-  inputs.push_back(session.directory);
-  return inputs;
-}
-
 // Prints once that `old_name` is deprecated in favour of `new_name` (a warning on standard error).
 void WarnDeprecatedOption(const std::string& old_name, const std::string& new_name);
 

@@ -116,26 +116,17 @@ Session WithCalibratedLights(const Session& target, const LightRigCalibration& c
   return copy;
 }
 
-namespace {
-// A session's inputs for the output guard: its files, its manifest and its folder.
-void AddSessionInputs(const Session& session, std::vector<std::string>* inputs) {
-  for (const std::string& file : session.InputFiles()) inputs->push_back(file);
-  inputs->push_back(session.manifest_path);
-  inputs->push_back(session.directory);
-}
-}  // namespace
-
 LightRigCalibration RunLightRigStage(const LightRigStageRequest& request, const LightRigOptions& options) {
   std::vector<Session> placements;
   std::vector<std::string> inputs;
   for (const std::string& path : request.placements) {
     placements.push_back(Session::Load(path));
-    AddSessionInputs(placements.back(), &inputs);
+    for (const std::string& input : SessionInputs(placements.back())) inputs.push_back(input);
   }
   std::optional<Session> diffuse;
   if (!request.diffuse.empty()) {
     diffuse = Session::Load(request.diffuse);
-    AddSessionInputs(*diffuse, &inputs);
+    for (const std::string& input : SessionInputs(*diffuse)) inputs.push_back(input);
   }
   if (options.albedo && !diffuse) ThrowError("--albedo", "needs --diffuse (the sphere it describes)");
   const std::string report_path = LightRigReportPath(request.out);
@@ -151,9 +142,7 @@ LightRigCalibration RunLightRigStage(const LightRigStageRequest& request, const 
       ThrowError("--write-session", "needs --apply-to SESSION or --diffuse SESSION (the session to give the lights)");
     }
     // The folder written replaces --write-session whole: never the target's folder or its photos.
-    std::vector<std::string> target_inputs;
-    AddSessionInputs(*target, &target_inputs);
-    RequireWritableOutput(request.write_session, request.overwrite, target_inputs);
+    RequireWritableOutput(request.write_session, request.overwrite, SessionInputs(*target));
   } else if (!request.apply_to.empty()) {
     ThrowError("--apply-to", "needs --write-session (where to write the session with the calibrated lights)");
   }

@@ -33,6 +33,16 @@ void RequireWritableOutputs(const std::string& output, const std::vector<Compani
 // is resumed rather than replaced).
 void RequireOutputOutsideInputs(const std::string& output, const std::vector<std::string>& inputs);
 
+// The inputs of a stage that reads a session (core/session.h): its files, its manifest and its folder.
+// A template, so that a binary whose command reads no session does not link the session code.
+template <typename SessionType>
+std::vector<std::string> SessionInputs(const SessionType& session) {
+  std::vector<std::string> inputs = session.InputFiles();
+  inputs.push_back(session.manifest_path);
+  inputs.push_back(session.directory);
+  return inputs;
+}
+
 // Every regular file under `folder`, recursively (none if it is not a folder): the inputs of a command
 // that reads a whole folder (a run folder, a COLMAP model, a calibration folder).
 std::vector<std::string> FilesUnder(const std::string& folder);
