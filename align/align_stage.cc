@@ -67,8 +67,9 @@ ColmapAlignment MergeColmap(const Session& session, const AlignStageOptions& opt
 }
 
 // A scanned mesh whose scan saw the platform's markers: its similarity into the world.
-void RegisterScannedMesh(const Session& session, SampleSpec* sample, nlohmann::json* extra) {
-  if (!IsMeshSample(sample->kind) || sample->scan_targets.empty()) return;
+std::optional<MeshRegistration> RegisterScannedMesh(const Session& session, SampleSpec* sample,
+                                                    nlohmann::json* extra) {
+  if (!IsMeshSample(sample->kind) || sample->scan_targets.empty()) return std::nullopt;
   if (!session.targets)
     ThrowError(session.manifest_path, "/sample/scan_targets needs a \"targets\" block with the markers' layout");
   const MeshRegistration registration =
@@ -77,6 +78,7 @@ void RegisterScannedMesh(const Session& session, SampleSpec* sample, nlohmann::j
   sample->world_from_mesh = registration.world_from_mesh;
   (*extra)["mesh_registration"] = ToJson(registration);
   Log(1, registration.BriefReport());
+  return registration;
 }
 
 }  // namespace
@@ -115,11 +117,18 @@ AlignStageResult AlignSessionToFolder(const Session& input, const AlignStageOpti
   if (!options.colmap_model.empty() || options.run_colmap) {
     stage.colmap = MergeColmap(session, options, directory.temporary_path(), &result, &extra);
   }
-  RegisterScannedMesh(session, &result.session.sample, &extra);
+  const std::optional<MeshRegistration> registration = RegisterScannedMesh(session, &result.session.sample, &extra);
+  result.mesh_registered = registration.has_value();
+  // Nothing is written when a calibration cannot be trusted, unless the user accepted it by name.
+  stage.verdicts = AlignmentVerdicts(input, result, registration, options.verdict_bounds);
+  EnforceVerdicts(&stage.verdicts, options.accept, input.manifest_path);
+  extra["verdicts"] = VerdictsToJson(stage.verdicts);
   // The aligned session's path fields still name files from the input session's folder.
   result.session.directory = session.directory;
   result.session = result.session.Rebased(out_dir);
-  result.session.name = session.name + "-aligned";
+  // Aligned again (an expert's choice: `ibrdf run` does not), the session keeps its name.
+  if (!session.Applied(SessionStage::kAlign)) result.session.name = session.name + "-aligned";
+  result.session.MarkApplied(SessionStage::kAlign);
   result.session.Save((fs::path(directory.temporary_path()) / "session.json").string());
   nlohmann::json alignment = ToJson(result);
   alignment.update(extra);
@@ -127,6 +136,8 @@ AlignStageResult AlignSessionToFolder(const Session& input, const AlignStageOpti
   directory.Commit();
   Log(1, result.bundle.BriefReport());
   Log(1, result.BriefReport());
+  Log(1, "align verdict: " + std::string(VerdictLevelName(WorstVerdict(stage.verdicts))) + " over " +
+             std::to_string(stage.verdicts.size()) + " checks");
   stage.session_path = out_dir + "/session.json";
   stage.success = true;
   return stage;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "align/aligner.h"
+#include "align/alignment_verdicts.h"
 #include "align/colmap_alignment.h"
 #include "align/colmap_runner.h"
 #include "align/intrinsic_calibration.h"
@@ -30,6 +31,9 @@ struct AlignStageOptions {
   ColmapRunnerOptions colmap_runner;        // with run_colmap (fix_intrinsics: keep the session's camera)
   ColmapAlignmentOptions colmap_alignment;  // COLMAP's model into the target frame
   bool overwrite = false;                   // replace an existing output folder
+  AlignmentVerdictBounds verdict_bounds;    // docs/verdicts.md
+  AcceptedChecks accept;                    // failed checks to proceed with anyway (--accept), recorded
+
   // False with `*why` naming the failing constraint.
   bool Check(std::string* why) const;
 };
@@ -41,6 +45,7 @@ struct AlignStageResult {
   std::optional<IntrinsicCalibrationResult> calibration;  // with calibration_dir
   std::optional<ColmapAlignment> colmap;                  // with colmap_model or run_colmap
   std::string session_path;                               // OUT/session.json
+  std::vector<Verdict> verdicts;                          // AlignmentVerdicts, accepted failures marked
   // One line: photos aligned and the extra steps taken.
   std::string BriefReport() const;
 };

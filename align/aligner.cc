@@ -461,6 +461,8 @@ std::string AlignResult::BriefReport() const {
     report += cylinder.BriefReport();
   } else if (sphere.fitted) {
     report += sphere.BriefReport();
+  } else if (mesh_registered) {
+    report += "mesh registered to the markers (a new world_from_mesh)";
   } else {
     report += "sample pose as given";
   }

@@ -85,6 +85,9 @@ struct AlignResult {
   LightFit light;
   WhiteReferencePose white_reference;  // posed only with the card's markers and white-reference photos
   BundleAdjustmentSummary bundle;
+  // The scanned mesh was registered to the markers after the alignment (align_stage's step): its
+  // world_from_mesh is new, not the sample's pose as given.
+  bool mesh_registered = false;
   double rms_px = 0.0;  // over all corners of used photos
   double total_s = 0.0;
   std::string BriefReport() const;

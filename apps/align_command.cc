@@ -37,6 +37,11 @@ IBRDF_COMMAND(30, Align) {
                   "With --run-colmap: let COLMAP refine the session's (or calibrated) intrinsics");
   AddOption(*c, "--colmap-max-center-error-m", o.colmap_alignment.max_center_error_m,
             "COLMAP photos whose centre lands further than this from the target-based one are outliers");
+  c->add_option("--accept", o.accept.names,
+                "Proceed although these checks fail (comma-separated names, e.g. sphere.radius, or all);\n"
+                "recorded as accepted in alignment.json and the run's summary (docs/verdicts.md)")
+      ->delimiter(',')
+      ->type_name("CHECK[,CHECK...]");
   c->callback([args] {
     StageLog stage("align");
     const Session session = Session::Load(args->session);

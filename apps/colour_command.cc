@@ -35,6 +35,10 @@ void AddColourCommand(CLI::App& app) {
       ->add_option("--min-patch-signal", o.min_patch_signal,
                    "Leave out patches whose brightest channel's mean signal is below this (normalized units)")
       ->capture_default_str();
+  command
+      ->add_option("--min-channel-fraction", o.min_channel_fraction,
+                   "Leave out patches with a channel below this fraction of the brightest patch's (a black channel)")
+      ->capture_default_str();
   command->add_option("--min-patches", o.min_patches, "Usable patches the fit needs")->capture_default_str();
   command->add_flag("--detect", args->detect, "Detect the chart (OpenCV mcc) even where the session gives its corners");
   command->add_flag("--overwrite", args->overwrite, "Replace an existing output folder");

@@ -42,17 +42,27 @@ IBRDF_COMMAND(80, Run) {
   // Arguments passed to a stage: in the order of these options (CLI11 runs their callbacks so), the
   // --STAGE-args words before the named options.
   using StageArgs = std::vector<std::string> MeasurementOptions::*;
-  const StageArgs derender = &MeasurementOptions::derender_args, check = &MeasurementOptions::check_args,
+  const StageArgs scan = &MeasurementOptions::scan_args, align = &MeasurementOptions::align_args,
+                  lights = &MeasurementOptions::lights_args, colour = &MeasurementOptions::colour_args,
+                  derender = &MeasurementOptions::derender_args, check = &MeasurementOptions::check_args,
                   reconstruct = &MeasurementOptions::reconstruct_args, report = &MeasurementOptions::report_args;
   const struct {
     const char* flag;
     StageArgs target;
     const char *stage, *help;
-  } more[] = {{"--derender-args", derender, "derender", "--shadow-edge-deg 2"},
+  } more[] = {{"--scan-args", scan, "scan", "--no-outliers --radius-factor 3"},
+              {"--align-args", align, "align", "--max-rms-px 2 --no-cylinder"},
+              {"--lights-args", lights, "lights white", "--min-signal 0.02"},
+              {"--colour-args", colour, "colour", "--min-patches 12 --detect"},
+              {"--derender-args", derender, "derender", "--shadow-edge-deg 2"},
               {"--check-args", check, "check", "--theta-bin-deg 5 --phi-bin-deg 10"},
               {"--reconstruct-args", reconstruct, "reconstruct", "--degree 1 --no-fold"},
               {"--report-args", report, "report", "--angles-deg 20,40,60"}},
-    named[] = {{"--lobes", reconstruct, "reconstruct", "Lafortune lobes (1 to 3)"},
+    named[] = {{"--calibrate", align, "align", "Calibrate the camera first from the ChArUco photos in this folder"},
+               {"--colmap", align, "align", "A COLMAP sparse model whose poses replace the targets'"},
+               {"--min-markers", align, "align", "Reference markers a photo needs"},
+               {"--accept", align, "align", "Proceed although these checks fail (docs/verdicts.md)"},
+               {"--lobes", reconstruct, "reconstruct", "Lafortune lobes (1 to 3)"},
                {"--bandwidth", reconstruct, "reconstruct", "Kernel radii: given, loo or gcv"},
                {"--max-theta-deg", reconstruct, "reconstruct", "Tabulate up to this theta"},
                {"--visibility", derender, "derender", "Mesh samples' shadow rays: auto, on or off"},

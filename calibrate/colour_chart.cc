@@ -76,6 +76,8 @@ bool ColourChartOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_LE(patch_fraction, 0.9);
   IBRDF_CHECK_OPTION_GE(min_patch_signal, 0.0);
   IBRDF_CHECK_OPTION_GE(max_clipped_fraction, 0.0);
+  IBRDF_CHECK_OPTION_GE(min_channel_fraction, 0.0);
+  IBRDF_CHECK_OPTION_LT(min_channel_fraction, 1.0);
   IBRDF_CHECK_OPTION_LT(max_clipped_fraction, 1.0);
   IBRDF_CHECK_OPTION_GE(min_patch_pixels, 1);
   IBRDF_CHECK_OPTION_GE(min_patches, 3);
@@ -218,6 +220,24 @@ ColourChartFit FitColourChart(const Session& session, const std::array<Eigen::Ve
     }
     fit.patches.push_back(patch);
   }
+  // Black channels, against the brightest usable patch in each channel.
+  Eigen::Vector3d brightest = Eigen::Vector3d::Zero();
+  for (const ColourPatch& patch : fit.patches) {
+    if (patch.excluded.empty()) brightest = brightest.cwiseMax(patch.camera_rgb);
+  }
+  for (ColourPatch& patch : fit.patches) {
+    if (!patch.excluded.empty()) continue;
+    for (int c = 0; c < 3; ++c) {
+      if (patch.camera_rgb[c] >= options.min_channel_fraction * brightest[c]) continue;
+      static const char* const kChannels[3] = {"red", "green", "blue"};
+      char text[128];
+      std::snprintf(text, sizeof(text), "black channel: camera %s %.2g %% of the brightest patch's (at least %.2g %%)",
+                    kChannels[c], 100.0 * patch.camera_rgb[c] / brightest[c],
+                    100.0 * options.min_channel_fraction);
+      patch.excluded = text;
+      break;
+    }
+  }
   // Least squares: space_from_camera minimizes sum |M c_k - r_k|^2 over the used patches.
   Eigen::MatrixXd cameras(3, kColorCheckerPatches), targets(3, kColorCheckerPatches);
   for (const ColourPatch& patch : fit.patches) {
@@ -322,6 +342,7 @@ void WriteColourStage(const Session& session, const ColourChartFit& fit, const s
   }
   AtomicDirectory directory(out_dir, overwrite);
   const std::string folder = directory.temporary_path();
+  corrected.MarkApplied(SessionStage::kColour);
   corrected.Rebased(out_dir).Save((std::filesystem::path(folder) / "session.json").string());
   WriteJsonFile((std::filesystem::path(folder) / "colour.json").string(), fit.ToJson());
   WriteImage((std::filesystem::path(folder) / "chart.png").string(), display, PixelFormat::kUint8);

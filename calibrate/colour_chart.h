@@ -28,6 +28,11 @@ struct ColourChartOptions {
   // exposure, in the chart's longest exposure) is below this is too dark to trust (black-level and
   // noise errors) and left out.
   double min_patch_signal = 0.01;
+  // A patch with a channel below this fraction of that channel in the chart's brightest usable
+  // patch is left out ("black channel"): the sensor cut it at its black level (the cyan patch's red, out
+  // of linear sRGB's gamut), so its camera colour is not the linear image of its reflectance, and it
+  // would pull every row of the matrix towards the cut.
+  double min_channel_fraction = 0.0025;
   // A patch with more than this fraction of clipped (or non-finite) pixels is left out.
   double max_clipped_fraction = 0.0;
   // A patch needs at least this many pixels in its read-out square.

@@ -155,7 +155,8 @@ LightRigCalibration RunLightRigStage(const LightRigStageRequest& request, const 
   Log(1, "lights written to " + request.out + " (report: " + report_path + ")");
   if (target) {
     const bool diffuse_center = request.apply_to.empty() && !request.known_sphere;
-    const Session copy = WithCalibratedLights(*target, calibration, request.out, diffuse_center);
+    Session copy = WithCalibratedLights(*target, calibration, request.out, diffuse_center);
+    copy.MarkApplied(SessionStage::kLights);
     AtomicDirectory directory(request.write_session, request.overwrite);
     copy.Rebased(request.write_session, Session::PathStyle::kAbsolute)
         .Save((fs::path(directory.temporary_path()) / "session.json").string());

@@ -262,6 +262,7 @@ LightCalibrationReport WriteLightCalibrationStage(const Session& session, const 
   LightCalibrationReport report;
   Session calibrated = ApplyLightCalibration(session, &report, options);
   calibrated.calibration.reset();  // the white reference is its only step, now applied
+  calibrated.MarkApplied(SessionStage::kLights);
   AtomicDirectory directory(out_dir, overwrite);
   const std::filesystem::path folder = directory.temporary_path();
   calibrated.Rebased(out_dir).Save((folder / "session.json").string());

@@ -768,6 +768,38 @@ bool VisibilityFromName(const std::string& name, Visibility* visibility) {
   return false;
 }
 
+const char* SessionStageName(SessionStage stage) {
+  switch (stage) {
+    case SessionStage::kScan:
+      return "scan";
+    case SessionStage::kAlign:
+      return "align";
+    case SessionStage::kLights:
+      return "lights";
+    case SessionStage::kColour:
+      return "colour";
+  }
+  UnhandledKind("SessionStage", static_cast<int>(stage));
+}
+
+bool SessionStageFromName(const std::string& name, SessionStage* stage) {
+  for (SessionStage candidate : {SessionStage::kScan, SessionStage::kAlign, SessionStage::kLights, SessionStage::kColour}) {
+    if (name == SessionStageName(candidate)) {
+      *stage = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool Session::Applied(SessionStage stage) const {
+  return std::find(stages_applied.begin(), stages_applied.end(), stage) != stages_applied.end();
+}
+
+void Session::MarkApplied(SessionStage stage) {
+  if (!Applied(stage)) stages_applied.push_back(stage);
+}
+
 Session Session::Load(const std::string& path) {
   Session session;
   session.manifest_path = fs::is_directory(path) ? (fs::path(path) / "session.json").string() : path;
@@ -821,6 +853,19 @@ Session Session::Load(const std::string& path) {
   }
   if (root.Has("colour_chart")) {
     session.colour_chart = ParseColourChart(root.Object("colour_chart"), session.directory, context);
+  }
+  if (root.Has("stages_applied")) {
+    const nlohmann::json& stages = root.Raw("stages_applied");
+    if (!stages.is_array()) ThrowError(root.Where("stages_applied"), "expected an array of stage names");
+    for (size_t i = 0; i < stages.size(); ++i) {
+      const std::string where = root.Where("stages_applied") + "/" + std::to_string(i);
+      SessionStage stage;
+      if (!stages[i].is_string() || !SessionStageFromName(stages[i].get<std::string>(), &stage)) {
+        ThrowError(where, "expected \"scan\", \"align\", \"lights\" or \"colour\", got " + stages[i].dump());
+      }
+      if (session.Applied(stage)) ThrowError(where, "\"" + std::string(SessionStageName(stage)) + "\" is listed twice");
+      session.stages_applied.push_back(stage);
+    }
   }
   for (JsonObject& photo : root.Objects("photos")) {
     session.photos.push_back(ParsePhoto(photo, session.directory, context));
@@ -884,6 +929,10 @@ nlohmann::json Session::ToJson() const {
   if (targets) json["targets"] = TargetsToJson(*targets, named);
   if (calibration) json["calibration"] = CalibrationToJson(*calibration, named);
   if (colour_chart) json["colour_chart"] = ColourChartToJson(*colour_chart, named);
+  if (!stages_applied.empty()) {
+    json["stages_applied"] = nlohmann::json::array();
+    for (SessionStage stage : stages_applied) json["stages_applied"].push_back(SessionStageName(stage));
+  }
   json["photos"] = nlohmann::json::array();
   for (const PhotoSpec& photo : photos) json["photos"].push_back(PhotoToJson(photo, named));
   return json;

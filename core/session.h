@@ -209,6 +209,18 @@ struct ColourChartSpec {
   std::vector<ColourPatchFit> patches;
 };
 
+// A stage that writes a session from a session (docs/session-format.md, "stages_applied").
+enum class SessionStage {
+  kScan,    // `ibrdf scan --session` (in `ibrdf run`): the raw scans merged into the mesh
+  kAlign,   // `ibrdf align`: poses from the targets (and the light, the sample, the mesh registration)
+  kLights,  // `ibrdf lights white` / `ibrdf lights calibrate`: the lights measured
+  kColour,  // `ibrdf colour`: the colour chart's matrix fitted
+  IBRDF_DUMMY_KIND
+};
+// "scan", "align", "lights", "colour"; and back (false for any other name).
+const char* SessionStageName(SessionStage stage);
+bool SessionStageFromName(const std::string& name, SessionStage* stage);
+
 struct Session {
   std::string name;
   std::string description;    // free text, optional
@@ -226,6 +238,13 @@ struct Session {
   std::optional<TargetsSpec> targets;
   std::optional<CalibrationSpec> calibration;
   std::optional<ColourChartSpec> colour_chart;  // a colour chart, if any
+  // The calibration stages that wrote this session, in order (SessionStage): `ibrdf run` resumes such
+  // a session instead of repeating them (an aligned session is not aligned again).
+  std::vector<SessionStage> stages_applied;
+  // Whether `stage` is among stages_applied.
+  bool Applied(SessionStage stage) const;
+  // Appends `stage` to stages_applied unless it is there already.
+  void MarkApplied(SessionStage stage);
 
   // Reads and validates a manifest (a session.json path, or a folder holding session.json). Unknown
   // keys, missing fields, wrong types, missing photo files and impossible values are Errors naming the

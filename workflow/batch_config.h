@@ -40,7 +40,7 @@ struct BatchConfig {
 //    "out": "batch-out",                          relative to the config file
 //    "sessions": ["sessions/*", "../samples/felt-sphere", {"path": "p", "name": "n", "options": {...}}],
 //    "options": {"stride": 2, "fits": true, "report": true, "check_regression": false,
-//                "degree": 1, "radius_h_deg": 3, "radius_d_deg": 6},
+//                "degree": 1, "radius_h_deg": 3, "radius_d_deg": 6, "align_args": "--max-rms-px 2", ...},
 //    "threads_per_job": 1, "mem_mb_per_job": 4000, "runtime_min_per_job": 60,
 //    "compare": ["bluepaint", "felt"]}
 // A session entry is a session folder, a session.json, a recipe folder or a recipe.json, or a glob

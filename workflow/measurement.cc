@@ -111,9 +111,11 @@ void Planner::Scan() {
     }
     fs::create_directories(At("scan"));
     scan.arguments = {"scan", "--session", manifest_path, "--out", At("scan/mesh.ply"), "--overwrite"};
+    scan.arguments.insert(scan.arguments.end(), options_.scan_args.begin(), options_.scan_args.end());
     Session merged = *session;
     merged.sample.mesh_file = At("scan/mesh.ply");
     merged.sample.scan_inputs.clear();
+    merged.MarkApplied(SessionStage::kScan);
     scan.action = [launch = launch_, arguments = scan.arguments, merged, folder = At("scan")] {
       const int code = launch("scan", arguments, "");
       if (code == 0) merged.SaveRebased(folder, Session::PathStyle::kAbsolute);
@@ -133,7 +135,11 @@ void Planner::Align() {
   if (session) {
     for (const std::string& file : session->InputFiles()) align.inputs.push_back(file);
   }
-  if (!session || !session->targets) {
+  align.arguments.insert(align.arguments.end(), options_.align_args.begin(), options_.align_args.end());
+  if (session && session->Applied(SessionStage::kAlign)) {
+    // A session `ibrdf align` wrote: resumed as it is, never aligned twice (its name would grow).
+    align.not_applicable = "the session was aligned already (stages_applied); its poses are used as they are";
+  } else if (!session || !session->targets) {
     align.not_applicable = "the session has no targets; its photos' poses are used as given";
     for (size_t i = 0; session && i < session->photos.size(); ++i) {
       if (!session->photos[i].camera_from_world) {
@@ -154,6 +160,7 @@ void Planner::Lights() {
   const std::optional<Session> session = SessionAt(current);
   Stage lights = MakeStage("lights", {"lights", "white", current, "--out", At("lights"), "--overwrite"}, {current},
                            {At("lights/session.json"), At("lights/white-reference.json")});
+  lights.arguments.insert(lights.arguments.end(), options_.lights_args.begin(), options_.lights_args.end());
   if (session) {
     for (const std::string& file : session->InputFiles()) lights.inputs.push_back(file);
   }
@@ -175,7 +182,12 @@ void Planner::Colour() {
   if (session) {
     for (const std::string& file : session->InputFiles()) colour.inputs.push_back(file);
   }
-  if (!session || !session->colour_chart) colour.not_applicable = "the session has no colour_chart";
+  colour.arguments.insert(colour.arguments.end(), options_.colour_args.begin(), options_.colour_args.end());
+  if (!session || !session->colour_chart) {
+    colour.not_applicable = "the session has no colour_chart";
+  } else if (session->colour_chart->matrix) {
+    colour.not_applicable = "the session's colour chart is fitted already (colour_chart.matrix); it is applied as it is";
+  }
   const bool applies = colour.not_applicable.empty();
   Execute(colour);
   if (applies) current = At("colour/session.json");

@@ -32,8 +32,10 @@ struct MeasurementOptions {
   // they end); false: one stage after another (--sequential).
   bool concurrent_sample_stages = true;
   std::string stop_after;  // the last stage to run ("": all of them) (--stop-after)
-  // Extra arguments appended to a stage's command line as given (--derender-args, --check-args,
-  // --reconstruct-args, --report-args, and run's named pass-through options); part of the stage's stamp.
+  // Extra arguments appended to a stage's command line as given (--scan-args, --align-args,
+  // --lights-args, --colour-args, --derender-args, --check-args, --reconstruct-args, --report-args, and
+  // run's named pass-through options); part of the stage's stamp.
+  std::vector<std::string> scan_args, align_args, lights_args, colour_args;
   std::vector<std::string> derender_args, check_args, reconstruct_args, report_args;
 
   // The messages name the flag: "--stride must be at least 1".

@@ -97,6 +97,42 @@ void AddTruth(const fs::path& dir, const std::string& truth_path, nlohmann::json
   (*summary)["truth"] = truth;
 }
 
+// The calibration stages' verdicts (align/alignment.json "verdicts", core/verdict.h), each with its
+// stage, and every stage's warnings in one list: the verdicts that are not ok (an accepted failure
+// included, marked so), align's own warnings and derender's exposure advice.
+void AddVerdicts(const fs::path& dir, nlohmann::json* summary) {
+  nlohmann::json verdicts = nlohmann::json::array(), warnings = nlohmann::json::array();
+  const std::optional<StageJson> align = StageJson::ReadIfExists((dir / "align" / "alignment.json").string());
+  if (align) {
+    const nlohmann::json list = align->ValueOr("/verdicts", nlohmann::json::array());
+    for (size_t i = 0; list.is_array() && i < list.size(); ++i) {
+      const std::string at = "/verdicts/" + std::to_string(i);
+      nlohmann::json v = {{"stage", "align"},
+                          {"check", align->String(at + "/check")},
+                          {"verdict", align->String(at + "/verdict")},
+                          {"measured", align->String(at + "/measured", "")},
+                          {"bound", align->String(at + "/bound", "")},
+                          {"remedy", align->String(at + "/remedy", "")},
+                          {"accepted", align->Boolean(at + "/accepted", false)}};
+      if (v["verdict"] != "ok") {
+        warnings.push_back("align: " + v["check"].get<std::string>() + ": " + v["verdict"].get<std::string>() +
+                           (v["accepted"].get<bool>() ? " (accepted by the user)" : "") + ": " +
+                           v["measured"].get<std::string>() + "; bound: " + v["bound"].get<std::string>());
+      }
+      verdicts.push_back(v);
+    }
+    const nlohmann::json own = align->ValueOr("/warnings", nlohmann::json::array());
+    for (const nlohmann::json& w : own) {
+      if (w.is_string()) warnings.push_back("align: " + w.get<std::string>());
+    }
+  }
+  if (summary->contains("samples")) {
+    for (const nlohmann::json& w : (*summary)["samples"]["exposure_warnings"]) warnings.push_back("derender: " + w.get<std::string>());
+  }
+  (*summary)["verdicts"] = verdicts;
+  (*summary)["warnings"] = warnings;
+}
+
 // "1.23 %", or "n/a" for a null (NaN) or absent figure.
 std::string Percent(const nlohmann::json& value) {
   if (!value.is_number()) return "n/a";
@@ -137,6 +173,7 @@ nlohmann::json BuildRunSummary(const WorkflowRun& run, const std::string& input,
   AddConsistency(dir, &summary);
   AddReconstruction(dir, &summary);
   AddTruth(dir, truth_path, &summary);
+  AddVerdicts(dir, &summary);
   const std::string report = (dir / "report" / "index.html").string();
   if (fs::exists(report)) summary["report"] = report;
   return summary;
@@ -145,6 +182,13 @@ nlohmann::json BuildRunSummary(const WorkflowRun& run, const std::string& input,
 std::vector<std::string> RunHeadline(const nlohmann::json& summary_json) {
   const StageJson summary(summary_json, "summary.json");
   std::vector<std::string> lines;
+  const nlohmann::json verdicts = summary.ValueOr("/verdicts", nlohmann::json::array());
+  for (const nlohmann::json& v : verdicts) {
+    if (!v.is_object() || v.value("verdict", "") == "ok") continue;
+    lines.push_back(std::string("verdict: ") + v.value("stage", "") + " " + v.value("check", "") + ": " +
+                    v.value("verdict", "") + (v.value("accepted", false) ? " (accepted by the user)" : "") + ": " +
+                    v.value("measured", "") + "; bound: " + v.value("bound", ""));
+  }
   if (summary.Has("/samples")) {
     std::string rejected;
     for (const auto& [reason, count] : summary.Object("/samples/rejected").items()) {

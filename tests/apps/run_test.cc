@@ -198,6 +198,43 @@ TEST(RunCommand, WhiteReferenceSessionRunsTheLightStageBeforeDerender) {
   EXPECT_TRUE(fs::exists(dir / "run/lights/white-reference.json"));
 }
 
+// A session `ibrdf align` wrote (stages_applied holds "align") is resumed, not aligned again: its name
+// does not grow, and aligning it again by hand keeps the name; align's options pass through run.
+TEST(RunCommand, AnAlignedSessionIsResumedNotAlignedAgain) {
+  ScratchDir dir;
+  ASSERT_EQ(RunIbrdf("synth --material " + std::string(IBRDF_SAMPLES_DIR) +
+                     "/materials/bluepaint.json --targets --photos 3 --out " + dir / "s")
+                .exit_code,
+            0);
+  RunResult result = RunIbrdf("align " + dir / "s" + " --out " + dir / "aligned");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json aligned = ReadJson(dir / "aligned/session.json");
+  const std::string name = aligned["name"];
+  EXPECT_EQ(name, ReadJson(dir / "s/session.json")["name"].get<std::string>() + "-aligned");
+  EXPECT_EQ(aligned["stages_applied"], nlohmann::json({"align"}));
+
+  result = RunIbrdf("run " + dir / "aligned" + " --out " + dir / "run" + " --stop-after derender --stride 4", true);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json summary = ReadJson(dir / "run/summary.json");
+  EXPECT_EQ(summary["stages"]["align"]["status"], "not_applicable");
+  EXPECT_NE(summary["stages"]["align"]["reason"].get<std::string>().find("aligned already"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "run/align"));
+  EXPECT_EQ(ReadJson(dir / "run/samples.npy.json")["session_name"], name);
+
+  result = RunIbrdf("align " + dir / "aligned" + " --out " + dir / "again");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(ReadJson(dir / "again/session.json")["name"], name);
+  EXPECT_EQ(ReadJson(dir / "again/session.json")["stages_applied"], nlohmann::json({"align"}));
+
+  // --align-args and --min-markers reach align: more markers than a photo shows drop every photo.
+  for (const std::string flags : {" --align-args \"--min-markers 500\"", " --min-markers 500"}) {
+    result = RunIbrdf("run " + dir / "s" + " --out " + dir / "run-markers" + " --stop-after align --overwrite" + flags);
+    EXPECT_NE(result.exit_code, 0) << flags << ":\n" << result.output;
+    EXPECT_NE(result.output.find("align"), std::string::npos) << result.output;
+    EXPECT_FALSE(fs::exists(dir / "run-markers/align/session.json")) << flags;
+  }
+}
+
 TEST(RunCommand, BadInputIsOneClearLine) {
   ScratchDir dir;
   RunResult result = RunIbrdf("run " + dir / "missing" + " --out " + dir / "run");

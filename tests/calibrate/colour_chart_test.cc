@@ -121,6 +121,36 @@ TEST(ColourChartTest, ClippedPatchesAreLeftOutAndSaid) {
   EXPECT_NE(message.find("white 9.5: clipped"), std::string::npos) << message;
 }
 
+// The camera's own RGB equal to linear sRGB: the cyan patch's red, negative in linear sRGB, reaches the
+// sensor as 0 (a black channel). That patch is left out and said; the matrix is then the identity
+// balanced by the light within 1 % (with it in the fit, every row leans towards the cut).
+TEST(ColourChartTest, ABlackChannelPatchIsLeftOutAndSaid) {
+  testing::ScratchDir scratch;
+  SynthOptions options = ChartOptions();
+  options.colour.camera_matrix = Eigen::Matrix3d::Identity();
+  const auto material = LoadMaterial(testing::MaterialPath("bluepaint"));
+  const Session session = Session::Load(testing::MakeSession(scratch.str(), options, *material));
+  const ColourChartFit fit = FitColourChart(session, *session.colour_chart->corners, {}, "test");
+  ASSERT_TRUE(fit.success);
+  EXPECT_NE(fit.patches[17].excluded.find("black channel: camera red"), std::string::npos) << fit.BriefReport();
+  int black = 0;
+  for (const ColourPatch& patch : fit.patches) black += patch.excluded.find("black channel") != std::string::npos;
+  EXPECT_EQ(black, 1) << fit.BriefReport();
+  ColourChartSpec chart = *session.colour_chart;
+  StoreColourFit(fit, &chart);
+  const Eigen::Matrix3d got = SampleColourMatrix(chart, session.lights[0].intensity);
+  const Eigen::Matrix3d expected = session.lights[0].intensity.cwiseQuotient(kTint).asDiagonal();
+  EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), 0.01 * expected.cwiseAbs().maxCoeff()) << got << "\n" << expected;
+  // Kept in, the cut patch pulls the matrix off (the failure this guards against).
+  ColourChartOptions keep;
+  keep.min_channel_fraction = 0.0;
+  ColourChartFit kept = FitColourChart(session, *session.colour_chart->corners, keep, "test");
+  ColourChartSpec biased = *session.colour_chart;
+  StoreColourFit(kept, &biased);
+  EXPECT_GT((SampleColourMatrix(biased, session.lights[0].intensity) - expected).cwiseAbs().maxCoeff(),
+            (got - expected).cwiseAbs().maxCoeff());
+}
+
 TEST(ColourChartTest, ADerenderWithoutTheFittedMatrixIsAnError) {
   testing::ScratchDir scratch;
   const auto material = LoadMaterial(testing::MaterialPath("bluepaint"));

@@ -153,6 +153,29 @@ TEST_F(SessionTest, OptionalBlocksTakeDefaults) {
   EXPECT_FALSE(session.name.empty());  // the folder's name
 }
 
+// stages_applied: the calibration stages that wrote the session round-trip in order; a name that is
+// not a stage, or one listed twice, is an error naming its entry.
+TEST_F(SessionTest, StagesAppliedRoundTripAndBadNamesAreErrors) {
+  json manifest = ValidManifest();
+  manifest["stages_applied"] = {"scan", "align"};
+  WriteManifest(manifest);
+  Session session = Session::Load(ManifestPath());
+  EXPECT_TRUE(session.Applied(SessionStage::kAlign));
+  EXPECT_FALSE(session.Applied(SessionStage::kColour));
+  session.MarkApplied(SessionStage::kColour);
+  session.MarkApplied(SessionStage::kAlign);  // already there: not listed twice
+  EXPECT_EQ(session.ToJson()["stages_applied"], json({"scan", "align", "colour"}));
+  manifest.erase("stages_applied");
+  WriteManifest(manifest);
+  EXPECT_FALSE(Session::Load(ManifestPath()).ToJson().contains("stages_applied"));  // absent: not written
+  manifest["stages_applied"] = {"align", "derender"};
+  ExpectLoadError(manifest, "/stages_applied/1");
+  manifest["stages_applied"] = {"align", "align"};
+  ExpectLoadError(manifest, "/stages_applied/1");
+  manifest["stages_applied"] = "align";
+  ExpectLoadError(manifest, "/stages_applied");
+}
+
 TEST_F(SessionTest, UnknownKeyAtRootIsAnError) {
   json manifest = ValidManifest();
   manifest["photo"] = json::array();

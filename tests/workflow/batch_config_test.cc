@@ -56,6 +56,28 @@ TEST(BatchConfig, GlobsExpandSortedToSessionFoldersAndNamesComeFromFolders) {
                                       "--stride", "3", "--no-fits"}));
 }
 
+// The stages' arguments of `ibrdf run` (--align-args, ...) from the options block; an entry's own
+// replace the batch's, and RunArguments passes each as one string.
+TEST(BatchConfig, StageArgumentsPassThroughToRun) {
+  ScratchDir dir;
+  MakeInputs(dir);
+  Write(dir / "batch.json", R"({"format": "ibrdf-batch", "version": 1, "out": "out",
+      "sessions": ["sessions/a-cylinder", {"path": "sessions/b-sphere", "options": {"align_args": "--no-light"}}],
+      "options": {"align_args": "--max-rms-px 2  --no-cylinder", "colour_args": "--detect"}})");
+  const BatchConfig config = ReadBatchConfig(dir / "batch.json");
+  ASSERT_EQ(config.entries.size(), 2u);
+  EXPECT_EQ(config.entries[0].options.align_args, (std::vector<std::string>{"--max-rms-px", "2", "--no-cylinder"}));
+  EXPECT_EQ(config.entries[1].options.align_args, (std::vector<std::string>{"--no-light"}));
+  EXPECT_EQ(config.entries[1].options.colour_args, (std::vector<std::string>{"--detect"}));
+  EXPECT_EQ(RunArguments(config.entries[0]),
+            (std::vector<std::string>{"run", dir / "sessions/a-cylinder", "--out", dir / "out/runs/a-cylinder",
+                                      "--align-args", "--max-rms-px 2 --no-cylinder", "--colour-args", "--detect"}));
+  Write(dir / "bad.json", R"({"format": "ibrdf-batch", "version": 1, "out": "out", "sessions": ["sessions/*"],
+      "options": {"align_args": ["--no-light"]}})");
+  const std::string message = testing::ErrorOf([&] { ReadBatchConfig(dir / "bad.json"); });
+  EXPECT_NE(message.find("/options/align_args"), std::string::npos) << message;
+}
+
 TEST(BatchConfig, ErrorsNameTheFileAndTheField) {
   ScratchDir dir;
   MakeInputs(dir);

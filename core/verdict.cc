@@ -1,0 +1,80 @@
+#include "core/verdict.h"
+
+#include <algorithm>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "core/logging.h"
+
+namespace ibrdf {
+
+const char* VerdictLevelName(VerdictLevel level) {
+  switch (level) {
+    case VerdictLevel::kOk:
+      return "ok";
+    case VerdictLevel::kWarn:
+      return "warn";
+    case VerdictLevel::kFail:
+      return "fail";
+  }
+  UnhandledKind("VerdictLevel", static_cast<int>(level));
+}
+
+std::string Verdict::Line() const {
+  std::string line = check + ": " + VerdictLevelName(level) + (accepted ? " (accepted)" : "") + ": " + measured +
+                     "; bound: " + bound;
+  if (!remedy.empty() && level != VerdictLevel::kOk) line += "; remedy: " + remedy;
+  return line;
+}
+
+bool AcceptedChecks::Accepts(const std::string& check) const {
+  return std::any_of(names.begin(), names.end(),
+                     [&](const std::string& name) { return name == "all" || name == check; });
+}
+
+void EnforceVerdicts(std::vector<Verdict>* verdicts, const AcceptedChecks& accepted, const std::string& where) {
+  std::string failures;
+  for (Verdict& verdict : *verdicts) {
+    switch (verdict.level) {
+      case VerdictLevel::kOk:
+        break;
+      case VerdictLevel::kWarn:
+        Log(1, "warning: " + verdict.Line());
+        break;
+      case VerdictLevel::kFail:
+        verdict.accepted = accepted.Accepts(verdict.check);
+        if (verdict.accepted) {
+          Log(1, "warning: accepted by the user: " + verdict.Line());
+        } else {
+          failures += "\n  " + verdict.Line() + " (an expert may proceed with --accept " + verdict.check + ")";
+        }
+        break;
+    }
+  }
+  if (!failures.empty()) ThrowError(where, "a calibration cannot be trusted:" + failures);
+}
+
+nlohmann::json VerdictsToJson(const std::vector<Verdict>& verdicts) {
+  nlohmann::json json = nlohmann::json::array();
+  for (const Verdict& verdict : verdicts) {
+    json.push_back({{"check", verdict.check},
+                    {"verdict", VerdictLevelName(verdict.level)},
+                    {"value", verdict.value},
+                    {"measured", verdict.measured},
+                    {"bound", verdict.bound},
+                    {"remedy", verdict.remedy},
+                    {"accepted", verdict.accepted}});
+  }
+  return json;
+}
+
+VerdictLevel WorstVerdict(const std::vector<Verdict>& verdicts) {
+  VerdictLevel worst = VerdictLevel::kOk;
+  for (const Verdict& verdict : verdicts) {
+    if (static_cast<int>(verdict.level) > static_cast<int>(worst)) worst = verdict.level;
+  }
+  return worst;
+}
+
+}  // namespace ibrdf
