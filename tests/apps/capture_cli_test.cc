@@ -142,5 +142,52 @@ TEST(CaptureCli, LowResolutionLightCardStopsAlignWithAVerdict) {
   EXPECT_FALSE(fs::exists(dir / "run/samples.npy"));
 }
 
+// Two photos and a wrong radius guess (0.03 m for a 0.04 m sphere), the radius not known: the sphere
+// fit collapses onto the lit limb (a radius of micrometres, the centre far off the platform). run stops
+// at align with the named verdicts, the values, the bounds and the remedy; accepted by name, the run
+// goes on and its summary says the failures were accepted.
+TEST(CaptureCli, ACollapsedSphereFitStopsTheRunUnlessAccepted) {
+  ScratchDir dir;
+  const RunResult synth = RunIbrdf("synth --out " + dir / "synth" + " --material " + MaterialPath("bluepaint") +
+                                   " --targets --light-photos 3 --photos 2");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const Session truth = Session::Load(dir / "synth");
+  std::string photos, light_photos;
+  for (size_t i = 0; i < truth.photos.size(); ++i) {
+    (truth.photos[i].role == PhotoRole::kTargets ? light_photos : photos) += " " + truth.PhotoPath(i);
+  }
+  ASSERT_EQ(RunIbrdf("targets --out " + dir / "targets" + " --no-charuco --dpi 72").exit_code, 0);
+  const RunResult init = RunIbrdf("session init" + photos + " --target-photos" + light_photos + " --targets " +
+                                  dir / "targets/targets.json" +
+                                  " --sample-radius-m 0.03 --light-position-m 1.2 0 0 --light-intensity 1,1,1 --out " +
+                                  dir / "s");
+  ASSERT_EQ(init.exit_code, 0) << init.output;
+  const RunResult run = RunIbrdf("run " + dir / "s" + " --out " + dir / "run" + " --no-report --no-fits");
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("sphere.radius: fail: fitted radius"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("sphere.center: fail"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("radius_known"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir / "run/align/session.json"));
+  EXPECT_FALSE(fs::exists(dir / "run/samples.npy"));
+
+  const RunResult accepted = RunIbrdf("run " + dir / "s" + " --out " + dir / "run" +
+                                      " --no-report --no-fits --stop-after derender --accept sphere.radius,sphere.center",
+                                      true);
+  ASSERT_EQ(accepted.exit_code, 0) << accepted.output;
+  const nlohmann::json summary = ReadJsonFile(dir / "run/summary.json");
+  int accepted_failures = 0;
+  for (const nlohmann::json& v : summary.at("verdicts")) {
+    accepted_failures += v.at("verdict") == "fail" && v.at("accepted") == true;
+  }
+  EXPECT_EQ(accepted_failures, 2) << summary.dump(1);
+  bool said = false;
+  for (const nlohmann::json& w : summary.at("warnings")) {
+    said |= w.get<std::string>().find("sphere.radius: fail (accepted by the user)") != std::string::npos;
+  }
+  EXPECT_TRUE(said) << summary.dump(1);
+  EXPECT_NE(accepted.output.find("verdict: align sphere.radius: fail (accepted by the user)"), std::string::npos)
+      << accepted.output;
+}
+
 }  // namespace
 }  // namespace ibrdf
