@@ -107,6 +107,8 @@ Session WithCalibratedLights(const Session& target, const LightRigCalibration& c
     }
     if (!found) ThrowError(copy.manifest_path, "light " + light.id + " was not calibrated");
   }
+  // Without a diffuse sphere of known albedo only the lights' ratios are known: the scale is relative.
+  copy.radiometry.relative_intensities = !calibration.intensities || !calibration.intensities->absolute;
   if (diffuse_center && calibration.intensities) {
     // The diffuse sphere's centre as its silhouette gave it (the radius sets the scale).
     copy.sample.center = calibration.intensities->center;

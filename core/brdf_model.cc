@@ -95,10 +95,19 @@ Eigen::Vector3d NonNegative(JsonObject& object, const std::string& key) {
   return v;
 }
 
-// An albedo or reflectance: in [0, 1] (energy conservation of the diffuse term).
-Eigen::Vector3d Reflectance(JsonObject& object, const std::string& key) {
+// An albedo or reflectance: in [0, 1] (energy conservation of the diffuse term); a material on a
+// relative scale ("scale": "relative": measured under lights whose common intensity is unknown) is
+// its true values times one unknown constant, so only finite and non-negative, at most 1e6.
+Eigen::Vector3d Reflectance(JsonObject& object, const std::string& key, bool relative) {
   const Eigen::Vector3d v = NonNegative(object, key);
-  if ((v.array() > 1.0).any()) ThrowError(object.Where(key), "expected reflectances in [0, 1]");
+  if (relative) {
+    if ((v.array() > 1e6).any()) ThrowError(object.Where(key), "expected relative reflectances of at most 1e6");
+    return v;
+  }
+  if ((v.array() > 1.0).any()) {
+    ThrowError(object.Where(key), "expected reflectances in [0, 1] (a material measured on a relative scale says "
+                                  "\"scale\": \"relative\")");
+  }
   return v;
 }
 
@@ -128,12 +137,17 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
   object.String("description", "");
   object.String("source", "");
   object.String("colour_space", "");  // the values' colour space (fits state their samples'); informative
+  const std::string scale = object.String("scale", "absolute");
+  if (scale != "absolute" && scale != "relative") {
+    ThrowError(object.Where("scale"), "expected \"absolute\" or \"relative\", got \"" + scale + "\"");
+  }
+  const bool relative = scale == "relative";
   const std::string model = object.String("model");
   std::unique_ptr<BrdfModel> brdf;
   if (model == "lambertian") {
-    brdf = std::make_unique<LambertianBrdf>(Reflectance(object, "albedo"));
+    brdf = std::make_unique<LambertianBrdf>(Reflectance(object, "albedo", relative));
   } else if (model == "lafortune") {
-    const Eigen::Vector3d diffuse = Reflectance(object, "diffuse");
+    const Eigen::Vector3d diffuse = Reflectance(object, "diffuse", relative);
     std::vector<LafortuneLobe> lobes;
     for (JsonObject& lobe_object : object.Objects("lobes")) {
       LafortuneLobe lobe;
@@ -146,8 +160,8 @@ std::unique_ptr<BrdfModel> MaterialFromJson(const nlohmann::json& value, const s
     }
     brdf = std::make_unique<LafortuneBrdf>(diffuse, std::move(lobes));
   } else if (model == "ggx") {
-    const Eigen::Vector3d diffuse = Reflectance(object, "diffuse_albedo");
-    const Eigen::Vector3d f0 = Reflectance(object, "specular_f0");
+    const Eigen::Vector3d diffuse = Reflectance(object, "diffuse_albedo", relative);
+    const Eigen::Vector3d f0 = Reflectance(object, "specular_f0", relative);
     const double alpha = object.Number("alpha");
     if (!(alpha > 0.0 && alpha <= 1.0)) ThrowError(object.Where("alpha"), "expected 0 < alpha <= 1");
     const std::string fresnel = object.String("fresnel", "schlick");

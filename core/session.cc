@@ -272,6 +272,11 @@ RadiometrySpec ParseRadiometry(JsonObject object, const std::string& directory) 
     noise_object.Finish();
     radiometry.noise = noise;
   }
+  const std::string scale = object.String("intensity_scale", "absolute");
+  if (scale != "absolute" && scale != "relative") {
+    ThrowError(object.Where("intensity_scale"), "expected \"absolute\" or \"relative\", got \"" + scale + "\"");
+  }
+  radiometry.relative_intensities = scale == "relative";
   if (object.Has("flat_field")) {
     radiometry.flat_field = object.String("flat_field");
     const std::string path = ResolvePath(directory, radiometry.flat_field);
@@ -654,6 +659,7 @@ nlohmann::json RadiometryToJson(const RadiometrySpec& radiometry) {
                   {"bits", radiometry.noise->bits}};
   }
   if (!radiometry.flat_field.empty()) r["flat_field"] = radiometry.flat_field;
+  if (radiometry.relative_intensities) r["intensity_scale"] = "relative";
   return r;
 }
 

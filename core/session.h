@@ -40,6 +40,10 @@ struct RadiometrySpec {
   // pixel (vignetting x pixel response), linear, 1 where exposure and gain alone are right (normally
   // the image centre). Radiance is divided by it. Empty: no flat field.
   std::string flat_field;
+  // The lights' intensities are known only up to one common scale ("intensity_scale": "relative"):
+  // ratios measured (a diffuse sphere of unknown albedo), the scale not. Every BRDF value downstream is
+  // then relative too, and every output says so; false: absolute ("absolute", the default).
+  bool relative_intensities = false;
 };
 
 // One raw range scan of a mesh sample (what `ibrdf scan` merges into the sample's mesh file); also the

@@ -1068,6 +1068,8 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
         {"directions",
          "unit vectors in the local frame, z = surface normal; wi towards the light, wo towards the camera"}}},
       {"colour_space", ColourSpaceDescription(session)},
+      // Relative: the lights' common scale is unknown, so is the BRDF's (every value times one constant).
+      {"intensity_scale", session.radiometry.relative_intensities ? "relative" : "absolute"},
       {"uncertainty", session.radiometry.noise ? "sigma: one standard deviation from the session's camera noise model"
                                                : "none: the session has no camera noise model; sigma is 0"},
       {"counts",
@@ -1114,7 +1116,10 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
 
 DerenderResult DerenderToFile(const Session& session, const DerenderOptions& options, const std::string& samples_path) {
   Log(1, "session " + session.name + ": " + std::to_string(session.photos.size()) + " photos, " +
-             SampleKindName(session.sample.kind) + " sample, response " + session.radiometry.response.Describe());
+             SampleKindName(session.sample.kind) + " sample, response " + session.radiometry.response.Describe() +
+             (session.radiometry.relative_intensities
+                  ? "; lights' intensities relative (known up to one scale): the BRDF's scale is relative too"
+                  : ""));
   DerenderResult result = Derender(session, options);
   if (result.samples.empty()) {
     ThrowError(session.manifest_path,

@@ -525,7 +525,8 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
   return result;
 }
 
-nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& name, const std::string& colour_space) {
+nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& name, const std::string& colour_space,
+                               bool relative_scale) {
   IBRDF_CHECK(fit.brdf != nullptr);
   nlohmann::json json = fit.brdf->ToJson();
   char description[256];
@@ -536,6 +537,12 @@ nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& nam
   json["name"] = name;
   json["description"] = description;
   json["colour_space"] = colour_space.empty() ? "unknown (not stated with the samples)" : colour_space;
+  if (relative_scale) {
+    json["scale"] = "relative";
+    json["description"] = json["description"].get<std::string>() +
+                          "; relative scale: the lights' common intensity was not measured, so every value is the "
+                          "material's times one unknown constant";
+  }
   return json;
 }
 

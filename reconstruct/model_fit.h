@@ -92,9 +92,10 @@ nlohmann::json ToJson(const ModelFitResult& fit);
 
 // The material file of a fit, with name, description (how and from what it was fitted) and
 // "colour_space": the samples' (their sidecar's "colour_space"; "unknown ..." when empty), which the
-// fitted values are in.
-nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& name,
-                               const std::string& colour_space = "");
+// fitted values are in; with `relative_scale` (samples measured under lights of relative intensity)
+// "scale": "relative", which lets the material's reflectances exceed 1 (core/brdf_model.h).
+nlohmann::json FitMaterialJson(const ModelFitResult& fit, const std::string& name, const std::string& colour_space = "",
+                               bool relative_scale = false);
 
 // Renderer materials for a GGX fit, named `name`: a metal (F0 above 0.2 with a diffuse albedo under a
 // tenth of it) as a rough conductor keeping its colour (pbrt-v4 "conductor" with "reflectance", Mitsuba

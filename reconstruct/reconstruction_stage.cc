@@ -271,7 +271,7 @@ std::string MaterialName(const ReconstructOptions& options, const std::string& s
 // (lowest relative RMS against the samples). `colour_space` (the samples' own, from their sidecar) is
 // stated in every material file and snippet.
 std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, const ModelFitOptions& options,
-                                     const std::string& name, const std::string& colour_space,
+                                     const std::string& name, const std::string& colour_space, bool relative_scale,
                                      const std::string& tmp, ReconstructResult* result, nlohmann::json* timings) {
   Timer timer;
   // The two fits side by side (each runs its starts in parallel too).
@@ -280,11 +280,11 @@ std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, con
   group.run([&] {
     lafortune = FitLafortune(samples, options);
     Log(1, lafortune.BriefReport());
-    WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, name + "-lafortune", colour_space));
+    WriteJsonFile(tmp + "/lafortune.json", FitMaterialJson(lafortune, name + "-lafortune", colour_space, relative_scale));
   });
   ggx = FitGgx(samples, options);
   Log(1, ggx.BriefReport());
-  WriteJsonFile(tmp + "/ggx.json", FitMaterialJson(ggx, name + "-ggx", colour_space));
+  WriteJsonFile(tmp + "/ggx.json", FitMaterialJson(ggx, name + "-ggx", colour_space, relative_scale));
   group.wait();
   const RendererSnippets snippets = RendererMaterials(ggx, name, colour_space);
   WriteText(tmp + "/" + snippets.pbrt_file, snippets.pbrt);
@@ -522,6 +522,7 @@ void CopySampleColour(const std::string& samples_file, nlohmann::json* summary) 
   const nlohmann::json sidecar = ReadJsonFile(SidecarPath(samples_file));
   if (sidecar.contains("colour_space")) (*summary)["colour_space"] = sidecar["colour_space"];
   if (sidecar.contains("colour")) (*summary)["colour"] = sidecar["colour"];
+  if (sidecar.contains("intensity_scale")) (*summary)["intensity_scale"] = sidecar["intensity_scale"];
 }
 
 // The stage after its inputs are read; `total` started before they were.
@@ -565,7 +566,11 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
   // Read before the fits start: they run beside the tabulation, which writes into result.summary.
   const nlohmann::json space = result.summary.value("colour_space", nlohmann::json());
   const std::string colour_space = space.is_string() ? space.get<std::string>() : space.is_null() ? "" : space.dump();
-  auto fit = [&] { chosen = FitModels(samples, options.fit, name, colour_space, tmp, &fitted, &fit_timings); };
+  const bool relative_scale = result.summary.value("intensity_scale", "absolute") == "relative";
+  if (relative_scale) Log(1, "relative scale: the samples' lights are known up to one common intensity");
+  auto fit = [&] {
+    chosen = FitModels(samples, options.fit, name, colour_space, relative_scale, tmp, &fitted, &fit_timings);
+  };
   tbb::task_group fitting;
   if (fits && fill_with_model) fit();
   if (fits && !fill_with_model) fitting.run(fit);

@@ -903,6 +903,31 @@ def run_figures(early, out, ready, explorer_job):
     return figures, explorer
 
 
+def notices_html(run_dir, side):
+    """Every calibration verdict that is not ok (align/alignment.json), the stages' warnings and the
+    samples' scale, at the top of the report: what the run could not trust, or had to be told."""
+    items = []
+    if side.get("intensity_scale") == "relative":
+        items.append(("relative scale", "the lights' intensities are known up to one common scale (ratios "
+                      "measured, the scale not): every BRDF value here, the table and the fits are the material's "
+                      "times one unknown constant"))
+    align = load_json(os.path.join(run_dir, "align", "alignment.json")) or {}
+    for v in align.get("verdicts", []):
+        if v.get("verdict") == "ok":
+            continue
+        label = f"align {v.get('check')}: {v.get('verdict')}" + (" (accepted by the user)" if v.get("accepted") else "")
+        items.append((label, f"{v.get('measured')}; bound: {v.get('bound')}; remedy: {v.get('remedy')}"))
+    for w in align.get("warnings", []):
+        items.append(("align", w))
+    for w in side.get("exposure", {}).get("warnings", []):
+        if isinstance(w, dict) and "message" in w:
+            items.append(("derender", w["message"]))
+    if not items:
+        return "<p>Verdicts: every calibration check ok; no stage warned.</p>"
+    rows = "\n".join(f"<tr><th>{html.escape(str(k))}</th><td>{html.escape(str(v))}</td></tr>" for k, v in items)
+    return f"<h2>Verdicts and warnings</h2>\n<table>{rows}</table>"
+
+
 def main():
     args = [a for a in sys.argv[1:] if a != "--data-later"]
     data_later = len(args) + 1 < len(sys.argv)
@@ -964,6 +989,7 @@ figure img {{ max-width: 100%; }} figcaption {{ font-size: 0.85em; color: #555; 
 <p>Run folder: <code>{html.escape(os.path.abspath(run_dir))}</code>. Figures after Marschner et al. 1999, Image-Based
 BRDF Measurement. Every figure is embedded in this file; the same PNGs lie beside it.</p>
 {explorer_link}
+{notices_html(run_dir, side)}
 <h2>Headline figures</h2>
 <table>{table}</table>
 <h2>The sample itself</h2>

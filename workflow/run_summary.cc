@@ -23,6 +23,7 @@ void AddSamples(const fs::path& dir, nlohmann::json* summary) {
   for (const auto& [reason, count] : rejected.items()) side->Count("/counts/rejected/" + reason);
   (*summary)["session"] = side->String("/session", "");
   (*summary)["session_name"] = side->String("/session_name", "");
+  (*summary)["intensity_scale"] = side->String("/intensity_scale", "absolute");
   (*summary)["samples"] = {{"file", (dir / "samples.npy").string()},
                            {"photos", side->Count("/counts/photos", 0)},
                            {"pixels_examined", side->Count("/counts/pixels_examined", 0)},
@@ -188,6 +189,9 @@ std::vector<std::string> RunHeadline(const nlohmann::json& summary_json) {
     lines.push_back(std::string("verdict: ") + v.value("stage", "") + " " + v.value("check", "") + ": " +
                     v.value("verdict", "") + (v.value("accepted", false) ? " (accepted by the user)" : "") + ": " +
                     v.value("measured", "") + "; bound: " + v.value("bound", ""));
+  }
+  if (summary.ValueOr("/intensity_scale", "absolute") == "relative") {
+    lines.push_back("relative scale: the lights' intensities are known up to one common scale; so is every BRDF value");
   }
   if (summary.Has("/samples")) {
     std::string rejected;
