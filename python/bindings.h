@@ -19,7 +19,8 @@ py::object ToPython(const nlohmann::json& value);
 // checks for signals (Ctrl-C raises KeyboardInterrupt here: the work is asked to stop at its next
 // progress-bar step, core/progress_observer.h, and joined first) and calls `progress(label, done,
 // total)` when a progress bar of the library has advanced (None: no callback). An exception of the
-// work is rethrown here, so the module's translators turn it into the Python exception.
+// work is rethrown here, so the module's translators turn it into the Python exception. Calls from
+// several Python threads run one after another.
 void RunLong(const std::function<void()>& work, const py::object& progress);
 
 // True once Ctrl-C asked the running RunLong work to stop: for work that has no progress bar to stop

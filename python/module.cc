@@ -73,6 +73,13 @@ struct ProgressState {
 bool StopRequested() { return g_stop_requested.load(); }
 
 void RunLong(const std::function<void()>& work, const py::object& progress) {
+  // One long call at a time: the progress observer is process-wide (calls from other Python threads wait).
+  static std::mutex one_at_a_time;
+  std::unique_lock<std::mutex> turn(one_at_a_time, std::defer_lock);
+  {
+    py::gil_scoped_release release;
+    turn.lock();
+  }
   auto state = std::make_shared<ProgressState>();
   g_stop_requested = false;
   SetProgressObserver([state](const std::string& label, uint64_t done, uint64_t total) {

@@ -45,6 +45,6 @@ def test_regression_inputs_raise(source, tmp_path, target):
     assert accepted == 0, f"{accepted} of {total} regression inputs of {target} were accepted"
 
 
-@pytest.mark.parametrize("target", ["merl", "bsdf", "npy", "material_json"])
+@pytest.mark.parametrize("target", sorted(TARGETS))
 def test_corpus_inputs_load_or_raise(source, tmp_path, target):
     replay(source, tmp_path, target, "corpus")

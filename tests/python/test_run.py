@@ -3,8 +3,11 @@ for byte, except the times its JSON files record (stage seconds, timings_s) and 
 that show the stage times (the timings figure, and the page that embeds it with the times' rows)."""
 import filecmp
 import json
+import os
 import shutil
+import signal
 import subprocess
+import threading
 
 import pytest
 
@@ -85,3 +88,10 @@ def test_run_refuses_another_inputs_folder(small_session, tmp_path, source):
 def test_run_bad_option():
     with pytest.raises(ValueError, match="stride"):
         ibrdf.run("samples/bluepaint-sphere", "/tmp/never", pixel_stride=0)
+
+
+def test_ctrl_c_stops_the_run_after_its_stage(small_session, tmp_path):
+    threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT)).start()
+    with pytest.raises(KeyboardInterrupt):
+        ibrdf.run(str(small_session), str(tmp_path / "r"), report=False)
+    assert not (tmp_path / "r" / "summary.json").exists()
