@@ -154,8 +154,8 @@ void RunLong(const std::function<void()>& work, const py::object& progress) {
     worker.join();
   }
   SetProgressObserver({});
-  report();
   if (error) std::rethrow_exception(error);
+  report();  // the last step, so that a callback sees done == total
 }
 
 namespace {
