@@ -7,10 +7,15 @@
 #include <iostream>
 #include <sstream>
 
+#include "core/progress_observer.h"
+
 namespace ibrdf {
 namespace {
 std::atomic<int> g_verbosity{2};
+ProgressObserver g_progress_observer;
 }
+
+void SetProgressObserver(ProgressObserver observer) { g_progress_observer = std::move(observer); }
 
 void SetVerbosity(int level) { g_verbosity = level; }
 int Verbosity() { return g_verbosity; }
@@ -37,6 +42,9 @@ ProgressBar::~ProgressBar() { Finish(); }
 
 void ProgressBar::Add(uint64_t done) {
   const uint64_t now = done_.fetch_add(done) + done;
+  if (g_progress_observer && !g_progress_observer(label_, now, total_)) {
+    throw Interrupted(label_ + ": interrupted");
+  }
   if (g_verbosity < 2) return;
   const double t = timer_.ElapsedSeconds();
   const int quarter = total_ ? static_cast<int>(4 * now / total_) : 4;

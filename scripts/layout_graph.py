@@ -16,7 +16,7 @@ import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 BEGIN, END = '<!-- layout-graph -->', '<!-- /layout-graph -->'
-NOT_LIBRARY_FOLDERS = {'tests', 'fuzz', 'benchmarks', 'apps', 'build'}
+NOT_LIBRARY_FOLDERS = {'tests', 'fuzz', 'benchmarks', 'apps', 'build', 'python'}
 # The layering the code relies on, checked on the transitive links: derender consumes a calibrated
 # session (it neither fits nor calibrates), radiometry is the one radiometric chain above core, and
 # reconstruct reads sample files (it needs nothing of the stages that make them).
