@@ -194,7 +194,8 @@ class PairFit {
   double inv_radius_;
   Matrix normal_ = Matrix::Zero();           // lower triangle of X^T W X
   Matrix squared_weights_ = Matrix::Zero();  // lower triangle of X^T W^2 X
-  Eigen::Matrix<double, kParams, 3> rhs_ = Eigen::Matrix<double, kParams, 3>::Zero();  // X^T log f
+  // X^T W log f, a column per channel.
+  Eigen::Matrix<double, kParams, 3> rhs_ = Eigen::Matrix<double, kParams, 3>::Zero();
   int count_[2] = {0, 0};
 };
 
@@ -262,7 +263,8 @@ bool FindPartner(const SampleGrid& grid, Symmetry symmetry, const BrdfSample& a,
       if (e.positive) near_p.emplace_back(squared_distance, &e);
     });
   }
-  if (a_positive && near_q.size() >= size_t(PairFit::kParams) && near_q.size() + near_p.size() >= 2 * PairFit::kParams) {
+  if (a_positive && near_q.size() >= size_t(PairFit::kParams) &&
+      near_q.size() + near_p.size() >= 2 * PairFit::kParams) {
     // At most kFitSamples of each side, evenly through the grid order (which keeps their spread over
     // the ball, every sheet of samples in it, as the nearest would not), so the cost stays bounded.
     PairFit fit(q, radius);
@@ -549,7 +551,9 @@ nlohmann::json ToJson(const ConsistencyReport& report, const ConsistencyOptions&
            "one least-squares fit of log f, quadratic in the offset from q, over side B as measured and side A's "
            "samples within match_deg of p taken to their images, plus side A's offset delta (slope and curvature "
            "shared, so they cancel); pairs whose delta has more than twice one sample's variance are dropped; "
-           "signed relative difference (a - b) / ((a + b) / 2) = 2 tanh(delta / 2) per pair; a bin of "
+           "with fewer than 11 samples around q (22 on both sides), the plain mean of side B at match_deg <= 1, "
+           "else no pair; "
+           "signed relative difference (a - b) / ((a + b) / 2) per pair (2 tanh(delta / 2) if fitted); a bin of "
            "(theta_i, theta_e, delta_phi) reports |median of its pairs' differences| and that median's standard "
            "error (rel_error_se); overall_rel_error = median over bins, p95_rel_error = 95th percentile over "
            "bins, median_bin_se = median over bins of rel_error_se"},

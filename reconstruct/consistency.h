@@ -14,13 +14,14 @@
 // The sides share the BRDF's slope and curvature, so a sharp highlight's curvature within the radius
 // (which biased a plain mean of side B by several per cent at 4 degrees) cancels, and delta is the log
 // of A over B at the same exact point q; a fit that leaves delta poorly determined (variance above
-// twice one sample's) gives no pair. Where the samples are fewer (small radii), side B's plain mean is
-// the partner, whose curvature error grows as the radius squared. Each pair gives a signed relative
-// difference (a - b) / ((a + b) / 2) (= 2 tanh(delta / 2) for a fitted pair); a bin of (theta_i,
-// theta_e, delta_phi) reports |median of its pairs' signed differences| (camera noise and the
-// remaining offsets fall on either side and cancel, a real violation, a bias of one sign, does not),
-// with that median's own standard error. The headline figures are the median and the 95th percentile
-// over bins, and the worst bins are listed with where they are.
+// twice one sample's) gives no pair. Where the samples are fewer, at radii up to 1 degree, side B's
+// plain mean is the partner (its curvature error grows as the radius squared); beyond, no pair.
+// Each pair gives a signed relative difference (a - b) / ((a + b) / 2) (= 2 tanh(delta / 2) for a
+// fitted pair); a bin of (theta_i, theta_e, delta_phi) reports |median of its pairs' signed
+// differences| (camera noise and the remaining offsets fall on either side and cancel, a real
+// violation, a bias of one sign, does not), with that median's own standard error. The headline
+// figures are the median and the 95th percentile over bins, and the worst bins are listed with where
+// they are.
 #pragma once
 
 #include <string>
@@ -70,7 +71,7 @@ struct ConsistencyFigure {
   double median_rel_error = 0.0;                                    // = overall_rel_error
   double p95_rel_error = 0.0;                                       // the 95th percentile over bins
   double median_bin_se = 0.0;  // the median over bins of mean_rel_error_se: the figures' own error bar
-  std::vector<size_t> worst;                                        // indices into `bins`, worst first
+  std::vector<size_t> worst;   // indices into `bins`, worst first
   bool valid() const { return !bins.empty(); }
   // "0.12 % median, 0.80 % p95 over 312 bins (worst 2.1 % at theta_i 15, theta_e 45, delta_phi 170 deg)",
   // or "invalid: no bin had N sample pairs".
