@@ -10,9 +10,11 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
+#include <Eigen/Cholesky>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/kind.h"
 #include "core/logging.h"
 #include "core/math.h"
 #include "core/statistics.h"
@@ -28,12 +30,26 @@ Eigen::Vector3d Embed(double theta_i, double theta_e, double delta_phi) {
   return {theta_i, theta_e * std::cos(delta_phi), theta_e * std::sin(delta_phi)};
 }
 
-// The samples in a grid of cells `cell` radians wide, for nearest-partner queries: the usable samples
+// The symmetry a figure tests: the image of a configuration under it.
+enum class Symmetry { kReciprocity, kBilateral };
+
+Eigen::Vector3d Image(Symmetry symmetry, const BrdfSample& s) {
+  switch (symmetry) {
+    case Symmetry::kReciprocity:
+      return Embed(s.theta_e, s.theta_i, -s.delta_phi);
+    case Symmetry::kBilateral:
+      return Embed(s.theta_i, s.theta_e, -s.delta_phi);
+  }
+  UnhandledKind("Symmetry", int(symmetry));
+}
+
+// The samples in a grid of cells `cell` radians wide, for neighbourhood queries: the usable samples
 // sorted by cell (x, y, z) and index, so a column of cells (x, y) is one run of the arrays, found by a
-// dense (x, y) table, and its cells z - 1 .. z + 1 one stretch of it.
-class PartnerGrid {
+// dense (x, y) table, and its cells z - 1 .. z + 1 one stretch of it. Each entry keeps its embedded
+// point, the embedded points of its reciprocal and mirrored configurations, and the log of its value.
+class SampleGrid {
  public:
-  PartnerGrid(const std::vector<BrdfSample>& samples, const std::vector<uint32_t>& usable, double cell) : cell_(cell) {
+  SampleGrid(const std::vector<BrdfSample>& samples, const std::vector<uint32_t>& usable, double cell) : cell_(cell) {
     const size_t n = usable.size();
     std::vector<Eigen::Vector3i> cells(n);
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
@@ -48,8 +64,8 @@ class PartnerGrid {
     }
     size_x_ = hi_.x() - lo_.x() + 1;
     size_y_ = hi_.y() - lo_.y() + 1;
-    // Sorted by (x, y, z), then by sample index: within a cell the samples keep their file order, so a
-    // partner's sum adds them in the order of the hash grid before (the same bits).
+    // Sorted by (x, y, z), then by sample index: within a cell the samples keep their file order, so the
+    // sums over a neighbourhood add them in the same order on any thread count (the same bits).
     std::vector<uint32_t> order(n);
     for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
     tbb::parallel_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
@@ -59,32 +75,41 @@ class PartnerGrid {
       if (ca.z() != cb.z()) return ca.z() < cb.z();
       return a < b;
     });
-    index_.resize(n);
+    entries_.resize(n);
     z_.resize(n);
-    points_.resize(n);
-    values_.resize(n);
     tbb::parallel_for(size_t(0), n, [&](size_t k) {
       const uint32_t index = usable[order[k]];
       const BrdfSample& s = samples[index];
-      index_[k] = index;
+      Entry& e = entries_[k];
+      e.index = index;
       z_[k] = cells[order[k]].z();
-      points_[k] = Embed(s.theta_i, s.theta_e, s.delta_phi);
-      values_[k] = Eigen::Vector3f(s.brdf[0], s.brdf[1], s.brdf[2]);
+      e.point = Embed(s.theta_i, s.theta_e, s.delta_phi).cast<float>();
+      e.image[int(Symmetry::kReciprocity)] = Image(Symmetry::kReciprocity, s).cast<float>();
+      e.image[int(Symmetry::kBilateral)] = Image(Symmetry::kBilateral, s).cast<float>();
+      e.positive = s.brdf[0] > 0.0f && s.brdf[1] > 0.0f && s.brdf[2] > 0.0f;
+      e.value = Eigen::Vector3f(s.brdf[0], s.brdf[1], s.brdf[2]);
+      for (int c = 0; c < 3; ++c) e.log_value[c] = e.positive ? std::log(s.brdf[c]) : 0.0f;
     });
     columns_.assign(size_t(size_x_) * size_y_ + 1, 0);
     for (size_t k = 0; k < n; ++k) ++columns_[Column(cells[order[k]]) + 1];
     for (size_t c = 1; c < columns_.size(); ++c) columns_[c] += columns_[c - 1];
   }
 
-  // The partner of `target`: the samples within `radius` (<= the cell size) whose centroid lies within
-  // `radius` * kMaxCentroidOffset of it, so that the target is surrounded by them (interpolation, not
-  // extrapolation: the BRDF's slope cancels to first order in their mean). Returns false otherwise, or
-  // when `exclude` is among them only.
-  bool Partner(const Eigen::Vector3d& target, double radius, uint32_t exclude, Eigen::Vector3d* value) const {
-    constexpr double kMaxCentroidOffset = 0.25;
-    const Eigen::Vector3i c = Cell(target);
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), sum = Eigen::Vector3d::Zero();
-    int n = 0;
+  // Single precision: the sample file's angles and values are floats.
+  struct Entry {
+    uint32_t index = 0;         // sample index
+    bool positive = false;      // every channel's value > 0 (its log is finite)
+    Eigen::Vector3f point;      // embedded point
+    Eigen::Vector3f image[2];   // embedded point of its image under each Symmetry
+    Eigen::Vector3f value;      // brdf per channel
+    Eigen::Vector3f log_value;  // log brdf per channel (0 where not positive)
+  };
+
+  // Calls visit(entry, squared distance) for every entry within `radius` (<= the cell size) of
+  // `center`, in grid order.
+  template <typename Visit>
+  void ForEachWithin(const Eigen::Vector3d& center, double radius, Visit visit) const {
+    const Eigen::Vector3i c = Cell(center);
     for (int x = c.x() - 1; x <= c.x() + 1; ++x) {
       if (x < lo_.x() || x > hi_.x()) continue;
       for (int y = c.y() - 1; y <= c.y() + 1; ++y) {
@@ -92,17 +117,12 @@ class PartnerGrid {
         const size_t column = Column(Eigen::Vector3i(x, y, 0));
         const auto begin = z_.begin() + columns_[column], end = z_.begin() + columns_[column + 1];
         for (auto it = std::lower_bound(begin, end, c.z() - 1); it != end && *it <= c.z() + 1; ++it) {
-          const size_t k = size_t(it - z_.begin());
-          if (index_[k] == exclude || (points_[k] - target).squaredNorm() > radius * radius) continue;
-          centroid += points_[k];
-          sum += values_[k].cast<double>();
-          ++n;
+          const Entry& e = entries_[size_t(it - z_.begin())];
+          const double squared_distance = (e.point.cast<double>() - center).squaredNorm();
+          if (squared_distance <= radius * radius) visit(e, squared_distance);
         }
       }
     }
-    if (n == 0 || (centroid / n - target).norm() > kMaxCentroidOffset * radius) return false;
-    *value = sum / n;
-    return true;
   }
 
  private:
@@ -115,16 +135,74 @@ class PartnerGrid {
   double cell_;
   Eigen::Vector2i lo_ = Eigen::Vector2i::Zero(), hi_ = Eigen::Vector2i::Constant(-1);  // (x, y) cells held
   int size_x_ = 0, size_y_ = 0;
-  std::vector<size_t> columns_;          // column (x, y) holds entries [columns_[c], columns_[c + 1])
-  std::vector<uint32_t> index_;          // sample index of each entry
-  std::vector<int> z_;                   // z cell of each entry (increasing within a column)
-  std::vector<Eigen::Vector3d> points_;  // embedded point of each entry
-  std::vector<Eigen::Vector3f> values_;  // brdf of each entry
+  std::vector<size_t> columns_;  // column (x, y) holds entries [columns_[c], columns_[c + 1])
+  std::vector<int> z_;           // z cell of each entry (increasing within a column)
+  std::vector<Entry> entries_;
+};
+
+// The joint local fit of one pair (see consistency.h): log f = c + g . d + d^T H d / 2 + delta [A side],
+// d the offset from the image point q in units of the radius, weighted least squares over the samples
+// around q (side B, as measured) and those around the sample's own point p (side A, each taken to its
+// image, near q). The fit shares the BRDF's slope and curvature between the sides, so delta, the log
+// of A over B at q, is free of both (to third order in the radius).
+class PairFit {
+ public:
+  static constexpr int kParams = 11;  // 1, d (3), d d^T (6), the A-side offset
+  static constexpr double kCurvaturePrior = 1e-5;
+  using Vector = Eigen::Matrix<double, kParams, 1>;
+  using Matrix = Eigen::Matrix<double, kParams, kParams>;
+
+  PairFit(const Eigen::Vector3d& q, double radius) : q_(q), inv_radius_(1.0 / radius) {}
+
+  // A sample at `point` (near q) with weight `weight`.
+  void Add(const Eigen::Vector3f& point, const Eigen::Vector3f& log_value, bool side_a, double weight) {
+    const Eigen::Vector3d d = (point.cast<double>() - q_) * inv_radius_;
+    Vector x;
+    x << 1.0, d[0], d[1], d[2], 0.5 * d[0] * d[0], 0.5 * d[1] * d[1], 0.5 * d[2] * d[2], d[0] * d[1], d[0] * d[2],
+        d[1] * d[2], side_a ? 1.0 : 0.0;
+    normal_.selfadjointView<Eigen::Lower>().rankUpdate(x, weight);
+    squared_weights_.selfadjointView<Eigen::Lower>().rankUpdate(x, weight * weight);
+    for (int c = 0; c < 3; ++c) rhs_.col(c) += (weight * log_value[c]) * x;
+    ++count_[side_a ? 1 : 0];
+  }
+
+  // The A-side offset per channel and its variance in units of one sample's. The six curvature
+  // coefficients carry a ridge penalty of kCurvaturePrior times the summed weight, so that a curvature
+  // the samples do not determine (across two sheets of samples) shrinks to none instead of trading
+  // against delta, while one they do determine (along the sheets, where a sharp highlight bends) is
+  // fitted. The variance is that of the weighted, penalized estimate (M^-1 X^T W^2 X M^-1, M the
+  // penalized X^T W X): 1 when side A is one sample and side B's fit exact, less with more. False
+  // where the fit is singular or the variance exceeds `max_variance`.
+  bool Solve(double max_variance, Eigen::Vector3d* delta, double* variance) const {
+    if (count_[0] + count_[1] < kParams) return false;
+    Matrix penalized = normal_;
+    const double prior = kCurvaturePrior * normal_(0, 0);  // times the summed weight
+    for (int i = 4; i < 10; ++i) penalized(i, i) += prior;
+    const Eigen::LLT<Matrix, Eigen::Lower> llt(penalized);
+    if (llt.info() != Eigen::Success) return false;
+    Vector unit = Vector::Zero();
+    unit[kParams - 1] = 1.0;
+    const Vector column = llt.solve(unit);  // the inverse's last column
+    *variance = column.dot(squared_weights_.selfadjointView<Eigen::Lower>() * column);
+    if (!(*variance > 0.0 && *variance <= max_variance)) return false;
+    for (int c = 0; c < 3; ++c) (*delta)[c] = column.dot(rhs_.col(c));
+    return std::isfinite(delta->sum());
+  }
+
+ private:
+  Eigen::Vector3d q_;
+  double inv_radius_;
+  Matrix normal_ = Matrix::Zero();           // lower triangle of X^T W X
+  Matrix squared_weights_ = Matrix::Zero();  // lower triangle of X^T W^2 X
+  // X^T W log f, a column per channel.
+  Eigen::Matrix<double, kParams, 3> rhs_ = Eigen::Matrix<double, kParams, 3>::Zero();
+  int count_[2] = {0, 0};
 };
 
 // The pairs of one bin: signed relative differences and both values, per channel.
 struct BinPairs {
   std::vector<double> signed_diff[3], a[3], b[3];
+  size_t fitted = 0;  // pairs whose partner came from the joint fit (the others: the plain mean)
 };
 
 struct BinGrid {
@@ -143,19 +221,106 @@ struct BinGrid {
   }
 };
 
-// Bins the pairs of every sample that `take` selects with its partner near `partner_point(sample)`.
-template <typename Take, typename PartnerPoint>
+// How a pair's partner value was found.
+enum class PartnerKind { kFit, kMean };
+
+// The partner of sample `a` (entry index `index`) under `symmetry`: side B's value at a's image point
+// q. Taken only where the samples within `radius` of q surround it (their centroid within
+// kMaxCentroidOffset * radius: interpolation, not extrapolation; a point at the edge of the measured
+// sheets gets no partner). Where side B has a sample per parameter and both sides together two, the
+// value is a exp(-delta) from the joint fit (PairFit) over the samples within `radius` of q (side B)
+// and of a's own point p (side A, taken to their images), at most kFitSamples of each; no partner
+// where that fit leaves delta undetermined (variance above kMaxDeltaVariance times one sample's: the
+// sheets of samples lie so that an offset cannot be told from a slope across them, which a mean
+// would only hide). Where the samples are fewer (small radii), the plain mean of side B's samples,
+// whose curvature error grows as radius^2 and is small at those radii.
+bool FindPartner(const SampleGrid& grid, Symmetry symmetry, const BrdfSample& a, uint32_t index, double radius,
+                 Eigen::Vector3d* b, PartnerKind* kind) {
+  constexpr double kMaxCentroidOffset = 0.25;
+  constexpr double kMaxDeltaVariance = 2.0;
+  constexpr size_t kFitSamples = 64;
+  constexpr double kMaxMeanRadiusDeg = 1.0;
+  using Near = std::pair<double, const SampleGrid::Entry*>;  // squared distance, entry
+  thread_local std::vector<Near> near_q, near_p;
+  near_q.clear();
+  near_p.clear();
+  const Eigen::Vector3d q = Image(symmetry, a), p = Embed(a.theta_i, a.theta_e, a.delta_phi);
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), sum = Eigen::Vector3d::Zero();
+  int around_q = 0;
+  grid.ForEachWithin(q, radius, [&](const SampleGrid::Entry& e, double squared_distance) {
+    if (e.index == index) return;
+    centroid += e.point.cast<double>();
+    sum += e.value.cast<double>();
+    ++around_q;
+    if (e.positive) near_q.emplace_back(squared_distance, &e);
+  });
+  if (around_q == 0 || (centroid / around_q - q).norm() > kMaxCentroidOffset * radius) return false;
+  const bool a_positive = a.brdf[0] > 0.0f && a.brdf[1] > 0.0f && a.brdf[2] > 0.0f;
+  // Side B alone must have a sample per parameter before side A is looked at (the cost of a sparse
+  // neighbourhood stays that of the mean).
+  if (a_positive && near_q.size() >= size_t(PairFit::kParams)) {
+    grid.ForEachWithin(p, radius, [&](const SampleGrid::Entry& e, double squared_distance) {
+      if (e.positive) near_p.emplace_back(squared_distance, &e);
+    });
+  }
+  if (a_positive && near_q.size() >= size_t(PairFit::kParams) &&
+      near_q.size() + near_p.size() >= 2 * PairFit::kParams) {
+    // At most kFitSamples of each side, evenly through the grid order (which keeps their spread over
+    // the ball, every sheet of samples in it, as the nearest would not), so the cost stays bounded.
+    PairFit fit(q, radius);
+    const size_t stride_q = (near_q.size() + kFitSamples - 1) / kFitSamples;
+    const size_t stride_p = (near_p.size() + kFitSamples - 1) / kFitSamples;
+    // The biweight kernel (1 - (distance / radius)^2)^2 about each side's own centre (floored at 1e-3
+    // so that the edge samples still count): the quadratic need hold only over about half the radius,
+    // where a sharp highlight's log bends least.
+    const double inv_r2 = 1.0 / (radius * radius);
+    auto weight = [inv_r2](double squared_distance) {
+      const double u = std::max(0.0, 1.0 - squared_distance * inv_r2);
+      return std::max(u * u, 1e-3);
+    };
+    for (size_t i = 0; i < near_q.size(); i += stride_q) {
+      fit.Add(near_q[i].second->point, near_q[i].second->log_value, /*side_a=*/false, weight(near_q[i].first));
+    }
+    for (size_t i = 0; i < near_p.size(); i += stride_p) {
+      fit.Add(near_p[i].second->image[int(symmetry)], near_p[i].second->log_value, /*side_a=*/true,
+              weight(near_p[i].first));
+    }
+    Eigen::Vector3d delta;
+    double variance = 0.0;
+    if (!fit.Solve(kMaxDeltaVariance, &delta, &variance)) return false;
+    for (int c = 0; c < 3; ++c) (*b)[c] = double(a.brdf[c]) * std::exp(-delta[c]);
+    *kind = PartnerKind::kFit;
+    return true;
+  }
+  if (radius > kMaxMeanRadiusDeg * kDegree) return false;
+  *b = sum / around_q;
+  *kind = PartnerKind::kMean;
+  return true;
+}
+
+// The standard error of a median of n values with this spread: sqrt(pi / 2) sigma / sqrt(n), sigma
+// from the median absolute deviation (1.4826 MAD, the normal's), so that outliers do not inflate it.
+double MedianStandardError(const std::vector<double>& values, double median) {
+  std::vector<double> deviation(values.size());
+  for (size_t i = 0; i < values.size(); ++i) deviation[i] = std::abs(values[i] - median);
+  const double sigma = 1.4826 * PercentileInPlace(&deviation, 0.5);
+  return std::sqrt(M_PI / 2.0) * sigma / std::sqrt(double(values.size()));
+}
+
+// Bins the pairs of every sample that `take` selects under `symmetry`.
+template <typename Take>
 ConsistencyFigure PairedFigure(const std::vector<BrdfSample>& samples, const std::vector<uint32_t>& usable,
-                               const PartnerGrid& grid, const BinGrid& bins, const ConsistencyOptions& options,
-                               Take take, PartnerPoint partner_point) {
+                               const SampleGrid& grid, const BinGrid& bins, const ConsistencyOptions& options,
+                               Symmetry symmetry, Take take) {
   std::unordered_map<int, BinPairs> by_bin;
   const double radius = options.match_deg * kDegree;
-  // The partner searches in parallel, a block at a time into a reused buffer; the pairs are then added
-  // to their bins serially in sample order (the same bins, in the same order, as the one-thread loop).
+  // The pair fits in parallel, a block at a time into a reused buffer; the pairs are then added to their
+  // bins serially in sample order (the same bins, in the same order, as the one-thread loop).
   constexpr size_t kBlock = 1 << 16;
   struct Found {
     bool paired = false;
     Eigen::Vector3d b;
+    PartnerKind kind = PartnerKind::kMean;
   };
   std::vector<Found> block(std::min(kBlock, usable.size()));
   for (size_t begin = 0; begin < usable.size(); begin += kBlock) {
@@ -165,7 +330,7 @@ ConsistencyFigure PairedFigure(const std::vector<BrdfSample>& samples, const std
         const uint32_t index = usable[i];
         const BrdfSample& a = samples[index];
         Found& found = block[i - begin];
-        found.paired = take(a) && grid.Partner(partner_point(a), radius, index, &found.b);
+        found.paired = take(a) && FindPartner(grid, symmetry, a, index, radius, &found.b, &found.kind);
       }
     });
     for (size_t i = begin; i < end; ++i) {
@@ -174,6 +339,13 @@ ConsistencyFigure PairedFigure(const std::vector<BrdfSample>& samples, const std
       const BrdfSample& a = samples[usable[i]];
       const Eigen::Vector3d& b = found.b;
       BinPairs& pairs = by_bin[bins.Index(a)];
+      switch (found.kind) {
+        case PartnerKind::kFit:
+          ++pairs.fitted;
+          break;
+        case PartnerKind::kMean:
+          break;
+      }
       for (int c = 0; c < 3; ++c) {
         const double mean = 0.5 * (double(a.brdf[c]) + b[c]);
         pairs.signed_diff[c].push_back(mean > 0.0 ? (double(a.brdf[c]) - b[c]) / mean : 0.0);
@@ -188,7 +360,7 @@ ConsistencyFigure PairedFigure(const std::vector<BrdfSample>& samples, const std
   }
   std::sort(order.begin(), order.end());
   ConsistencyFigure figure;
-  std::vector<double> errors;
+  std::vector<double> errors, standard_errors;
   std::vector<double> channel_errors[3];
   for (const int index : order) {
     BinPairs& pairs = by_bin[index];
@@ -196,19 +368,25 @@ ConsistencyFigure PairedFigure(const std::vector<BrdfSample>& samples, const std
     bin.center_deg = bins.CenterDeg(index);
     bin.count_a = bin.count_b = int(pairs.a[0].size());
     for (int c = 0; c < 3; ++c) {
-      bin.rel_error[c] = std::abs(PercentileInPlace(&pairs.signed_diff[c], 0.5));
+      const double median = PercentileInPlace(&pairs.signed_diff[c], 0.5);
+      bin.rel_error[c] = std::abs(median);
+      bin.rel_error_se[c] = MedianStandardError(pairs.signed_diff[c], median);
       bin.value_a[c] = PercentileInPlace(&pairs.a[c], 0.5);
       bin.value_b[c] = PercentileInPlace(&pairs.b[c], 0.5);
       channel_errors[c].push_back(bin.rel_error[c]);
     }
     bin.mean_rel_error = bin.rel_error.mean();
+    bin.mean_rel_error_se = bin.rel_error_se.mean();
     errors.push_back(bin.mean_rel_error);
+    standard_errors.push_back(bin.mean_rel_error_se);
     figure.pairs += bin.count_a;
+    figure.fitted_pairs += pairs.fitted;
     figure.bins.push_back(bin);
   }
   if (figure.valid()) {
     figure.median_rel_error = figure.overall_rel_error = Percentile(errors, 0.5);
     figure.p95_rel_error = Percentile(errors, 0.95);
+    figure.median_bin_se = Percentile(standard_errors, 0.5);
     for (int c = 0; c < 3; ++c) figure.per_channel_rel_error[c] = Percentile(channel_errors[c], 0.5);
     std::vector<size_t> worst(figure.bins.size());
     for (size_t i = 0; i < worst.size(); ++i) worst[i] = i;
@@ -231,7 +409,9 @@ nlohmann::json BinJson(const BinComparison& bin) {
           {"value_a", Rgb(bin.value_a)},
           {"value_b", Rgb(bin.value_b)},
           {"rel_error_rgb", Rgb(bin.rel_error)},
-          {"rel_error", bin.mean_rel_error}};
+          {"rel_error", bin.mean_rel_error},
+          {"rel_error_se_rgb", Rgb(bin.rel_error_se)},
+          {"rel_error_se", bin.mean_rel_error_se}};
 }
 
 nlohmann::json FigureJson(const ConsistencyFigure& figure, int min_pairs) {
@@ -242,10 +422,12 @@ nlohmann::json FigureJson(const ConsistencyFigure& figure, int min_pairs) {
           {"headline", figure.Headline(min_pairs)},
           {"bins_compared", figure.bins.size()},
           {"pairs", figure.pairs},
+          {"fitted_pairs", figure.fitted_pairs},
           {"overall_rel_error", figure.valid() ? nlohmann::json(figure.overall_rel_error) : nlohmann::json()},
           {"per_channel_rel_error", figure.valid() ? Rgb(figure.per_channel_rel_error) : nlohmann::json()},
           {"median_rel_error", figure.valid() ? nlohmann::json(figure.median_rel_error) : nlohmann::json()},
           {"p95_rel_error", figure.valid() ? nlohmann::json(figure.p95_rel_error) : nlohmann::json()},
+          {"median_bin_se", figure.valid() ? nlohmann::json(figure.median_bin_se) : nlohmann::json()},
           {"worst_bins", worst},
           {"bins", bins}};
 }
@@ -329,20 +511,18 @@ ConsistencyReport CheckConsistency(const std::vector<BrdfSample>& samples, const
   for (const double radius : radii) {
     ConsistencyOptions at = options;
     at.match_deg = radius;
-    const PartnerGrid grid(samples, usable, radius * kDegree);
+    const SampleGrid grid(samples, usable, radius * kDegree);
     report.match_deg = radius;
     // Each unordered pair once: reciprocity from the side theta_i < theta_e, bilateral symmetry from
     // delta_phi < 0. The two figures only read the grid: side by side on two threads.
     tbb::parallel_invoke(
         [&] {
-          report.reciprocity = PairedFigure(
-              samples, usable, grid, bins, at, [](const BrdfSample& s) { return s.theta_i < s.theta_e; },
-              [](const BrdfSample& s) { return Embed(s.theta_e, s.theta_i, -s.delta_phi); });
+          report.reciprocity = PairedFigure(samples, usable, grid, bins, at, Symmetry::kReciprocity,
+                                            [](const BrdfSample& s) { return s.theta_i < s.theta_e; });
         },
         [&] {
-          report.bilateral_symmetry = PairedFigure(
-              samples, usable, grid, bins, at, [](const BrdfSample& s) { return s.delta_phi < 0.0f; },
-              [](const BrdfSample& s) { return Embed(s.theta_i, s.theta_e, -s.delta_phi); });
+          report.bilateral_symmetry = PairedFigure(samples, usable, grid, bins, at, Symmetry::kBilateral,
+                                                   [](const BrdfSample& s) { return s.delta_phi < 0.0f; });
         });
     if (report.reciprocity.bins.size() >= ConsistencyReport::kAutoMinBins &&
         report.bilateral_symmetry.bins.size() >= ConsistencyReport::kAutoMinBins) {
@@ -366,11 +546,17 @@ nlohmann::json ToJson(const ConsistencyReport& report, const ConsistencyOptions&
           {"version", 2},
           {"samples", report.samples},
           {"method",
-           "each sample paired with the mean of the measured samples within match_deg of its reciprocal "
-           "(mirrored) point, where their centroid lies within match_deg / 4 of it (no extrapolation); signed relative "
-           "difference (a - b) / ((a + b) / 2) per "
-           "pair; a bin of (theta_i, theta_e, delta_phi) reports |median of its pairs' differences|; "
-           "overall_rel_error = median over bins, p95_rel_error = 95th percentile over bins"},
+           "each sample (side A, at p) against the measured samples within match_deg of its reciprocal "
+           "(mirrored) point q (side B), where their centroid lies within match_deg / 4 of q (no extrapolation): "
+           "one least-squares fit of log f, quadratic in the offset from q, over side B as measured and side A's "
+           "samples within match_deg of p taken to their images, plus side A's offset delta (slope and curvature "
+           "shared, so they cancel); pairs whose delta has more than twice one sample's variance are dropped; "
+           "with fewer than 11 samples around q (22 on both sides), the plain mean of side B at match_deg <= 1, "
+           "else no pair; "
+           "signed relative difference (a - b) / ((a + b) / 2) per pair (2 tanh(delta / 2) if fitted); a bin of "
+           "(theta_i, theta_e, delta_phi) reports |median of its pairs' differences| and that median's standard "
+           "error (rel_error_se); overall_rel_error = median over bins, p95_rel_error = 95th percentile over "
+           "bins, median_bin_se = median over bins of rel_error_se"},
           {"options",
            {{"theta_bin_deg", options.theta_bin_deg},
             {"phi_bin_deg", options.phi_bin_deg},

@@ -4,14 +4,24 @@
 //    of directions with light and camera exchanged;
 //  - bilateral symmetry: f(theta_i, theta_e, delta_phi) against f(theta_i, theta_e, -delta_phi) (the JSON
 //    keeps "isotropy" as an alias of "bilateral_symmetry" for one release).
-// Samples are compared with samples, never with an extrapolated estimate: each sample's partner is the
-// mean of the measured samples within `match_deg` of its reciprocal (or mirrored) point, taken only
-// where their centroid lies within a quarter of that radius of the point (the point is surrounded, so
-// the BRDF's slope cancels to first order; a point at the edge of the measured sheets gets no partner).
-// Each pair gives a signed relative difference (a - b) / ((a + b) / 2); a bin of (theta_i, theta_e,
-// delta_phi) reports |median of its pairs' signed differences|, so camera noise and the remaining
-// offsets (which fall on either side) cancel, while a real violation (a bias of one sign) does not. The headline
-// figures are the median and the 95th percentile over bins, and the worst bins are listed with where they are.
+// Samples are compared with samples, never with an extrapolated estimate. Each sample (side A, at its
+// point p) is paired with the measured samples within `match_deg` of its image point q (side B), taken
+// only where their centroid lies within a quarter of that radius of q (q is surrounded; a point at the
+// edge of the measured sheets gets no partner). Where the samples suffice (side B a sample per
+// parameter, both sides together two), the pair's difference is one joint weighted least-squares fit
+// of log f, quadratic in the offset from q, over side B's samples as measured and side A's (those
+// within `match_deg` of p) taken to their images, with one extra parameter: side A's offset delta.
+// The sides share the BRDF's slope and curvature, so a sharp highlight's curvature within the radius
+// (which biased a plain mean of side B by several per cent at 4 degrees) cancels, and delta is the log
+// of A over B at the same exact point q; a fit that leaves delta poorly determined (variance above
+// twice one sample's) gives no pair. Where the samples are fewer, at radii up to 1 degree, side B's
+// plain mean is the partner (its curvature error grows as the radius squared); beyond, no pair.
+// Each pair gives a signed relative difference (a - b) / ((a + b) / 2) (= 2 tanh(delta / 2) for a
+// fitted pair); a bin of (theta_i, theta_e, delta_phi) reports |median of its pairs' signed
+// differences| (camera noise and the remaining offsets fall on either side and cancel, a real
+// violation, a bias of one sign, does not), with that median's own standard error. The headline
+// figures are the median and the 95th percentile over bins, and the worst bins are listed with where
+// they are.
 #pragma once
 
 #include <string>
@@ -44,18 +54,24 @@ struct BinComparison {
   int count_a = 0, count_b = 0;      // sample pairs in the bin (both: one pair per sample of the bin)
   Eigen::Vector3d value_a, value_b;  // median RGB of the bin's samples and of their partners (1/sr)
   Eigen::Vector3d rel_error;         // per channel, |median over pairs of (a - b) / ((a + b) / 2)|
-  double mean_rel_error = 0.0;       // over the channels
+  // Per channel, the standard error of that median from the pairs' spread (sqrt(pi / 2) 1.4826 MAD /
+  // sqrt(pairs)); pairs that share samples are not independent, so take it as a lower bound.
+  Eigen::Vector3d rel_error_se = Eigen::Vector3d::Zero();
+  double mean_rel_error = 0.0;     // over the channels
+  double mean_rel_error_se = 0.0;  // over the channels
 };
 
 // One check's bins and headline figures.
 struct ConsistencyFigure {
   std::vector<BinComparison> bins;
   size_t pairs = 0;                // sample pairs in reported bins
+  size_t fitted_pairs = 0;         // of those, the pairs whose partner is the joint fit (not the mean)
   double overall_rel_error = 0.0;  // the headline: the median over bins of mean_rel_error
   Eigen::Vector3d per_channel_rel_error = Eigen::Vector3d::Zero();  // per channel, median over bins
   double median_rel_error = 0.0;                                    // = overall_rel_error
   double p95_rel_error = 0.0;                                       // the 95th percentile over bins
-  std::vector<size_t> worst;                                        // indices into `bins`, worst first
+  double median_bin_se = 0.0;  // the median over bins of mean_rel_error_se: the figures' own error bar
+  std::vector<size_t> worst;   // indices into `bins`, worst first
   bool valid() const { return !bins.empty(); }
   // "0.12 % median, 0.80 % p95 over 312 bins (worst 2.1 % at theta_i 15, theta_e 45, delta_phi 170 deg)",
   // or "invalid: no bin had N sample pairs".
@@ -75,7 +91,7 @@ struct ConsistencyReport {
   std::string BriefReport() const;
 };
 
-// Pairs every sample with its nearest reciprocal and mirrored partner and bins the pairs. Throws Error
+// Pairs every sample with its reciprocal and mirrored neighbourhoods and bins the pairs. Throws Error
 // on invalid options.
 ConsistencyReport CheckConsistency(const std::vector<BrdfSample>& samples, const ConsistencyOptions& options);
 
