@@ -903,6 +903,93 @@ def run_figures(early, out, ready, explorer_job):
     return figures, explorer
 
 
+def _cells(values):
+    return "".join(f"<td>{html.escape(str(v))}</td>" for v in values)
+
+
+def _table(header, rows):
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
+    return f"<table><tr>{head}</tr>" + "\n".join(f"<tr>{_cells(r)}</tr>" for r in rows) + "</table>\n"
+
+
+def _fmt(value, scale=1.0, digits=3):
+    return "n/a" if not isinstance(value, (int, float)) else f"{value * scale:.{digits}g}"
+
+
+def acquisition_html(run_dir, side):
+    """What the calibration stages found (align/alignment.json, lights/white-reference.json,
+    colour/colour.json): the verdicts as a pass/fail table, each photo's markers and residual, the
+    sample's fit, the light, the white reference, the colour fit per patch, and the clipped pixels."""
+    align = load_json(os.path.join(run_dir, "align", "alignment.json"))
+    white = load_json(os.path.join(run_dir, "lights", "white-reference.json"))
+    colour = load_json(os.path.join(run_dir, "colour", "colour.json"))
+    parts = []
+    if align:
+        verdicts = align.get("verdicts", [])
+        if verdicts:
+            names = {"ok": "pass", "warn": "warn", "fail": "FAIL"}
+            parts.append("<h3>Checks</h3>" + _table(
+                ["check", "verdict", "measured", "bound"],
+                [[v.get("check"), names.get(v.get("verdict"), v.get("verdict")) + (" (accepted)" if v.get("accepted") else ""),
+                  v.get("measured"), v.get("bound")] for v in verdicts]))
+        rows = []
+        for image in align.get("images", []):
+            rows.append([image.get("photo"), "used" if image.get("used") else "dropped: " + str(image.get("dropped", "")),
+                         image.get("markers"), image.get("light_markers"), image.get("outlier_corners"),
+                         _fmt(image.get("rms_px")), _fmt(image.get("position_sigma_m"), 1e3),
+                         _fmt(image.get("rotation_sigma_deg"))])
+        parts.append(f"<h3>Photos posed</h3><p>Bundle adjustment: marker corner RMS {_fmt(align.get('rms_px'))} px over "
+                     f"the used photos.</p>" + _table(
+                         ["photo", "pose", "markers", "light markers", "outlier corners", "RMS px", "position sigma mm",
+                          "rotation sigma deg"], rows))
+        sphere = align.get("sphere")
+        if sphere:
+            sigma = sphere.get("center_sigma_m", [None, None, None])
+            parts.append("<h3>Sample</h3>" + _table(
+                ["sphere centre (m)", "centre sigma (mm)", "radius (m)", "radius sigma (mm)", "silhouette points",
+                 "limb balance", "radius known"],
+                [[", ".join(_fmt(v, 1, 5) for v in sphere.get("center", [])), ", ".join(_fmt(v, 1e3) for v in sigma),
+                  _fmt(sphere.get("radius"), 1, 5), _fmt(sphere.get("radius_sigma_m"), 1e3),
+                  sphere.get("silhouette_points"), _fmt(sphere.get("limb_balance")), sphere.get("radius_known")]]))
+        if "mesh_registration" in align:
+            m = align["mesh_registration"]
+            parts.append("<h3>Mesh registration</h3>" + _table(
+                ["markers used", "corner RMS mm", "worst marker mm"],
+                [[m.get("used_markers"), _fmt(m.get("rms_m"), 1e3), _fmt(m.get("max_marker_rms_m"), 1e3)]]))
+        light = align.get("light")
+        if light:
+            if light.get("fitted"):
+                parts.append("<h3>Light from its markers</h3>" + _table(
+                    ["position (m)", "markers' spread (mm)"],
+                    [[", ".join(_fmt(v, 1, 5) for v in light.get("position", [])), _fmt(light.get("spread_m"), 1e3)]]))
+            else:
+                parts.append(f"<h3>Light</h3><p>As the session states it ({html.escape(str(light.get('reason', '')))}).</p>")
+    if white:
+        scalars = [[k, v] for k, v in white.items() if isinstance(v, (int, float, str)) and k not in ("format", "version")]
+        parts.append("<h3>White reference</h3>" + _table(["field", "value"], scalars))
+    if colour:
+        rows = [[p.get("name"), "used" if "residual" in p else "left out: " + str(p.get("excluded", "")),
+                 _fmt(p.get("residual"), 100), ", ".join(_fmt(v, 1, 4) for v in p.get("camera_rgb", []))]
+                for p in colour.get("patches", [])]
+        chart = ""
+        chart_png = os.path.join(run_dir, "colour", "chart.png")
+        if os.path.exists(chart_png):
+            with open(chart_png, "rb") as f:
+                chart = (f'<figure><img src="data:image/png;base64,{base64.b64encode(f.read()).decode("ascii")}" '
+                         f'alt="chart.png" style="max-width:480px"><figcaption>the chart as located '
+                         f'(colour/chart.png)</figcaption></figure>')
+        parts.append(f"<h3>Colour chart</h3><p>{colour.get('patches_used')} patches used; residual RMS "
+                     f"{_fmt(colour.get('rms_residual'), 100)} %, worst {_fmt(colour.get('max_residual'), 100)} %.</p>"
+                     + chart + _table(["patch", "fit", "residual %", "camera RGB"], rows))
+    rejected = side.get("counts", {}).get("rejected", {})
+    clipped = {k: v for k, v in rejected.items() if "saturat" in k or "clip" in k}
+    if clipped:
+        parts.append("<h3>Clipping</h3>" + _table(["rejected as", "pixels"], [[k, v] for k, v in clipped.items()]))
+    if not parts:
+        return "<h2>Acquisition</h2><p>No calibration stage ran: the session's poses, sample and lights are used as given.</p>"
+    return "<h2>Acquisition</h2>\n" + "\n".join(parts)
+
+
 def notices_html(run_dir, side):
     """Every calibration verdict that is not ok (align/alignment.json), the stages' warnings and the
     samples' scale, at the top of the report: what the run could not trust, or had to be told."""
@@ -999,6 +1086,7 @@ pixel that gave a sample, f_model(wi, wo) times the irradiance term E cos(theta_
 {appearance_html(data, out, figures)}
 {held_out_html(data, out, figures)}
 {lights_section(out, data)}
+{acquisition_html(run_dir, side)}
 <h2>Sample coverage</h2>
 {figure_html(out, figures['coverage'], 'exitant directions sampled at each incidence angle')}
 <h2>Incidence plane, three colour channels</h2>

@@ -167,7 +167,7 @@ TEST(CaptureCli, ACollapsedSphereFitStopsTheRunUnlessAccepted) {
   EXPECT_FALSE(fs::exists(dir / "run/samples.npy"));
 
   const RunResult accepted = RunIbrdf("run " + dir / "s" + " --out " + dir / "run" +
-                                      " --no-report --no-fits --stop-after derender --accept sphere.radius,sphere.center",
+                                      " --no-fits --accept sphere.radius,sphere.center",
                                       true);
   ASSERT_EQ(accepted.exit_code, 0) << accepted.output;
   const nlohmann::json summary = ReadJsonFile(dir / "run/summary.json");
@@ -183,6 +183,14 @@ TEST(CaptureCli, ACollapsedSphereFitStopsTheRunUnlessAccepted) {
   EXPECT_TRUE(said) << summary.dump(1);
   EXPECT_NE(accepted.output.find("verdict: align sphere.radius: fail (accepted by the user)"), std::string::npos)
       << accepted.output;
+  // The report opens with the verdicts and shows the acquisition: checks, photos posed, the sample's fit.
+  std::ifstream page_file(dir / "run/report/index.html");
+  const std::string page((std::istreambuf_iterator<char>(page_file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(page.find("<h2>Verdicts and warnings</h2>"), std::string::npos);
+  EXPECT_NE(page.find("align sphere.radius: fail (accepted by the user)"), std::string::npos);
+  EXPECT_NE(page.find("<h2>Acquisition</h2>"), std::string::npos);
+  EXPECT_NE(page.find("<td>FAIL (accepted)</td>"), std::string::npos);
+  EXPECT_NE(page.find("<h3>Photos posed</h3>"), std::string::npos);
 }
 
 }  // namespace
