@@ -24,6 +24,7 @@ void AddColourCommand(CLI::App& app) {
     std::string session, out;
     ColourChartOptions options;
     bool detect = false, overwrite = false;
+    AcceptedChecks accept;
   };
   auto args = std::make_shared<Args>();
   ColourChartOptions& o = args->options;
@@ -42,6 +43,10 @@ void AddColourCommand(CLI::App& app) {
   command->add_option("--min-patches", o.min_patches, "Usable patches the fit needs")->capture_default_str();
   command->add_flag("--detect", args->detect, "Detect the chart (OpenCV mcc) even where the session gives its corners");
   command->add_flag("--overwrite", args->overwrite, "Replace an existing output folder");
+  command->add_option("--accept", args->accept.names,
+                      "Proceed although these checks fail (comma-separated, or all); recorded in colour.json")
+      ->delimiter(',')
+      ->type_name("CHECK[,CHECK...]");
   command->callback([args] {
     StageLog stage("colour");
     const Session session = Session::Load(args->session);
@@ -49,7 +54,7 @@ void AddColourCommand(CLI::App& app) {
       ThrowError(session.manifest_path, "has no colour_chart block (docs/session-format.md): nothing to fit");
     }
     RequireWritableOutput(args->out, args->overwrite, SessionInputs(session));
-    const ColourChartFit fit = LocateAndFitColourChart(session, args->options, args->detect);
+    ColourChartFit fit = LocateAndFitColourChart(session, args->options, args->detect);
     Log(1, fit.BriefReport());
     for (const ColourPatch& patch : fit.patches) {
       char line[200];
@@ -66,6 +71,9 @@ void AddColourCommand(CLI::App& app) {
         Log(1, line + patch.excluded);
       }
     }
+    // Nothing is written when the fit cannot be trusted, unless the user accepted it by name.
+    fit.verdicts = ColourChartVerdicts(fit);
+    EnforceVerdicts(&fit.verdicts, args->accept, session.manifest_path + ": /colour_chart");
     WriteColourStage(session, fit, args->out, args->overwrite);
     Log(1, "session with the colour matrix written to " + args->out + "/session.json (fit in " + args->out +
                "/colour.json)");

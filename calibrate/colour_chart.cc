@@ -106,6 +106,7 @@ nlohmann::json ColourChartFit::ToJson() const {
                          {"patches_used", used},
                          {"rms_residual", rms_residual},
                          {"max_residual", max_residual},
+                         {"verdicts", VerdictsToJson(verdicts)},
                          {"patches", nlohmann::json::array()}};
   for (const ColourPatch& patch : patches) {
     nlohmann::json p = {{"patch", patch.index + 1},
@@ -322,6 +323,34 @@ Image ColourChartDisplayImage(const Session& session) {
     }
   }
   return display;
+}
+
+std::vector<Verdict> ColourChartVerdicts(const ColourChartFit& fit) {
+  std::vector<Verdict> verdicts;
+  char text[160];
+  Verdict residual;
+  residual.check = "colour.fit_residual";
+  residual.value = fit.rms_residual;
+  std::snprintf(text, sizeof(text), "residual %.2f %% RMS over %d patches (worst %.2f %%)", 100.0 * fit.rms_residual,
+                fit.used, 100.0 * fit.max_residual);
+  residual.measured = text;
+  residual.bound = "warn over 3 %, fail over 10 %";
+  residual.level = VerdictLevel::kOk;
+  if (!(fit.rms_residual <= 0.03)) residual.level = VerdictLevel::kWarn;
+  if (!(fit.rms_residual <= 0.10)) residual.level = VerdictLevel::kFail;
+  residual.remedy = "check the chart's corner patches (colour_chart.corners) or detect it (--detect); light the chart "
+                    "evenly, without glare";
+  verdicts.push_back(residual);
+  Verdict used;
+  used.check = "colour.patches_used";
+  used.value = fit.used;
+  std::snprintf(text, sizeof(text), "%d of %d patches used", fit.used, kColorCheckerPatches);
+  used.measured = text;
+  used.bound = "warn under 18";
+  used.level = fit.used < 18 ? VerdictLevel::kWarn : VerdictLevel::kOk;
+  used.remedy = "expose the chart so that its white patch is bright but not clipped (the left-out patches say why)";
+  verdicts.push_back(used);
+  return verdicts;
 }
 
 void WriteColourStage(const Session& session, const ColourChartFit& fit, const std::string& out_dir, bool overwrite) {

@@ -17,6 +17,7 @@
 #include "core/camera.h"
 #include "core/image_io.h"
 #include "core/session.h"
+#include "core/verdict.h"
 
 namespace ibrdf {
 
@@ -70,6 +71,7 @@ struct ColourChartFit {
   int used = 0;                      // patches in the fit
   double rms_residual = 0.0;         // over the used patches
   double max_residual = 0.0;
+  std::vector<Verdict> verdicts;     // ColourChartVerdicts, once graded (written into colour.json)
 
   // "colour: 24 patches (22 used; cyan: clipped, ...), residual 0.4 % RMS, 1.1 % worst"
   std::string BriefReport() const;
@@ -106,6 +108,11 @@ Image ColourChartDisplayImage(const Session& session);
 // (ColourChartFit::ToJson) and OUT/chart.png (ColourChartDisplayImage with each patch's read-out
 // centre marked), as one folder that appears complete.
 void WriteColourStage(const Session& session, const ColourChartFit& fit, const std::string& out_dir, bool overwrite);
+
+// The colour fit's verdicts (docs/verdicts.md): the residual over the used patches (warn over 3 %,
+// fail over 10 %: a chart located wrong, or a camera RGB that no 3x3 matrix maps to the chart), and
+// the patches used (warn under 18 of 24).
+std::vector<Verdict> ColourChartVerdicts(const ColourChartFit& fit);
 
 // Writes the fit into a colour_chart block (matrix and per-patch residuals or exclusions).
 void StoreColourFit(const ColourChartFit& fit, ColourChartSpec* chart);

@@ -924,14 +924,14 @@ def acquisition_html(run_dir, side):
     white = load_json(os.path.join(run_dir, "lights", "white-reference.json"))
     colour = load_json(os.path.join(run_dir, "colour", "colour.json"))
     parts = []
+    verdicts = (align or {}).get("verdicts", []) + (colour or {}).get("verdicts", [])
+    if verdicts:
+        names = {"ok": "pass", "warn": "warn", "fail": "FAIL"}
+        parts.append("<h3>Checks</h3>" + _table(
+            ["check", "verdict", "measured", "bound"],
+            [[v.get("check"), names.get(v.get("verdict"), v.get("verdict")) + (" (accepted)" if v.get("accepted") else ""),
+              v.get("measured"), v.get("bound")] for v in verdicts]))
     if align:
-        verdicts = align.get("verdicts", [])
-        if verdicts:
-            names = {"ok": "pass", "warn": "warn", "fail": "FAIL"}
-            parts.append("<h3>Checks</h3>" + _table(
-                ["check", "verdict", "measured", "bound"],
-                [[v.get("check"), names.get(v.get("verdict"), v.get("verdict")) + (" (accepted)" if v.get("accepted") else ""),
-                  v.get("measured"), v.get("bound")] for v in verdicts]))
         rows = []
         for image in align.get("images", []):
             rows.append([image.get("photo"), "used" if image.get("used") else "dropped: " + str(image.get("dropped", "")),
@@ -999,11 +999,14 @@ def notices_html(run_dir, side):
                       "measured, the scale not): every BRDF value here, the table and the fits are the material's "
                       "times one unknown constant"))
     align = load_json(os.path.join(run_dir, "align", "alignment.json")) or {}
-    for v in align.get("verdicts", []):
-        if v.get("verdict") == "ok":
-            continue
-        label = f"align {v.get('check')}: {v.get('verdict')}" + (" (accepted by the user)" if v.get("accepted") else "")
-        items.append((label, f"{v.get('measured')}; bound: {v.get('bound')}; remedy: {v.get('remedy')}"))
+    colour = load_json(os.path.join(run_dir, "colour", "colour.json")) or {}
+    for stage, stage_json in (("align", align), ("colour", colour)):
+        for v in stage_json.get("verdicts", []):
+            if v.get("verdict") == "ok":
+                continue
+            label = (f"{stage} {v.get('check')}: {v.get('verdict')}" +
+                     (" (accepted by the user)" if v.get("accepted") else ""))
+            items.append((label, f"{v.get('measured')}; bound: {v.get('bound')}; remedy: {v.get('remedy')}"))
     for w in align.get("warnings", []):
         items.append(("align", w))
     for w in side.get("exposure", {}).get("warnings", []):

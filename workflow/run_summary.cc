@@ -98,33 +98,36 @@ void AddTruth(const fs::path& dir, const std::string& truth_path, nlohmann::json
   (*summary)["truth"] = truth;
 }
 
-// The calibration stages' verdicts (align/alignment.json "verdicts", core/verdict.h), each with its
+// The calibration stages' verdicts (align/alignment.json and colour/colour.json "verdicts",
+// core/verdict.h), each with its
 // stage, and every stage's warnings in one list: the verdicts that are not ok (an accepted failure
 // included, marked so), align's own warnings and derender's exposure advice.
 void AddVerdicts(const fs::path& dir, nlohmann::json* summary) {
   nlohmann::json verdicts = nlohmann::json::array(), warnings = nlohmann::json::array();
-  const std::optional<StageJson> align = StageJson::ReadIfExists((dir / "align" / "alignment.json").string());
-  if (align) {
-    const nlohmann::json list = align->ValueOr("/verdicts", nlohmann::json::array());
+  for (const auto& [stage, file] : {std::pair<std::string, std::string>{"align", "align/alignment.json"},
+                                     std::pair<std::string, std::string>{"colour", "colour/colour.json"}}) {
+    const std::optional<StageJson> stage_json = StageJson::ReadIfExists((dir / file).string());
+    if (!stage_json) continue;
+    const nlohmann::json list = stage_json->ValueOr("/verdicts", nlohmann::json::array());
     for (size_t i = 0; list.is_array() && i < list.size(); ++i) {
       const std::string at = "/verdicts/" + std::to_string(i);
-      nlohmann::json v = {{"stage", "align"},
-                          {"check", align->String(at + "/check")},
-                          {"verdict", align->String(at + "/verdict")},
-                          {"measured", align->String(at + "/measured", "")},
-                          {"bound", align->String(at + "/bound", "")},
-                          {"remedy", align->String(at + "/remedy", "")},
-                          {"accepted", align->Boolean(at + "/accepted", false)}};
+      nlohmann::json v = {{"stage", stage},
+                          {"check", stage_json->String(at + "/check")},
+                          {"verdict", stage_json->String(at + "/verdict")},
+                          {"measured", stage_json->String(at + "/measured", "")},
+                          {"bound", stage_json->String(at + "/bound", "")},
+                          {"remedy", stage_json->String(at + "/remedy", "")},
+                          {"accepted", stage_json->Boolean(at + "/accepted", false)}};
       if (v["verdict"] != "ok") {
-        warnings.push_back("align: " + v["check"].get<std::string>() + ": " + v["verdict"].get<std::string>() +
+        warnings.push_back(stage + ": " + v["check"].get<std::string>() + ": " + v["verdict"].get<std::string>() +
                            (v["accepted"].get<bool>() ? " (accepted by the user)" : "") + ": " +
                            v["measured"].get<std::string>() + "; bound: " + v["bound"].get<std::string>());
       }
       verdicts.push_back(v);
     }
-    const nlohmann::json own = align->ValueOr("/warnings", nlohmann::json::array());
+    const nlohmann::json own = stage_json->ValueOr("/warnings", nlohmann::json::array());
     for (const nlohmann::json& w : own) {
-      if (w.is_string()) warnings.push_back("align: " + w.get<std::string>());
+      if (w.is_string()) warnings.push_back(stage + ": " + w.get<std::string>());
     }
   }
   if (summary->contains("samples")) {

@@ -3,6 +3,8 @@
 // known camera matrix and light tint: residuals, clipped patches left out and said, too few patches.
 #include "calibrate/colour_chart.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "core/brdf_model.h"
@@ -149,6 +151,27 @@ TEST(ColourChartTest, ABlackChannelPatchIsLeftOutAndSaid) {
   StoreColourFit(kept, &biased);
   EXPECT_GT((SampleColourMatrix(biased, session.lights[0].intensity) - expected).cwiseAbs().maxCoeff(),
             (got - expected).cwiseAbs().maxCoeff());
+}
+
+// The fit's verdicts: a synthetic chart passes both; a residual over 3 % warns, over 10 % fails; fewer
+// than 18 patches warn. A failure stops `ibrdf colour` unless accepted (core/verdict.h).
+TEST(ColourChartTest, VerdictsGradeTheResidualAndThePatchesUsed) {
+  ColourChartFit fit;
+  fit.used = 24;
+  fit.rms_residual = 0.0055;
+  EXPECT_EQ(WorstVerdict(ColourChartVerdicts(fit)), VerdictLevel::kOk);
+  fit.rms_residual = 0.05;
+  EXPECT_EQ(ColourChartVerdicts(fit)[0].level, VerdictLevel::kWarn);
+  fit.rms_residual = 0.3;
+  std::vector<Verdict> verdicts = ColourChartVerdicts(fit);
+  EXPECT_EQ(verdicts[0].check, "colour.fit_residual");
+  EXPECT_EQ(verdicts[0].level, VerdictLevel::kFail);
+  EXPECT_THROW(EnforceVerdicts(&verdicts, AcceptedChecks(), "test"), Error);
+  fit.rms_residual = 0.01;
+  fit.used = 12;
+  EXPECT_EQ(ColourChartVerdicts(fit)[1].level, VerdictLevel::kWarn);
+  fit.rms_residual = std::nan("");
+  EXPECT_EQ(ColourChartVerdicts(fit)[0].level, VerdictLevel::kFail);
 }
 
 TEST(ColourChartTest, ADerenderWithoutTheFittedMatrixIsAnError) {
