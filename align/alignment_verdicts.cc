@@ -69,7 +69,7 @@ std::vector<Verdict> AlignmentVerdicts(const Session& input, const AlignResult& 
       v.bound = Format("fitted / stated radius within %.3g-%.3g (warn), ", 1.0 / bounds.warn_radius_ratio,
                        bounds.warn_radius_ratio) +
                 Format("%.3g-%.3g (fail)", 1.0 / bounds.fail_radius_ratio, bounds.fail_radius_ratio);
-      v.level = Above(std::isfinite(off) ? off : HUGE_VAL, bounds.warn_radius_ratio, bounds.fail_radius_ratio);
+      v.level = Above(off, bounds.warn_radius_ratio, bounds.fail_radius_ratio);  // a zero radius: inf, fails
       v.remedy = "state the radius and mark it known (session init --sample-radius-m R --radius-known; sample.radius_known), or add "
                  "photos whose silhouettes see the sphere's limb all around";
       verdicts.push_back(v);

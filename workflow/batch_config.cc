@@ -63,6 +63,22 @@ std::vector<std::string> ExpandPattern(const std::string& pattern, const std::st
   return inputs;
 }
 
+// The stages' arguments: the batch config's key and `ibrdf run`'s flag for each (one string, split at
+// spaces).
+struct StageArgsKey {
+  const char* key;
+  const char* flag;
+  std::vector<std::string> MeasurementOptions::*member;
+};
+const StageArgsKey kStageArgs[] = {{"scan_args", "--scan-args", &MeasurementOptions::scan_args},
+                                   {"align_args", "--align-args", &MeasurementOptions::align_args},
+                                   {"lights_args", "--lights-args", &MeasurementOptions::lights_args},
+                                   {"colour_args", "--colour-args", &MeasurementOptions::colour_args},
+                                   {"derender_args", "--derender-args", &MeasurementOptions::derender_args},
+                                   {"check_args", "--check-args", &MeasurementOptions::check_args},
+                                   {"reconstruct_args", "--reconstruct-args", &MeasurementOptions::reconstruct_args},
+                                   {"report_args", "--report-args", &MeasurementOptions::report_args}};
+
 // Reads an "options" block on top of `options`.
 void ReadOptions(JsonObject block, MeasurementOptions* options) {
   options->pixel_stride = block.Integer("stride", options->pixel_stride);
@@ -72,17 +88,11 @@ void ReadOptions(JsonObject block, MeasurementOptions* options) {
   options->fits = block.Boolean("fits", options->fits);
   options->report = block.Boolean("report", options->report);
   options->check_regression = block.Boolean("check_regression", options->check_regression);
-  // Stage arguments as `ibrdf run --STAGE-args` takes them: one string, split at spaces.
-  const std::pair<const char*, std::vector<std::string> MeasurementOptions::*> stage_args[] = {
-      {"scan_args", &MeasurementOptions::scan_args},           {"align_args", &MeasurementOptions::align_args},
-      {"lights_args", &MeasurementOptions::lights_args},       {"colour_args", &MeasurementOptions::colour_args},
-      {"derender_args", &MeasurementOptions::derender_args},   {"check_args", &MeasurementOptions::check_args},
-      {"reconstruct_args", &MeasurementOptions::reconstruct_args}, {"report_args", &MeasurementOptions::report_args}};
-  for (const auto& [key, member] : stage_args) {
-    if (!block.Has(key)) continue;
-    std::vector<std::string>& words = options->*member;
+  for (const StageArgsKey& stage : kStageArgs) {
+    if (!block.Has(stage.key)) continue;
+    std::vector<std::string>& words = options->*stage.member;
     words.clear();  // an entry's own replaces the batch's
-    std::istringstream text(block.String(key));
+    std::istringstream text(block.String(stage.key));
     for (std::string word; text >> word;) words.push_back(word);
   }
   block.Finish();
@@ -200,16 +210,12 @@ std::vector<std::string> RunArguments(const BatchEntry& entry) {
   if (!o.fits) arguments.push_back("--no-fits");
   if (!o.report) arguments.push_back("--no-report");
   if (o.check_regression) arguments.push_back("--check-regression");
-  const std::pair<const char*, const std::vector<std::string>*> stage_args[] = {
-      {"--scan-args", &o.scan_args},         {"--align-args", &o.align_args},   {"--lights-args", &o.lights_args},
-      {"--colour-args", &o.colour_args},     {"--derender-args", &o.derender_args},
-      {"--check-args", &o.check_args},       {"--reconstruct-args", &o.reconstruct_args},
-      {"--report-args", &o.report_args}};
-  for (const auto& [flag, words] : stage_args) {
-    if (words->empty()) continue;
+  for (const StageArgsKey& stage : kStageArgs) {
+    const std::vector<std::string>& words = o.*stage.member;
+    if (words.empty()) continue;
     std::string joined;
-    for (const std::string& word : *words) joined += (joined.empty() ? "" : " ") + word;
-    arguments.insert(arguments.end(), {flag, joined});
+    for (const std::string& word : words) joined += (joined.empty() ? "" : " ") + word;
+    arguments.insert(arguments.end(), {stage.flag, joined});
   }
   return arguments;
 }
