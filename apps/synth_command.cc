@@ -69,6 +69,8 @@ IBRDF_COMMAND(10, Synth) {
       ->check(CLI::IsMember({"default", "none"}));
   c.add_option("--bits", r.bits, "Quantization bits: 8 to 16, or 0 for float EXR");
   c.add_flag("--srgb", r.srgb, "Store photos with the sRGB response");
+  c.add_option("--response", r.response, "The sensor's curve: linear, srgb or toe-shoulder (a film-like S-curve)")
+      ->check(CLI::IsMember({"linear", "srgb", "toe-shoulder"}));
   c.add_flag("--no-shot-noise", r.no_shot_noise, "No photon shot noise");
   c.add_flag("--no-read-noise", r.no_read_noise, "No read noise");
   c.add_flag("--no-clip", r.no_clip, "Do not clip at saturation (float output only)");
@@ -82,6 +84,8 @@ IBRDF_COMMAND(10, Synth) {
   AddOption(c, "--brackets", o.radiometry.brackets, "Exposures per pose (an HDR bracket, shorter than the auto one)");
   AddOption(c, "--bracket-step-ev", o.radiometry.bracket_step_ev, "Stops between a bracket's exposures");
   c.add_flag("--light-unknown", o.radiometry.light_unknown, "No light intensity; a white-reference photo per light");
+  c.add_flag("--response-unknown", o.radiometry.response_unknown,
+             "The session states its response as \"unknown\" (measure it: `ibrdf response`, from --brackets)");
   c.add_option("--camera-matrix", r.camera_matrix, "Camera RGB = M * linear sRGB, M as 9 numbers row by row")
       ->expected(9);
   c.add_flag("--colour-chart", o.colour.chart, "Also photograph a ColorChecker Classic (for `ibrdf colour`)");

@@ -41,7 +41,7 @@ const Session& BenchSession(int kind) {
     SynthOptions options;
     options.rig.num_photos = 4;
     if (kind == kSrgbFlat) {
-      options.effects.srgb = true;
+      options.effects.curve = SensorCurve::kSrgb;
       options.effects.black_level = 0.03;
       options.effects.vignetting = 0.4;
       options.radiometry.light_unknown = true;

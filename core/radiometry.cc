@@ -26,7 +26,10 @@ double Response::ToLinear(double v) const {
       const double t = x - static_cast<double>(i);
       return table[i] + t * (table[i + 1] - table[i]);
     }
+    case Kind::kUnknown:
+      break;
   }
+  IBRDF_CHECK(false) << "an unknown response read linearly";
   return v;
 }
 
@@ -45,7 +48,10 @@ double Response::FromLinear(double v) const {
       const double t = (v - table[i]) / (table[i + 1] - table[i]);
       return (static_cast<double>(i) + t) / static_cast<double>(table.size() - 1);
     }
+    case Kind::kUnknown:
+      break;
   }
+  IBRDF_CHECK(false) << "an unknown response encoded";
   return v;
 }
 
@@ -59,6 +65,8 @@ std::string Response::Describe() const {
       return "gamma " + std::to_string(gamma);
     case Kind::kTable:
       return "table (" + std::to_string(table.size()) + " entries)";
+    case Kind::kUnknown:
+      return "unknown";
   }
   UnhandledKind("Response::Kind", static_cast<int>(kind));
 }
@@ -76,6 +84,17 @@ bool Response::Check(std::string* why) const {
         message << "table must be strictly increasing: table[" << i << "] = " << table[i] << " after table[" << i - 1
                 << "] = " << table[i - 1];
         *why = message.str();
+        return false;
+      }
+    }
+    if (!uncertainty.empty() && uncertainty.size() != table.size()) {
+      *why = "uncertainty must have one entry per table entry (" + std::to_string(table.size()) + "), got " +
+             std::to_string(uncertainty.size());
+      return false;
+    }
+    for (double u : uncertainty) {
+      if (!(u >= 0.0) || !std::isfinite(u)) {
+        *why = "uncertainty entries must be finite and non-negative";
         return false;
       }
     }

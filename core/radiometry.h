@@ -19,16 +19,20 @@ struct Response {
     kSrgb,    // IEC 61966-2-1 sRGB transfer curve
     kGamma,   // file value = linear^(1/gamma)
     kTable,   // measured: linear value at N file values evenly spaced over [0, 1]
+    kUnknown,  // not known: nothing may read the photos linearly until it is measured (`ibrdf response`)
     IBRDF_DUMMY_KIND
   };
   Kind kind = Kind::kLinear;
   double gamma = 2.2;         // kGamma only
   std::vector<double> table;  // kTable only: strictly increasing, table.front() at 0, table.back() at 1
+  // kTable only, optional: each entry's relative standard error (as measured by `ibrdf response`).
+  std::vector<double> uncertainty;
 
   // Encoded (file) value to linear, and back. Both are monotonic; table lookups interpolate linearly.
+  // An unknown response has neither (a programming error: the radiometric chain refuses it first).
   double ToLinear(double encoded) const;
   double FromLinear(double linear) const;
-  // "linear", "srgb", "gamma 2.2", "table (256 entries)".
+  // "linear", "srgb", "gamma 2.2", "table (256 entries)", "unknown".
   std::string Describe() const;
   // Checks the parameters; false with a reason when they cannot describe a response.
   bool Check(std::string* why) const;

@@ -225,10 +225,12 @@ Response ParseResponse(JsonObject& parent) {
       response.kind = Response::Kind::kLinear;
     } else if (name == "srgb") {
       response.kind = Response::Kind::kSrgb;
+    } else if (name == "unknown") {
+      response.kind = Response::Kind::kUnknown;
     } else {
       ThrowError(parent.Where("response"), "unknown response \"" + name +
-                                               "\" (expected \"linear\", \"srgb\", {\"gamma\": g} or "
-                                               "{\"table\": [...]})");
+                                               "\" (expected \"linear\", \"srgb\", \"unknown\", {\"gamma\": g} "
+                                               "or {\"table\": [...]})");
     }
   } else if (value.is_object()) {
     JsonObject object = parent.Object("response");
@@ -238,6 +240,7 @@ Response ParseResponse(JsonObject& parent) {
     } else if (object.Has("table")) {
       response.kind = Response::Kind::kTable;
       response.table = object.Numbers("table");
+      if (object.Has("uncertainty")) response.uncertainty = object.Numbers("uncertainty");
     } else {
       ThrowError(parent.Where("response"), "expected {\"gamma\": g} or {\"table\": [...]}");
     }
@@ -649,6 +652,10 @@ nlohmann::json RadiometryToJson(const RadiometrySpec& radiometry) {
       break;
     case Response::Kind::kTable:
       r["response"] = {{"table", radiometry.response.table}};
+      if (!radiometry.response.uncertainty.empty()) r["response"]["uncertainty"] = radiometry.response.uncertainty;
+      break;
+    case Response::Kind::kUnknown:
+      r["response"] = "unknown";
       break;
   }
   r["black_level"] = radiometry.black_level;
@@ -784,12 +791,15 @@ const char* SessionStageName(SessionStage stage) {
       return "lights";
     case SessionStage::kColour:
       return "colour";
+    case SessionStage::kResponse:
+      return "response";
   }
   UnhandledKind("SessionStage", static_cast<int>(stage));
 }
 
 bool SessionStageFromName(const std::string& name, SessionStage* stage) {
-  for (SessionStage candidate : {SessionStage::kScan, SessionStage::kAlign, SessionStage::kLights, SessionStage::kColour}) {
+  for (SessionStage candidate : {SessionStage::kScan, SessionStage::kAlign, SessionStage::kLights, SessionStage::kColour,
+                                 SessionStage::kResponse}) {
     if (name == SessionStageName(candidate)) {
       *stage = candidate;
       return true;
@@ -867,7 +877,7 @@ Session Session::Load(const std::string& path) {
       const std::string where = root.Where("stages_applied") + "/" + std::to_string(i);
       SessionStage stage;
       if (!stages[i].is_string() || !SessionStageFromName(stages[i].get<std::string>(), &stage)) {
-        ThrowError(where, "expected \"scan\", \"align\", \"lights\" or \"colour\", got " + stages[i].dump());
+        ThrowError(where, "expected \"scan\", \"align\", \"lights\", \"colour\" or \"response\", got " + stages[i].dump());
       }
       if (session.Applied(stage)) ThrowError(where, "\"" + std::string(SessionStageName(stage)) + "\" is listed twice");
       session.stages_applied.push_back(stage);

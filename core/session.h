@@ -219,9 +219,10 @@ enum class SessionStage {
   kAlign,   // `ibrdf align`: poses from the targets (and the light, the sample, the mesh registration)
   kLights,  // `ibrdf lights white` / `ibrdf lights calibrate`: the lights measured
   kColour,  // `ibrdf colour`: the colour chart's matrix fitted
+  kResponse,  // `ibrdf response`: the camera's response curve measured from exposure brackets
   IBRDF_DUMMY_KIND
 };
-// "scan", "align", "lights", "colour"; and back (false for any other name).
+// "scan", "align", "lights", "colour", "response"; and back (false for any other name).
 const char* SessionStageName(SessionStage stage);
 bool SessionStageFromName(const std::string& name, SessionStage* stage);
 

@@ -159,6 +159,11 @@ RadianceReader::RadianceReader(const Session& session) : impl_(std::make_unique<
   impl.directory = session.directory;
   impl.width = session.camera.width;
   impl.height = session.camera.height;
+  if (session.radiometry.response.kind == Response::Kind::kUnknown) {
+    ThrowError(session.manifest_path + ": /radiometry/response",
+               "is \"unknown\": the photos cannot be read linearly until the camera's response is measured "
+               "(`ibrdf response SESSION --out DIR`, from exposure brackets) or stated");
+  }
   impl.linear = session.radiometry.response.kind == Response::Kind::kLinear;
   impl.table = !impl.linear;
   if (session.radiometry.noise && session.radiometry.noise->bits > 0) {

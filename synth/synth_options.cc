@@ -132,12 +132,34 @@ bool SynthRigOptions::Check(std::string* why) const {
   return true;
 }
 
+const char* SensorCurveName(SensorCurve curve) {
+  switch (curve) {
+    case SensorCurve::kLinear:
+      return "linear";
+    case SensorCurve::kSrgb:
+      return "srgb";
+    case SensorCurve::kToeShoulder:
+      return "toe-shoulder";
+  }
+  UnhandledKind("SensorCurve", static_cast<int>(curve));
+}
+
+bool SensorCurveFromName(const std::string& name, SensorCurve* curve) {
+  for (SensorCurve candidate : {SensorCurve::kLinear, SensorCurve::kSrgb, SensorCurve::kToeShoulder}) {
+    if (name == SensorCurveName(candidate)) {
+      *curve = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
 CameraEffects CameraEffects::None() {
   CameraEffects effects;
   effects.shot_noise = false;
   effects.read_noise = false;
   effects.bits = 0;
-  effects.srgb = false;
+  effects.curve = SensorCurve::kLinear;
   effects.black_level = 0.0;
   effects.supersample = 1;
   return effects;

@@ -96,6 +96,17 @@ struct SynthRigOptions {
   bool Check(std::string* why) const;
 };
 
+// The camera's curve from linear signal to file value.
+enum class SensorCurve {
+  kLinear,       // file value = signal
+  kSrgb,         // the IEC 61966-2-1 sRGB curve
+  kToeShoulder,  // a film-like S-curve with a toe and a shoulder (ToeShoulderEncode, synthetic_radiometry.h)
+  IBRDF_DUMMY_KIND
+};
+// "linear", "srgb", "toe-shoulder"; and back (false for any other name).
+const char* SensorCurveName(SensorCurve curve);
+bool SensorCurveFromName(const std::string& name, SensorCurve* curve);
+
 // What the sensor does to the ideal image. Defaults model a 12-bit camera with shot and read noise.
 struct CameraEffects {
   bool shot_noise = true;        // Poisson photon noise on full_well_e electrons at saturation
@@ -103,7 +114,7 @@ struct CameraEffects {
   double full_well_e = 20000.0;  // electrons at the saturation level
   double read_noise_e = 4.0;     // electrons, one sigma
   int bits = 12;                 // quantization: 8 to 16 (stored as 8- or 16-bit PNG); 0 = float EXR
-  bool srgb = false;             // encode with the sRGB curve before quantization
+  SensorCurve curve = SensorCurve::kLinear;  // applied after clipping, before quantization
   bool clip = true;              // clip at the saturation level (1.0)
   double black_level = 0.0;      // offset added to the linear signal (normalized units)
   int supersample = 1;           // n x n rays per pixel, averaged (1 = the pixel centre only)
@@ -124,6 +135,9 @@ struct SynthRadiometryOptions {
   // `bracket` id. 1: no brackets.
   int brackets = 1;
   double bracket_step_ev = 2.0;
+  // The session states its response as "unknown" (as a camera's JPEGs leave it) instead of the curve
+  // the photos were written with; truth.json keeps the curve. `ibrdf response` measures it from brackets.
+  bool response_unknown = false;
   // The session states a unit light intensity (1, 1, 1) instead of the true one and carries a white
   // reference (calibration.white_reference) that recovers it: one photo of a flat target of albedo
   // white_reflectance and side white_size at the sample's centre (the sample taken away), facing

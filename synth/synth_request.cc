@@ -27,7 +27,13 @@ SynthOptions SynthOptionsFromRequest(const SynthRequest& request) {
   if (request.full_well_e >= 0) e.full_well_e = request.full_well_e;
   if (request.read_noise_e >= 0) e.read_noise_e = request.read_noise_e;
   if (request.vignetting >= 0) e.vignetting = request.vignetting;
-  if (request.srgb) e.srgb = true;
+  if (request.srgb) e.curve = SensorCurve::kSrgb;
+  if (!request.response.empty()) {
+    if (!SensorCurveFromName(request.response, &e.curve)) {
+      ThrowError("--response", "unknown curve \"" + request.response + "\" (expected linear, srgb or toe-shoulder)");
+    }
+    if (request.srgb && e.curve != SensorCurve::kSrgb) ThrowError("--response", "contradicts --srgb");
+  }
   if (request.no_shot_noise) e.shot_noise = false;
   if (request.no_read_noise) e.read_noise = false;
   if (request.no_clip) {

@@ -25,6 +25,7 @@ struct SynthRequest {
   int bits = -1, supersample = -1;
   double black_level = -1, full_well_e = -1, read_noise_e = -1, vignetting = -1;
   bool srgb = false, no_shot_noise = false, no_read_noise = false;
+  std::string response;  // the sensor's curve by name (SensorCurveFromName); "" = the preset's (srgb with --srgb)
   bool no_clip = false;  // needs float output (bits 0)
   // The marker platform; with it, cameras look down from 45 degrees and 3 light-target photos are
   // taken unless camera_elevation_given or light_photos_given.

@@ -37,6 +37,31 @@ namespace fs = std::filesystem;
 namespace ibrdf {
 namespace {
 
+// The response a session states for photos written through `curve`: the curve itself (a 4097-entry
+// table for the toe-and-shoulder curve, exact to 1e-6 relative by linear interpolation), or "unknown".
+Response SessionResponse(SensorCurve curve, bool unknown) {
+  Response response;
+  if (unknown) {
+    response.kind = Response::Kind::kUnknown;
+    return response;
+  }
+  switch (curve) {
+    case SensorCurve::kLinear:
+      response.kind = Response::Kind::kLinear;
+      break;
+    case SensorCurve::kSrgb:
+      response.kind = Response::Kind::kSrgb;
+      break;
+    case SensorCurve::kToeShoulder: {
+      response.kind = Response::Kind::kTable;
+      constexpr int kEntries = 4097;
+      for (int i = 0; i < kEntries; ++i) response.table.push_back(ToeShoulderDecode(double(i) / (kEntries - 1)));
+      break;
+    }
+  }
+  return response;
+}
+
 // Where an irregular-shape session keeps its scan (relative to the session folder).
 constexpr char kScanMesh[] = "scan/mesh.ply";
 constexpr char kTruthMesh[] = "truth-mesh.ply";
@@ -249,7 +274,7 @@ Session BuildSession(const SynthOptions& options) {
                                   "synth camera");
 
   const CameraEffects& effects = options.effects;
-  session.radiometry.response.kind = effects.srgb ? Response::Kind::kSrgb : Response::Kind::kLinear;
+  session.radiometry.response = SessionResponse(effects.curve, options.radiometry.response_unknown);
   session.radiometry.black_level = effects.black_level;
   // Unclipped files state no saturation level (float files then have none; radiometry/linear_image.h).
   session.radiometry.saturation_stated = effects.clip;
@@ -698,7 +723,7 @@ nlohmann::json GeneratorJson(const SynthOptions& options) {
             {"full_well_e", effects.full_well_e},
             {"read_noise_e", effects.read_noise_e},
             {"bits", effects.bits},
-            {"srgb", effects.srgb},
+            {"curve", SensorCurveName(effects.curve)},
             {"clip", effects.clip},
             {"black_level", effects.black_level},
             {"supersample", effects.supersample},
@@ -707,6 +732,7 @@ nlohmann::json GeneratorJson(const SynthOptions& options) {
            {{"brackets", options.radiometry.brackets},
             {"bracket_step_ev", options.radiometry.bracket_step_ev},
             {"light_unknown", options.radiometry.light_unknown},
+            {"response_unknown", options.radiometry.response_unknown},
             {"light_intensity", ToJson(options.scene.light_intensity)}}}};
 }
 

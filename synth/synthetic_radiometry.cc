@@ -25,6 +25,34 @@ namespace fs = std::filesystem;
 
 namespace ibrdf {
 
+namespace {
+constexpr double kToeShoulderPower = 1.6, kToeShoulderKnee = 0.25;
+}  // namespace
+
+double ToeShoulderEncode(double x) {
+  if (x <= 0.0) return 0.0;
+  const double p = std::pow(x, kToeShoulderPower);
+  return (1.0 + kToeShoulderKnee) * p / (p + kToeShoulderKnee);
+}
+
+double ToeShoulderDecode(double v) {
+  if (v <= 0.0) return 0.0;
+  // v (x^a + k) = (1 + k) x^a  =>  x^a = v k / (1 + k - v).
+  return std::pow(v * kToeShoulderKnee / (1.0 + kToeShoulderKnee - v), 1.0 / kToeShoulderPower);
+}
+
+double EncodeSensorCurve(SensorCurve curve, double linear) {
+  switch (curve) {
+    case SensorCurve::kLinear:
+      return linear;
+    case SensorCurve::kSrgb:
+      return LinearToSrgb(linear);
+    case SensorCurve::kToeShoulder:
+      return ToeShoulderEncode(linear);
+  }
+  UnhandledKind("SensorCurve", static_cast<int>(curve));
+}
+
 double VignettingAt(const Camera& camera, double strength, double x, double y) {
   if (strength <= 0.0) return 1.0;
   const double cx = camera.PrincipalX(), cy = camera.PrincipalY();
@@ -70,7 +98,7 @@ uint64_t SimulateSensor(const CameraEffects& effects, uint64_t seed, uint64_t st
           v = 1.0;
           pixel_clipped = true;
         }
-        if (effects.srgb) v = LinearToSrgb(v);
+        v = EncodeSensorCurve(effects.curve, v);
         // Round half up (v >= 0): the truncating conversion is inline where std::round is a libm call.
         if (effects.bits > 0) v = double(int64_t(std::min(v, 1.0) * levels_max + 0.5)) / levels_max;
         image.at(x, y, c) = static_cast<float>(v);

@@ -25,6 +25,16 @@ namespace ibrdf {
 // that the corner keeps 1 - strength. Strength 0: 1 everywhere.
 double VignettingAt(const Camera& camera, double strength, double x, double y);
 
+// The toe-and-shoulder curve (SensorCurve::kToeShoulder): file = (1 + k) x^a / (x^a + k) with a = 1.6,
+// k = 0.25 (a Naka-Rushton curve, the shape of film's and of a JPEG camera's tone curve in log
+// exposure): 0 at 0 and 1 at 1, a toe (slope 0 at black) and a shoulder (slope 0.32 at full scale).
+// Decode is its exact inverse.
+double ToeShoulderEncode(double linear);
+double ToeShoulderDecode(double encoded);
+
+// A signal in [0, 1] through the sensor's curve.
+double EncodeSensorCurve(SensorCurve curve, double linear);
+
 // Multiplies a linear signal image by the vignetting of the given strength (nothing for 0).
 void ApplyVignetting(const Camera& camera, double strength, Image* signal);
 

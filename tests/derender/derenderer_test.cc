@@ -155,7 +155,7 @@ TEST(Derender, SrgbEightBitWithBlackLevelIsLinearized) {
   const LambertianBrdf material(Eigen::Vector3d::Constant(0.5));
   SynthOptions options = NoiseFree();
   options.rig.num_photos = 4;
-  options.effects.srgb = true;
+  options.effects.curve = SensorCurve::kSrgb;
   options.effects.bits = 8;
   options.effects.black_level = 0.02;
   const Session session = Session::Load(MakeSession(dir / "s", options, material));

@@ -57,7 +57,7 @@ TEST(Radiometry, CalibratedSrgbSessionMatchesLinearSession) {
   const auto material = LoadMaterial(MaterialPath("bluepaint"));
   const Session linear = Session::Load(MakeSession(dir / "linear", Small(), *material));
   SynthOptions options = Small();
-  options.effects.srgb = true;
+  options.effects.curve = SensorCurve::kSrgb;
   options.effects.black_level = 0.03;
   options.effects.vignetting = 0.4;
   options.radiometry.light_unknown = true;
@@ -258,7 +258,7 @@ TEST(Radiometry, LightStageCalibratesAndRefusesSaturatedReference) {
   options.rig.num_photos = 2;
   options.rig.width = 200;
   options.rig.height = 150;
-  options.effects.srgb = true;
+  options.effects.curve = SensorCurve::kSrgb;
   options.effects.black_level = 0.03;
   options.effects.vignetting = 0.4;
   options.radiometry.light_unknown = true;

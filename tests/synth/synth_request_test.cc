@@ -68,7 +68,7 @@ TEST(SynthRequest, EffectsPresetAndOverrides) {
   request.light_intensity = {2.0, 2.0, 1.0};
   options = SynthOptionsFromRequest(request);
   EXPECT_EQ(options.scene.sample, SampleSpec::Kind::kCylinder);
-  EXPECT_TRUE(options.effects.srgb);
+  EXPECT_EQ(options.effects.curve, SensorCurve::kSrgb);
   EXPECT_FALSE(options.effects.read_noise);
   EXPECT_EQ(options.scene.origin, Eigen::Vector3d(1.0, 2.0, 3.0));
   EXPECT_EQ(options.scene.light_intensity, Eigen::Vector3d(2.0, 2.0, 1.0));
