@@ -11,8 +11,10 @@
 #include "core/brdf_coords.h"
 #include "core/brdf_model.h"
 #include "core/rgl_bsdf.h"
+#include "core/statistics.h"
 #include "core/tensor_file.h"
 #include "tests/error_of.h"
+#include "tests/reconstruct/mitsuba_measured.h"
 #include "tests/scratch_dir.h"
 #include "tests/test_util.h"
 
@@ -101,6 +103,52 @@ TEST(BsdfExport, FileHasTheFieldsTheReadersRequire) {
   EXPECT_EQ(file.at("vndf").Describe(), "float32 [1, 23, 64, 64]");
   EXPECT_EQ(file.at("ndf").Describe(), "float32 [2, 128]");
   EXPECT_EQ(file.at("jacobian").Describe(), "uint8 [1]");
+}
+
+// The `jacobian` byte says whether a reader multiplies the table by ndf / (4 sigma); the tables are
+// written for that product, so the byte must be 1. brdf-loader, pbrt-v4 and core/rgl_bsdf.h multiply
+// whatever the byte says, Mitsuba 3 only when it is set (tests/reconstruct/mitsuba_measured.h follows
+// its measured.cpp): read Mitsuba's way the file gives what the others read (at the box spectrum's
+// plateaus 700, 530 and 420 nm in a spectral variant, the rgb channels in an RGB one), and the same
+// file with the byte 0 does not, while the others cannot tell the two apart.
+TEST(BsdfExport, JacobianIsSetAndMitsubaReadsWhatTheOthersRead) {
+  ScratchDir dir;
+  const GgxBrdf ggx(Eigen::Vector3d(0.3, 0.2, 0.1), Eigen::Vector3d(0.04, 0.04, 0.04), 0.3);
+  WriteTensorFile(dir / "set.bsdf", BuildRglBsdf(BatchOf(ggx), "ggx", BsdfExportOptions{}));
+  TensorFile file = ReadTensorFile(dir / "set.bsdf");
+  ASSERT_EQ(file.at("jacobian").data, std::vector<uint8_t>{1});
+  file["jacobian"] = BytesField({0});
+  WriteTensorFile(dir / "unset.bsdf", file);
+  const bool spectral = file.count("wavelengths") > 0;
+  const std::vector<float> lambdas = spectral ? std::vector<float>{700.0f, 530.0f, 420.0f}
+                                              : std::vector<float>{0.0f, 1.0f, 2.0f};
+  const testing::MitsubaMeasured mitsuba(dir / "set.bsdf", spectral), mitsuba_unset(dir / "unset.bsdf", spectral);
+  EXPECT_TRUE(mitsuba.jacobian());
+  EXPECT_FALSE(mitsuba_unset.jacobian());
+  const RglBsdf others(dir / "set.bsdf"), others_unset(dir / "unset.bsdf");
+  std::vector<double> set_error, unset_error;
+  for (int ti = 5; ti <= 75; ti += 10) {
+    for (int to = 5; to <= 75; to += 10) {
+      for (int dp = 0; dp <= 180; dp += 30) {
+        const Eigen::Vector3d light = FromSpherical(ti * M_PI / 180, 0.0);
+        const Eigen::Vector3d camera = FromSpherical(to * M_PI / 180, dp * M_PI / 180);
+        const Eigen::Vector3d g = others.EvalCosine(camera, light);
+        EXPECT_EQ(others_unset.EvalCosine(camera, light), g);
+        const std::vector<double> m = mitsuba.Eval(camera, light, lambdas),
+                                  u = mitsuba_unset.Eval(camera, light, lambdas);
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_GT(g[c], 0.0);
+          set_error.push_back(std::abs(m[c] - g[c]) / g[c]);
+          unset_error.push_back(std::abs(u[c] - g[c]) / g[c]);
+        }
+      }
+    }
+  }
+  const double set_max = *std::max_element(set_error.begin(), set_error.end());
+  std::printf("Mitsuba 3's reading against brdf-loader's: max %.2g with the byte set; median %.1f %% with it 0\n",
+              set_max, 100 * Median(unset_error));
+  EXPECT_LT(set_max, 1e-4);
+  EXPECT_GT(Median(unset_error), 0.1);
 }
 
 // Glossy materials: the file against the model it was written from, theta <= 80 degrees.
