@@ -4,6 +4,9 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
 
 #include <ceres/sized_cost_function.h>
 #include <Eigen/Core>
@@ -80,6 +83,94 @@ class LafortuneAnalyticResidual : public ceres::SizedCostFunction<1, 1 + 3 * kLo
   double xy_, z_, value_, inv_sigma_;
 };
 
+// Plausibility penalties (ModelFitOptions, "Plausible where no camera looked" in docs/reconstruct.md):
+// hinge residuals, zero while the bound holds, weighted heavily against the data residuals (which are in
+// sigmas), so Ceres keeps the fit inside the bound wherever the samples allow it.
+constexpr double kPlausibilityPenaltyWeight = 1e3;
+
+// One channel of a Lafortune model's directional albedo for one incidence direction, on a fixed exitant
+// quadrature (points' xy = wi.x wo.x + wi.y wo.y and z = wi.z wo.z, weights cos theta_o d omega summing
+// to pi): r = weight * max(0, A / bound - 1). Analytic derivatives, as LafortuneAnalyticResidual.
+template <int kLobes>
+class LafortuneAlbedoPenalty : public ceres::SizedCostFunction<1, 1 + 3 * kLobes> {
+ public:
+  LafortuneAlbedoPenalty(std::vector<std::pair<double, double>> xy_z, std::vector<double> weights, double bound)
+      : xy_z_(std::move(xy_z)), weights_(std::move(weights)), inv_bound_(1.0 / bound) {
+    for (double w : weights_) weight_sum_ += w;
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double* p = parameters[0];
+    double albedo = p[0] / M_PI * weight_sum_;
+    double gradient[1 + 3 * kLobes] = {weight_sum_ / M_PI};
+    for (size_t q = 0; q < xy_z_.size(); ++q) {
+      for (int k = 0; k < kLobes; ++k) {
+        const double base = p[1 + 3 * k] * xy_z_[q].first + p[2 + 3 * k] * xy_z_[q].second;
+        if (!(base > 0.0)) continue;
+        const double n = p[3 + 3 * k], log_base = std::log(base);
+        if (n * log_base > 100.0) return false;  // overflow on a trial step: Ceres shrinks the step
+        const double lobe = weights_[q] * std::exp(n * log_base);
+        albedo += lobe;
+        const double d_base = n * lobe / base;
+        gradient[1 + 3 * k] += d_base * xy_z_[q].first;
+        gradient[2 + 3 * k] += d_base * xy_z_[q].second;
+        gradient[3 + 3 * k] += lobe * log_base;
+      }
+    }
+    const double excess = albedo * inv_bound_ - 1.0;
+    residuals[0] = excess > 0.0 ? kPlausibilityPenaltyWeight * excess : 0.0;
+    if (jacobians && jacobians[0]) {
+      for (int j = 0; j < 1 + 3 * kLobes; ++j) {
+        jacobians[0][j] = excess > 0.0 ? kPlausibilityPenaltyWeight * inv_bound_ * gradient[j] : 0.0;
+      }
+    }
+    return std::isfinite(residuals[0]);
+  }
+
+ private:
+  std::vector<std::pair<double, double>> xy_z_;
+  std::vector<double> weights_;
+  double weight_sum_ = 0.0;
+  double inv_bound_;
+};
+
+// One channel of a Lafortune model at one direction pair no sample constrains, held below a ceiling:
+// r = weight * max(0, log f - log ceiling).
+template <int kLobes>
+class LafortuneCeilingPenalty : public ceres::SizedCostFunction<1, 1 + 3 * kLobes> {
+ public:
+  LafortuneCeilingPenalty(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo, double ceiling)
+      : xy_(wi.x() * wo.x() + wi.y() * wo.y()), z_(wi.z() * wo.z()), log_ceiling_(std::log(ceiling)) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double* p = parameters[0];
+    double f = p[0] / M_PI;
+    double gradient[1 + 3 * kLobes] = {1.0 / M_PI};
+    for (int k = 0; k < kLobes; ++k) {
+      const double base = p[1 + 3 * k] * xy_ + p[2 + 3 * k] * z_;
+      if (!(base > 0.0)) continue;
+      const double n = p[3 + 3 * k], log_base = std::log(base);
+      if (n * log_base > 100.0) return false;
+      const double lobe = std::exp(n * log_base);
+      f += lobe;
+      gradient[1 + 3 * k] = n * lobe / base * xy_;
+      gradient[2 + 3 * k] = n * lobe / base * z_;
+      gradient[3 + 3 * k] = lobe * log_base;
+    }
+    const double excess = std::log(std::max(f, 1e-300)) - log_ceiling_;
+    residuals[0] = excess > 0.0 ? kPlausibilityPenaltyWeight * excess : 0.0;
+    if (jacobians && jacobians[0]) {
+      for (int j = 0; j < 1 + 3 * kLobes; ++j) {
+        jacobians[0][j] = excess > 0.0 ? kPlausibilityPenaltyWeight * gradient[j] / f : 0.0;
+      }
+    }
+    return std::isfinite(residuals[0]);
+  }
+
+ private:
+  double xy_, z_, log_ceiling_;
+};
+
 // GGX microfacet model as GgxBrdf evaluates it, all three channels: parameters [diffuse_albedo r g b],
 // [specular_f0 r g b], [alpha].
 struct GgxResidual {
@@ -129,6 +220,59 @@ struct GgxResidual {
 
   Eigen::Vector3d wi, wo, value, inv_sigma;
   bool dielectric = false;
+};
+
+// The GGX model's directional albedo per channel for one incidence direction on a fixed exitant
+// quadrature (the points' GgxResidual against 0 with sigma 1 is f itself; `weights` cos theta_o d omega):
+// r_c = weight * max(0, A_c / bound_c - 1); an infinite bound is no bound.
+struct GgxAlbedoPenalty {
+  GgxAlbedoPenalty(std::vector<GgxResidual> points_in, std::vector<double> weights_in, const Eigen::Vector3d& bound)
+      : points(std::move(points_in)), weights(std::move(weights_in)), inv_bound(bound.cwiseInverse()) {}
+
+  template <class T>
+  bool operator()(const T* diffuse, const T* f0, const T* alpha, T* residual) const {
+    T albedo[3] = {T(0.0), T(0.0), T(0.0)};
+    for (size_t q = 0; q < points.size(); ++q) {
+      T f[3];
+      if (!points[q](diffuse, f0, alpha, f)) return false;
+      for (int c = 0; c < 3; ++c) albedo[c] += T(weights[q]) * f[c];
+    }
+    for (int c = 0; c < 3; ++c) {
+      const T excess = albedo[c] * T(inv_bound[c]) - T(1.0);
+      residual[c] = excess > T(0.0) ? T(kPlausibilityPenaltyWeight) * excess : T(0.0);
+    }
+    return true;
+  }
+
+  std::vector<GgxResidual> points;
+  std::vector<double> weights;
+  Eigen::Vector3d inv_bound;
+};
+
+// The GGX model at one direction pair no sample constrains, held below a ceiling per channel:
+// r_c = weight * max(0, log f_c - log ceiling_c); an infinite ceiling is none.
+struct GgxCeilingPenalty {
+  GgxCeilingPenalty(const GgxResidual& point_in, const Eigen::Vector3d& ceiling) : point(point_in) {
+    for (int c = 0; c < 3; ++c) log_ceiling[c] = std::log(ceiling[c]);
+  }
+
+  template <class T>
+  bool operator()(const T* diffuse, const T* f0, const T* alpha, T* residual) const {
+    T f[3];
+    if (!point(diffuse, f0, alpha, f)) return false;
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(log_ceiling[c]) || !(f[c] > T(0.0))) {
+        residual[c] = T(0.0);
+        continue;
+      }
+      const T excess = log(f[c]) - T(log_ceiling[c]);
+      residual[c] = excess > T(0.0) ? T(kPlausibilityPenaltyWeight) * excess : T(0.0);
+    }
+    return true;
+  }
+
+  GgxResidual point;
+  Eigen::Vector3d log_ceiling;
 };
 
 }  // namespace ibrdf

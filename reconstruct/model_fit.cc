@@ -14,6 +14,7 @@
 #include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
 
+#include "core/brdf_coords.h"
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
@@ -107,7 +108,8 @@ double RelativeRms(const BrdfModel& model, const std::vector<FitSample>& samples
 }
 
 // The relative RMS by band of the larger of theta_i, theta_o: 0-25, 25-50, 50-80 degrees (and beyond,
-// up to the fit's theta limit, in the last band).
+// up to the fit's theta limit, in the last band), over the channels each sample measured (an unmeasured
+// channel's value is no datum).
 std::vector<double> BandRelativeRms(const BrdfModel& model, const std::vector<FitSample>& samples) {
   std::vector<double> sum(3, 0.0);
   std::vector<size_t> count(3, 0);
@@ -116,6 +118,7 @@ std::vector<double> BandRelativeRms(const BrdfModel& model, const std::vector<Fi
     const size_t band = theta < 25.0 ? 0 : theta < 50.0 ? 1 : 2;
     const Eigen::Vector3d f = model.Eval(s.wi, s.wo);
     for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(s.sigma[c])) continue;  // not measured
       const double rel = (f[c] - s.value[c]) / std::max(std::abs(s.value[c]), 1e-6);
       sum[band] += rel * rel;
       ++count[band];
@@ -124,6 +127,188 @@ std::vector<double> BandRelativeRms(const BrdfModel& model, const std::vector<Fi
   std::vector<double> rms(3, 0.0);
   for (size_t b = 0; b < 3; ++b) rms[b] = count[b] ? std::sqrt(sum[b] / double(count[b])) : 0.0;
   return rms;
+}
+
+// The albedo penalty's fixed quadrature: incidence directions (in the x-z plane: the models are
+// isotropic) and exitant points, midpoints of 16 x 32 cells in (cos^2 theta_o, phi_o) as
+// DirectionalAlbedo's, with weights cos theta_o d omega summing to pi.
+struct AlbedoQuadrature {
+  std::vector<Eigen::Vector3d> wi, wo;
+  std::vector<double> weights;
+};
+
+AlbedoQuadrature MakeAlbedoQuadrature() {
+  constexpr int kRings = 16, kSectors = 32;
+  AlbedoQuadrature q;
+  for (double theta_deg : {0.0, 25.0, 45.0, 60.0, 70.0, 78.0, 84.0, 89.0}) {
+    const double theta = theta_deg * M_PI / 180.0;
+    q.wi.emplace_back(std::sin(theta), 0.0, std::cos(theta));
+  }
+  for (int r = 0; r < kRings; ++r) {
+    const double u = (r + 0.5) / kRings;
+    const double cos_o = std::sqrt(u), sin_o = std::sqrt(1.0 - u);
+    for (int k = 0; k < kSectors; ++k) {
+      const double phi = 2.0 * M_PI * (k + 0.5) / kSectors;
+      q.wo.emplace_back(sin_o * std::cos(phi), sin_o * std::sin(phi), cos_o);
+      q.weights.push_back(0.5 * (1.0 / kRings) * (2.0 * M_PI / kSectors));
+    }
+  }
+  return q;
+}
+
+// A direction pair near retro-reflection that no sample constrains, its ceiling per channel
+// (ModelFitOptions::max_unmeasured_ratio times `beside`, the largest sample beside it; infinite where
+// none is) and its theta_h.
+struct Probe {
+  Eigen::Vector3d wi, wo, ceiling, beside;
+  double theta_h_deg = 0.0;
+};
+
+// What a plausible fit to the samples keeps to: each channel's albedo bound and the retro-reflection
+// probes.
+struct PlausibilityBounds {
+  Eigen::Vector3d albedo = Eigen::Vector3d::Ones();
+  std::vector<Probe> probes;
+  double theta_d_min = 0.0;  // the samples' smallest theta_d, radians
+};
+
+PlausibilityBounds MakePlausibilityBounds(const std::vector<FitSample>& samples, const ModelFitOptions& options) {
+  PlausibilityBounds bounds;
+  Eigen::Vector3d largest = Eigen::Vector3d::Zero();
+  double theta_d_min = M_PI;
+  std::vector<HalfDiffAngles> angles(samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    ToHalfDiff(samples[i].wi, samples[i].wo, &angles[i]);
+    theta_d_min = std::min(theta_d_min, angles[i].theta_d);
+    for (int c = 0; c < 3; ++c) {
+      if (std::isfinite(samples[i].sigma[c])) largest[c] = std::max(largest[c], samples[i].value[c]);
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    bounds.albedo[c] = options.relative_scale ? M_PI * largest[c] : 1.0;
+    if (!(bounds.albedo[c] > 0.0)) bounds.albedo[c] = std::numeric_limits<double>::infinity();
+  }
+  bounds.theta_d_min = theta_d_min;
+  // Retro-reflection is sampled (a camera beside the light): nothing there to bound.
+  const double degree = M_PI / 180.0;
+  if (theta_d_min < 1.0 * degree) return bounds;
+  // The largest sample per channel in each half-degree bin of theta_h, whatever its theta_d: at the
+  // same theta_h the samples of smallest theta_d alone miss a sharp lobe's peak at theta_h 0, where
+  // few samples lie.
+  constexpr int kBins = 180;
+  std::vector<Eigen::Vector3d> beside(kBins, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3i> counted(kBins, Eigen::Vector3i::Zero());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const int bin = std::clamp(int(angles[i].theta_h / degree * 2.0), 0, kBins - 1);
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(samples[i].sigma[c])) continue;
+      beside[bin][c] = std::max(beside[bin][c], samples[i].value[c]);
+      ++counted[bin][c];
+    }
+  }
+  const double cos_max = std::cos(options.max_theta_deg * degree);
+  for (double theta_h_deg = 0.0; theta_h_deg <= options.max_theta_deg; theta_h_deg += 2.0) {
+    Eigen::Vector3d largest_beside = Eigen::Vector3d::Zero();
+    Eigen::Vector3i count = Eigen::Vector3i::Zero();
+    const int centre = int(theta_h_deg * 2.0);
+    for (int bin = std::max(0, centre - 5); bin <= std::min(kBins - 1, centre + 4); ++bin) {
+      largest_beside = largest_beside.cwiseMax(beside[bin]);
+      count += counted[bin];
+    }
+    Probe probe;
+    probe.theta_h_deg = theta_h_deg;
+    probe.beside = largest_beside;
+    bool any = false;
+    for (int c = 0; c < 3; ++c) {
+      const bool known = count[c] > 0 && largest_beside[c] > 0.0;
+      probe.ceiling[c] = known ? options.max_unmeasured_ratio * largest_beside[c]
+                               : std::numeric_limits<double>::infinity();
+      any = any || known;
+    }
+    if (!any) continue;
+    // Exact retro-reflection and halfway to the smallest sampled theta_d, in and across the plane.
+    const double theta_d[3] = {0.0, 0.5 * theta_d_min, 0.5 * theta_d_min};
+    const double phi_d[3] = {0.0, 0.0, 0.5 * M_PI};
+    for (int k = 0; k < 3; ++k) {
+      HalfDiffAngles a;
+      a.theta_h = theta_h_deg * degree;
+      a.theta_d = theta_d[k];
+      a.phi_d = phi_d[k];
+      FromHalfDiff(a, &probe.wi, &probe.wo);
+      if (!(probe.wi.z() >= cos_max && probe.wo.z() >= cos_max)) continue;
+      bounds.probes.push_back(probe);
+    }
+  }
+  return bounds;
+}
+
+// The fit's verdict against its bounds (ModelFitResult: max_albedo, albedo_bound, max_retro_ratio,
+// held_by_plausibility, plausible, implausible), on the dense albedo grid and at every probe.
+void JudgePlausibility(const BrdfModel& model, const PlausibilityBounds& bounds, const ModelFitOptions& options,
+                       ModelFitResult* result) {
+  const char* channel_names = "RGB";
+  const Eigen::Vector3d albedo = MaxDirectionalAlbedoPerChannel(model);
+  result->max_albedo = albedo.maxCoeff();
+  result->relative_scale = options.relative_scale;
+  result->albedo_bound = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    if (!std::isfinite(bounds.albedo[c])) continue;
+    result->albedo_bound = std::max(result->albedo_bound, bounds.albedo[c]);
+    char line[160];
+    if (albedo[c] > bounds.albedo[c] * (1.0 + options.plausibility_tolerance)) {
+      std::snprintf(line, sizeof(line), "directional albedo %c %.3f above its bound %.3g", channel_names[c],
+                    albedo[c], bounds.albedo[c]);
+      result->implausible.push_back(line);
+    } else if (albedo[c] >= 0.99 * bounds.albedo[c]) {
+      std::snprintf(line, sizeof(line), "albedo %c at its bound %.3g", channel_names[c], bounds.albedo[c]);
+      result->held_by_plausibility.push_back(line);
+    }
+  }
+  result->max_retro_ratio = 0.0;
+  result->theta_d_min_deg = bounds.theta_d_min * 180.0 / M_PI;
+  result->retro_probes = bounds.probes.size();
+  for (int c = 0; c < 3; ++c) {
+    int held = 0, probed = 0;
+    double worst_ratio = 0.0, worst_theta_h = 0.0;
+    for (const Probe& probe : bounds.probes) {
+      if (!std::isfinite(probe.ceiling[c])) continue;
+      ++probed;
+      const double f = model.Eval(probe.wi, probe.wo)[c];
+      const double ratio = f / probe.beside[c];
+      if (ratio > worst_ratio) worst_ratio = ratio, worst_theta_h = probe.theta_h_deg;
+      if (f >= 0.98 * probe.ceiling[c]) ++held;
+    }
+    result->max_retro_ratio = std::max(result->max_retro_ratio, worst_ratio);
+    // Beyond the samples' theta: compared with the samples beside the last probe of this channel.
+    const Probe* last = nullptr;
+    for (const Probe& probe : bounds.probes) {
+      if (std::isfinite(probe.ceiling[c]) && (!last || probe.theta_h_deg >= last->theta_h_deg)) last = &probe;
+    }
+    for (double theta_deg : {85.0, 89.0}) {
+      if (!last || theta_deg <= last->theta_h_deg) continue;
+      const double theta = theta_deg * M_PI / 180.0;
+      const Eigen::Vector3d w(std::sin(theta), 0.0, std::cos(theta));
+      const double ratio = model.Eval(w, w)[c] / last->beside[c];
+      if (ratio <= options.max_unmeasured_ratio) continue;
+      char beyond[200];
+      std::snprintf(beyond, sizeof(beyond), "retro-reflection %c at %g deg %.3g times the samples at theta_h %g deg",
+                    channel_names[c], theta_deg, ratio, last->theta_h_deg);
+      result->beyond_samples.push_back(beyond);
+      break;
+    }
+    char line[200];
+    if (worst_ratio > options.max_unmeasured_ratio * (1.0 + options.plausibility_tolerance)) {
+      std::snprintf(line, sizeof(line),
+                    "retro-reflection %c %.3g times the samples beside it at theta_h %g deg (ceiling %g times)",
+                    channel_names[c], worst_ratio, worst_theta_h, options.max_unmeasured_ratio);
+      result->implausible.push_back(line);
+    } else if (held > 0) {
+      std::snprintf(line, sizeof(line), "retro-reflection %c at its ceiling at %d of %d probes", channel_names[c],
+                    held, probed);
+      result->held_by_plausibility.push_back(line);
+    }
+  }
+  result->plausible = result->implausible.empty();
 }
 
 // Penalty keeping a lobe's maximum anywhere, max(|Cxy|, |Cz|)^n, below `cap`: the excess of n log(max)
@@ -150,8 +335,9 @@ struct LobeCapPenalty {
 
 template <int kLobes>
 std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& samples, const ModelFitOptions& options,
-                                                 double* cost, int* starts, size_t* ranked_on,
-                                                 std::vector<std::string>* at_bound, std::vector<std::string>* at_cap) {
+                                                 const PlausibilityBounds& bounds, double* cost, int* starts,
+                                                 size_t* ranked_on, std::vector<std::string>* at_bound,
+                                                 std::vector<std::string>* at_cap) {
   // Starting lobes: a forward (specular) lobe, a retro-reflective one and a broad one, in several
   // sharpnesses; every channel keeps the best of its starts. Channels and starts run in parallel.
   const double starts_table[][3][3] = {
@@ -178,6 +364,19 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
     caps[c] = std::max(options.max_lobe_ratio * maximum[c],
                        std::min(options.min_lobe_cap, options.max_lobe_floor_ratio * maximum[c]));
   }
+  // The albedo penalty's quadrature as the residual reads it: per incidence angle, each exitant point's
+  // (wi.x wo.x + wi.y wo.y, wi.z wo.z).
+  const AlbedoQuadrature quadrature = MakeAlbedoQuadrature();
+  std::vector<std::vector<std::pair<double, double>>> xy_z(quadrature.wi.size());
+  for (size_t a = 0; a < quadrature.wi.size(); ++a) {
+    for (const Eigen::Vector3d& wo : quadrature.wo) {
+      const Eigen::Vector3d& wi = quadrature.wi[a];
+      xy_z[a].emplace_back(wi.x() * wo.x() + wi.y() * wo.y(), wi.z() * wo.z());
+    }
+  }
+  // The albedo bound each channel's quadrature is held to: the bound itself, lowered below where the
+  // dense grid finds the fit above it (the quadrature misses part of a narrow lobe).
+  Eigen::Vector3d quadrature_bound = bounds.albedo;
   // One channel's solve from `p` over `fitted` (indices into `samples`); returns the final cost. A
   // `ranking` solve (a start on the subset) stops at options.start_tolerance.
   const auto solve = [&](int c, const std::vector<size_t>& fitted, double* p, bool ranking) {
@@ -193,6 +392,16 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LobeCapPenalty<kLobes>, kLobes, kParameters>(
                                  new LobeCapPenalty<kLobes>(std::log(caps[c]))),
                              nullptr, p);
+    if (options.plausibility_constraints && std::isfinite(quadrature_bound[c])) {
+      for (size_t a = 0; a < quadrature.wi.size(); ++a) {
+        problem.AddResidualBlock(
+            new LafortuneAlbedoPenalty<kLobes>(xy_z[a], quadrature.weights, quadrature_bound[c]), nullptr, p);
+      }
+    }
+    for (const Probe& probe : bounds.probes) {
+      if (!options.plausibility_constraints || !std::isfinite(probe.ceiling[c])) continue;
+      problem.AddResidualBlock(new LafortuneCeilingPenalty<kLobes>(probe.wi, probe.wo, probe.ceiling[c]), nullptr, p);
+    }
     problem.SetParameterLowerBound(p, 0, 0.0);
     for (int k = 0; k < kLobes; ++k) {
       for (int j = 1; j <= 2; ++j) {
@@ -236,6 +445,39 @@ std::unique_ptr<LafortuneBrdf> FitLafortuneLobes(const std::vector<FitSample>& s
   if (two_phase) {
     tbb::parallel_for(0, 3, [&](int c) { costs[winners[c]] = solve(c, all, solutions[winners[c]].data(), false); });
     *ranked_on = subset.size();
+  }
+  // The model of the winners' parameters.
+  const auto model_of = [&](std::vector<LafortuneLobe>* lobes, Eigen::Vector3d* diffuse) {
+    const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+    lobes->assign(kLobes, LafortuneLobe{zero, zero, zero});
+    for (int c = 0; c < 3; ++c) {
+      const double* p = solutions[winners[c]].data();
+      (*diffuse)[c] = p[0];
+      for (int k = 0; k < kLobes; ++k) {
+        (*lobes)[k].cxy[c] = p[1 + 3 * k];
+        (*lobes)[k].cz[c] = p[2 + 3 * k];
+        (*lobes)[k].n[c] = p[3 + 3 * k];
+      }
+    }
+  };
+  // Where the dense albedo grid finds a channel above its bound, that channel's quadrature bound is
+  // lowered by the ratio and the channel solved again from where it ended (at most three times).
+  for (int round = 0; round < (options.plausibility_constraints ? 3 : 0); ++round) {
+    std::vector<LafortuneLobe> lobes;
+    Eigen::Vector3d diffuse;
+    model_of(&lobes, &diffuse);
+    const Eigen::Vector3d albedo = MaxDirectionalAlbedoPerChannel(LafortuneBrdf(diffuse, lobes));
+    std::vector<int> again;
+    for (int c = 0; c < 3; ++c) {
+      if (!(albedo[c] > bounds.albedo[c])) continue;
+      quadrature_bound[c] *= 0.999 * bounds.albedo[c] / albedo[c];
+      again.push_back(c);
+    }
+    if (again.empty()) break;
+    tbb::parallel_for(size_t(0), again.size(), [&](size_t j) {
+      const int c = again[j];
+      costs[winners[c]] = solve(c, all, solutions[winners[c]].data(), false);
+    });
   }
   Eigen::Vector3d diffuse;
   std::vector<LafortuneLobe> lobes(kLobes);
@@ -287,17 +529,40 @@ bool ModelFitOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GE(max_lobe_ratio, 1.0);
   IBRDF_CHECK_OPTION_GT(min_lobe_cap, 0.0);
   IBRDF_CHECK_OPTION_GE(max_lobe_floor_ratio, max_lobe_ratio);
+  IBRDF_CHECK_OPTION_GE(max_unmeasured_ratio, 1.0);
+  IBRDF_CHECK_OPTION_GE(plausibility_tolerance, 0.0);
   return true;
 }
 
 std::string ModelFitResult::BriefReport() const {
   char buffer[320];
   std::snprintf(buffer, sizeof(buffer),
-                "%s fit: %zu samples, relative RMS %.2f %%, cost %.4g, %d starts, max directional albedo %.3f%s, "
-                "%.2f s",
-                model.c_str(), samples_used, 100.0 * rel_rms, final_cost, starts, max_albedo,
-                max_albedo > 1.0 ? " (ABOVE 1: not energy conserving)" : "", seconds);
+                "%s fit: %zu samples, relative RMS %.2f %%, cost %.4g, %d starts, max directional albedo %.3f "
+                "(bound %.3g%s), %.2f s",
+                model.c_str(), samples_used, 100.0 * rel_rms, final_cost, starts, max_albedo, albedo_bound,
+                relative_scale ? ", relative scale: pi x the largest sample, not 1" : "", seconds);
   std::string text = buffer;
+  char retro[192];
+  if (retro_probes > 0) {
+    std::snprintf(retro, sizeof(retro),
+                  "; retro-reflection (samples from theta_d %.1f deg) at most %.2f x the samples beside it (%zu probes)",
+                  theta_d_min_deg, max_retro_ratio, retro_probes);
+  } else {
+    std::snprintf(retro, sizeof(retro), "; retro-reflection sampled (theta_d from %.1f deg): no ceiling", theta_d_min_deg);
+  }
+  text += retro;
+  if (!plausible) {
+    text += "; NOT PLAUSIBLE:";
+    for (const std::string& why : implausible) text += " " + why + ";";
+  }
+  if (!held_by_plausibility.empty()) {
+    text += "; held by a plausibility bound:";
+    for (const std::string& b : held_by_plausibility) text += " " + b + ";";
+  }
+  if (!beyond_samples.empty()) {
+    text += "; beyond the samples' theta (held by the lobe cap only):";
+    for (const std::string& b : beyond_samples) text += " " + b + ";";
+  }
   if (start_samples > 0) text += "; starts ranked on " + std::to_string(start_samples) + " samples, the best refined";
   if (band_rel_rms.size() == 3) {
     char bands[160];
@@ -333,6 +598,18 @@ nlohmann::json ToJson(const ModelFitResult& fit) {
                          {"seconds", fit.seconds}};
   if (fit.start_samples > 0) json["starts_ranked_on_samples"] = fit.start_samples;
   if (fit.model == "lafortune") json["lobes_at_cap"] = fit.at_lobe_cap;
+  json["albedo_bound"] = fit.albedo_bound;
+  json["albedo_bound_kind"] = fit.relative_scale
+                                  ? "relative scale: pi x the largest sample (the lights' intensity is unknown, so 1 "
+                                    "means nothing)"
+                                  : "1 (energy conservation)";
+  json["max_retro_ratio_vs_samples_beside"] = fit.max_retro_ratio;
+  json["samples_theta_d_min_deg"] = fit.theta_d_min_deg;
+  json["retro_probes"] = fit.retro_probes;
+  json["held_by_plausibility"] = fit.held_by_plausibility;
+  json["retro_beyond_samples"] = fit.beyond_samples;
+  json["plausible"] = fit.plausible;
+  json["implausible_because"] = fit.implausible;
   if (fit.band_rel_rms.size() == 3) {
     json["rel_rms_by_theta_max_deg"] = {
         {"0-25", fit.band_rel_rms[0]}, {"25-50", fit.band_rel_rms[1]}, {"50-80", fit.band_rel_rms[2]}};
@@ -362,14 +639,16 @@ Eigen::Vector3d DirectionalAlbedo(const BrdfModel& brdf, double theta_i) {
   return sum * (0.5 * (1.0 / kRings) * (2.0 * M_PI / kSectors));
 }
 
-double MaxDirectionalAlbedo(const BrdfModel& brdf) {
-  double largest = 0.0;
+Eigen::Vector3d MaxDirectionalAlbedoPerChannel(const BrdfModel& brdf) {
+  Eigen::Vector3d largest = Eigen::Vector3d::Zero();
   for (int i = 0; i < 40; ++i) {
     const double theta = (89.5 * i / 39.0) * M_PI / 180.0;
-    largest = std::max(largest, DirectionalAlbedo(brdf, theta).maxCoeff());
+    largest = largest.cwiseMax(DirectionalAlbedo(brdf, theta));
   }
   return largest;
 }
+
+double MaxDirectionalAlbedo(const BrdfModel& brdf) { return MaxDirectionalAlbedoPerChannel(brdf).maxCoeff(); }
 
 ModelFitResult FitLafortune(const std::vector<BrdfSample>& samples, const ModelFitOptions& options) {
   std::string why;
@@ -382,22 +661,23 @@ ModelFitResult FitLafortune(const std::vector<BrdfSample>& samples, const ModelF
   if (picked.size() < size_t(1 + 3 * options.lafortune_lobes)) {
     ThrowError("lafortune fit", "only " + std::to_string(picked.size()) + " usable samples");
   }
+  const PlausibilityBounds bounds = MakePlausibilityBounds(picked, options);
   switch (options.lafortune_lobes) {
     case 1:
-      result.brdf = FitLafortuneLobes<1>(picked, options, &result.final_cost, &result.starts, &result.start_samples,
-                                         &result.at_bound, &result.at_lobe_cap);
+      result.brdf = FitLafortuneLobes<1>(picked, options, bounds, &result.final_cost, &result.starts,
+                                         &result.start_samples, &result.at_bound, &result.at_lobe_cap);
       break;
     case 2:
-      result.brdf = FitLafortuneLobes<2>(picked, options, &result.final_cost, &result.starts, &result.start_samples,
-                                         &result.at_bound, &result.at_lobe_cap);
+      result.brdf = FitLafortuneLobes<2>(picked, options, bounds, &result.final_cost, &result.starts,
+                                         &result.start_samples, &result.at_bound, &result.at_lobe_cap);
       break;
     default:
-      result.brdf = FitLafortuneLobes<3>(picked, options, &result.final_cost, &result.starts, &result.start_samples,
-                                         &result.at_bound, &result.at_lobe_cap);
+      result.brdf = FitLafortuneLobes<3>(picked, options, bounds, &result.final_cost, &result.starts,
+                                         &result.start_samples, &result.at_bound, &result.at_lobe_cap);
       break;
   }
   result.rel_rms = RelativeRms(*result.brdf, picked);
-  result.max_albedo = MaxDirectionalAlbedo(*result.brdf);
+  JudgePlausibility(*result.brdf, bounds, options, &result);
   result.band_rel_rms = BandRelativeRms(*result.brdf, picked);
   result.seconds = timer.ElapsedSeconds();
   result.success = true;
@@ -426,6 +706,10 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
   constexpr int kStarts = 3, kVariants = 2;
   std::array<std::array<double, 7>, kStarts * kVariants> solutions;
   std::array<double, kStarts * kVariants> costs;
+  const PlausibilityBounds bounds = MakePlausibilityBounds(picked, options);
+  const AlbedoQuadrature quadrature = MakeAlbedoQuadrature();
+  // Each variant's albedo bounds of its quadrature (lowered where the dense grid finds the fit above).
+  std::array<Eigen::Vector3d, 2> quadrature_bound = {bounds.albedo, bounds.albedo};
   // One variant's solve from `p` over `fitted` (indices into `picked`); a `ranking` solve (a start on
   // the subset, as the Lafortune fit's) stops at options.start_tolerance.
   const auto solve = [&](bool dielectric, const std::vector<size_t>& fitted, double* p, bool ranking) {
@@ -441,6 +725,22 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<GgxResidual, 3, 3, 3, 1>(
                                    new GgxResidual(s.wi, s.wo, s.value, s.sigma, dielectric)),
                                &huber, diffuse, f0, alpha);
+    }
+    const Eigen::Vector3d zero = Eigen::Vector3d::Zero(), one = Eigen::Vector3d::Ones();
+    const std::vector<Eigen::Vector3d> no_directions;
+    const std::vector<Probe> no_probes;
+    for (const Eigen::Vector3d& wi : options.plausibility_constraints ? quadrature.wi : no_directions) {
+      std::vector<GgxResidual> points;
+      for (const Eigen::Vector3d& wo : quadrature.wo) points.emplace_back(wi, wo, zero, one, dielectric);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<GgxAlbedoPenalty, 3, 3, 3, 1>(
+              new GgxAlbedoPenalty(std::move(points), quadrature.weights, quadrature_bound[dielectric ? 0 : 1])),
+          nullptr, diffuse, f0, alpha);
+    }
+    for (const Probe& probe : options.plausibility_constraints ? bounds.probes : no_probes) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<GgxCeilingPenalty, 3, 3, 3, 1>(new GgxCeilingPenalty(
+                                   GgxResidual(probe.wi, probe.wo, zero, one, dielectric), probe.ceiling)),
+                               nullptr, diffuse, f0, alpha);
     }
     for (int c = 0; c < 3; ++c) {
       problem.SetParameterLowerBound(diffuse, c, 0.0);
@@ -485,17 +785,37 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
       costs[winners[variant]] = solve(variant == 0, all, solutions[winners[variant]].data(), false);
     });
   }
+  // The model of a variant's solution (the dielectric variant's second block is sqrt(F0)).
+  const auto model_of = [&](int variant) {
+    const double* p = solutions[winners[variant]].data();
+    const bool dielectric = variant == 0;
+    Eigen::Vector3d f0(p[3], p[4], p[5]);
+    if (dielectric) f0 = f0.cwiseProduct(f0);
+    return std::make_unique<GgxBrdf>(Eigen::Vector3d(p[0], p[1], p[2]), f0, p[6],
+                                     dielectric ? GgxFresnel::kDielectric : GgxFresnel::kSchlick);
+  };
+  // Where the dense albedo grid finds a variant's channel above its bound, its quadrature bound is
+  // lowered by the ratio and the variant solved again from where it ended (at most three times).
+  tbb::parallel_for(0, kVariants, [&](int variant) {
+    for (int round = 0; round < (options.plausibility_constraints ? 3 : 0); ++round) {
+      const Eigen::Vector3d albedo = MaxDirectionalAlbedoPerChannel(*model_of(variant));
+      bool again = false;
+      for (int c = 0; c < 3; ++c) {
+        if (!(albedo[c] > bounds.albedo[c])) continue;
+        quadrature_bound[variant][c] *= 0.999 * bounds.albedo[c] / albedo[c];
+        again = true;
+      }
+      if (!again) break;
+      costs[winners[variant]] = solve(variant == 0, all, solutions[winners[variant]].data(), false);
+    }
+  });
   std::unique_ptr<BrdfModel> best_model;
   int best_job = -1;
   double best_rms = std::numeric_limits<double>::infinity();
   for (int variant = 0; variant < kVariants; ++variant) {
     const int chosen = winners[variant];
-    const double* p = solutions[chosen].data();
     const bool dielectric = variant == 0;
-    Eigen::Vector3d f0(p[3], p[4], p[5]);
-    if (dielectric) f0 = f0.cwiseProduct(f0);
-    auto model = std::make_unique<GgxBrdf>(Eigen::Vector3d(p[0], p[1], p[2]), f0, p[6],
-                                           dielectric ? GgxFresnel::kDielectric : GgxFresnel::kSchlick);
+    std::unique_ptr<BrdfModel> model = model_of(variant);
     const double rms = RelativeRms(*model, picked);
     result.variants.emplace_back(dielectric ? "dielectric" : "conductor", rms);
     if (rms < best_rms) {
@@ -518,7 +838,7 @@ ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOpti
   result.final_cost = costs[best_job];
   result.brdf = std::move(best_model);
   result.rel_rms = best_rms;
-  result.max_albedo = MaxDirectionalAlbedo(*result.brdf);
+  JudgePlausibility(*result.brdf, bounds, options, &result);
   result.band_rel_rms = BandRelativeRms(*result.brdf, picked);
   result.seconds = timer.ElapsedSeconds();
   result.success = true;

@@ -42,6 +42,24 @@ struct ModelFitOptions {
   double max_lobe_ratio = 3.0;
   double min_lobe_cap = 1.0;           // 1/sr
   double max_lobe_floor_ratio = 30.0;  // times the largest sample
+  // Directional albedo at most 1 (energy conservation) is a constraint of every solve: a penalty on a
+  // fixed quadrature (8 incidence angles, 16 x 32 exitant cells), checked after on the dense grid of
+  // MaxDirectionalAlbedo and the solve tightened where that grid finds it above. With `relative_scale`
+  // (lights of relative intensity: every value is the material's times one unknown constant) 1 means
+  // nothing; the bound is then pi times the channel's largest sample, the albedo of a surface as
+  // bright as the brightest sample everywhere (docs/decisions.md, "Fit plausibility").
+  bool relative_scale = false;
+  // Retro-reflection (theta_d below the samples' smallest, where no camera can look: it would stand in
+  // the light) is held below this many times the largest sample at the same theta_h (within 2.5
+  // degrees): a penalty at probe directions (theta_d 0 and half the smallest sampled) every 2 degrees
+  // of theta_h up to max_theta_deg. Beyond the samples' theta the lobe cap above is the bound.
+  double max_unmeasured_ratio = 2.0;
+  // A fit is plausible when its dense albedo is within this fraction above its bound and no probe above
+  // its ceiling by more; an implausible fit is reported and never chosen by the reconstruct stage.
+  double plausibility_tolerance = 0.02;
+  // False: the solves leave the albedo bound and the retro-reflection ceilings out (the fit is still
+  // judged against them); for comparisons only.
+  bool plausibility_constraints = true;
   uint64_t seed = 1;
   bool Check(std::string* why) const;
 };
@@ -61,9 +79,28 @@ struct ModelFitResult {
   // max_lobe_ratio): the cap, not the samples, holds them ("lobe 1 G at 1 /sr").
   std::vector<std::string> at_lobe_cap;
   // The largest directional albedo over a dense grid of incidence directions on the whole hemisphere
-  // (0 to 89.5 degrees), per channel's max; a plausible BRDF keeps it at most 1.
+  // (0 to 89.5 degrees), per channel's max; a plausible BRDF keeps it at most albedo_bound (1, or in
+  // relative sessions pi times the largest sample: ModelFitOptions::relative_scale).
   double max_albedo = 0.0;
-  // Relative RMS against the samples used by band of max(theta_i, theta_o): 0-25, 25-50, 50-80 degrees.
+  double albedo_bound = 1.0;  // the largest of the channels' bounds
+  bool relative_scale = false;
+  // The fit's largest value at the retro-reflection probes over the largest sample beside each (its
+  // ceiling is ModelFitOptions::max_unmeasured_ratio times that); 0 where retro-reflection was sampled.
+  double max_retro_ratio = 0.0;
+  double theta_d_min_deg = 0.0;  // the samples' smallest theta_d (retro-reflection is theta_d 0)
+  size_t retro_probes = 0;       // retro-reflection probes (none where theta_d_min_deg is below 1 degree)
+  // Channels held by a plausibility bound rather than by the samples ("albedo G at its bound 1",
+  // "retro-reflection R at its ceiling at 12 of 120 probes").
+  std::vector<std::string> held_by_plausibility;
+  // Channels whose retro-reflection at 85 or 89 degrees, beyond the samples' theta, exceeds
+  // ModelFitOptions::max_unmeasured_ratio times the samples beside the last probe: bounded there by the
+  // lobe cap only (a real grazing peak such as felt's is kept), so said.
+  std::vector<std::string> beyond_samples;
+  // False with the reasons where the fit breaks a plausibility bound even so; the stage never chooses it.
+  bool plausible = true;
+  std::vector<std::string> implausible;
+  // Relative RMS against the samples used by band of max(theta_i, theta_o): 0-25, 25-50, 50-80 degrees,
+  // over the channels each sample measured.
   std::vector<double> band_rel_rms;
   // GGX: the Fresnel variant kept ("dielectric": exact Fresnel of eta(F0), vanishing with F0 = 0;
   // "conductor": Schlick per channel, F0 rising to 1 at grazing, as a metal) and every variant tried
@@ -78,6 +115,7 @@ struct ModelFitResult {
 // integral of f cos(theta_o) over the exitant hemisphere (midpoint rule, 48 x 96 cells in (cos^2 theta_o,
 // phi_o)), and its maximum over theta_i in 0 to 89.5 degrees (40 angles).
 Eigen::Vector3d DirectionalAlbedo(const BrdfModel& brdf, double theta_i);
+Eigen::Vector3d MaxDirectionalAlbedoPerChannel(const BrdfModel& brdf);
 double MaxDirectionalAlbedo(const BrdfModel& brdf);
 
 // Fits each colour channel separately with `lafortune_lobes` lobes from several starting points.
@@ -87,7 +125,8 @@ ModelFitResult FitLafortune(const std::vector<BrdfSample>& samples, const ModelF
 // the variant with the lower relative RMS against the samples and says so (variant, variants).
 ModelFitResult FitGgx(const std::vector<BrdfSample>& samples, const ModelFitOptions& options);
 
-// The fit as summary JSON: model, error, samples, starts, time, parameters at a bound, plausibility.
+// The fit as summary JSON: model, error, samples, starts, time, parameters at a bound, plausibility
+// (albedo and its bound, the retro-reflection ratio, what the bounds hold, why a fit is implausible).
 nlohmann::json ToJson(const ModelFitResult& fit);
 
 // The material file of a fit, with name, description (how and from what it was fitted) and

@@ -267,13 +267,16 @@ std::string MaterialName(const ReconstructOptions& options, const std::string& s
   return name;
 }
 
-// The Lafortune and GGX fits, their material files and renderer snippets; returns the chosen model
-// (lowest relative RMS against the samples). `colour_space` (the samples' own, from their sidecar) is
-// stated in every material file and snippet.
-std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, const ModelFitOptions& options,
+// The Lafortune and GGX fits, their material files and renderer snippets; returns the chosen model, the
+// plausible fit (ModelFitResult::plausible) with the lower relative RMS against the samples, or null
+// where neither is plausible; the summary says which fit was rejected and why. `colour_space` (the
+// samples' own, from their sidecar) is stated in every material file and snippet.
+std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, const ModelFitOptions& fit_options,
                                      const std::string& name, const std::string& colour_space, bool relative_scale,
                                      const std::string& tmp, ReconstructResult* result, nlohmann::json* timings) {
   Timer timer;
+  ModelFitOptions options = fit_options;
+  options.relative_scale = relative_scale;
   // The two fits side by side (each runs its starts in parallel too).
   ModelFitResult lafortune, ggx;
   tbb::task_group group;
@@ -290,19 +293,35 @@ std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, con
   WriteText(tmp + "/" + snippets.pbrt_file, snippets.pbrt);
   WriteText(tmp + "/" + snippets.mitsuba_file, snippets.mitsuba);
   (*timings)["fits_s"] = timer.ElapsedSeconds();
-  const bool lafortune_chosen = lafortune.rel_rms < ggx.rel_rms;
+  ModelFitResult* chosen = nullptr;
+  nlohmann::json rejected = nlohmann::json::object();
+  for (ModelFitResult* fit : {&lafortune, &ggx}) {
+    if (!fit->plausible) {
+      std::string why;
+      for (const std::string& reason : fit->implausible) why += (why.empty() ? "" : "; ") + reason;
+      rejected[fit->model] = why;
+      Log(1, "the " + fit->model + " fit is not chosen: not plausible (" + why + ")");
+      continue;
+    }
+    if (!chosen || fit->rel_rms < chosen->rel_rms) chosen = fit;
+  }
   result->summary["fits"] = {{"lafortune", ToJson(lafortune)},
                              {"ggx", ToJson(ggx)},
-                             {"chosen", lafortune_chosen ? "lafortune" : "ggx"},
+                             {"chosen", chosen ? chosen->model : "none"},
+                             {"rejected", rejected},
                              {"renderer_snippets", {snippets.pbrt_file, snippets.mitsuba_file}},
                              {"snippet_kind", snippets.kind}};
   result->fitted = true;
   result->lafortune_rel_rms = lafortune.rel_rms;
   result->ggx_rel_rms = ggx.rel_rms;
-  result->chosen_model = lafortune_chosen ? "lafortune" : "ggx";
-  Log(1, "chosen model: " + result->chosen_model + " (relative RMS against the samples " +
-             std::to_string(100.0 * std::min(lafortune.rel_rms, ggx.rel_rms)) + " %)");
-  return std::move(lafortune_chosen ? lafortune.brdf : ggx.brdf);
+  result->chosen_model = chosen ? chosen->model : "none";
+  if (!chosen) {
+    Log(0, "no fit chosen: neither the Lafortune nor the GGX fit is plausible (fits.rejected in summary.json)");
+    return nullptr;
+  }
+  Log(1, "chosen model: " + result->chosen_model + " (the plausible fit of lower relative RMS against the samples, " +
+             std::to_string(100.0 * chosen->rel_rms) + " %)");
+  return std::move(chosen->brdf);
 }
 
 // The .bsdf file's description: what it was made from, and how many nodes were measured,
@@ -572,7 +591,14 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
     chosen = FitModels(samples, options.fit, name, colour_space, relative_scale, tmp, &fitted, &fit_timings);
   };
   tbb::task_group fitting;
-  if (fits && fill_with_model) fit();
+  if (fits && fill_with_model) {
+    fit();
+    if (!chosen) {
+      ThrowError("--fill model", "no plausible fit to fill the unmeasured cells with: " +
+                                     fitted.summary["fits"]["rejected"].dump() +
+                                     " (--fill extrapolate or none leaves them to the regression)");
+    }
+  }
   if (fits && !fill_with_model) fitting.run(fit);
   MerlTable table;
   std::vector<uint8_t> domain;
