@@ -138,6 +138,7 @@ BASE = {
     ("lights", "synth"): (["--lights", "2", "--focal-px", "300"], ["--out", "OUT"]),
     ("align",): ([], ["s", "--out", "OUT"]),
     ("colour",): ([], ["s", "--out", "OUT"]),
+    ("response",): ([], ["s", "--out", "OUT"]),
     ("derender",): (["--stride", "2"], ["s", "--out", "OUT.npy"]),
     ("reconstruct",): (["--no-fits", "--no-bsdf"], ["r/samples.npy", "--out", "OUT"]),
     ("check",): ([], ["r/samples.npy", "--out", "OUT.json"]),
