@@ -14,13 +14,6 @@ std::string Format(const char* format, double a, double b = 0.0, double c = 0.0)
   return text;
 }
 
-// ok / warn / fail of `value` against an upper bound pair (larger is worse).
-VerdictLevel Above(double value, double warn, double fail) {
-  if (!(value <= fail)) return VerdictLevel::kFail;  // NaN fails
-  if (value > warn) return VerdictLevel::kWarn;
-  return VerdictLevel::kOk;
-}
-
 }  // namespace
 
 std::vector<Verdict> AlignmentVerdicts(const Session& input, const AlignResult& result,
@@ -53,7 +46,7 @@ std::vector<Verdict> AlignmentVerdicts(const Session& input, const AlignResult& 
     v.value = result.rms_px;
     v.measured = Format("marker corner RMS %.3f px", result.rms_px);
     v.bound = Format("warn over %.2f px, fail over %.2f px", bounds.warn_rms_px, bounds.fail_rms_px);
-    v.level = Above(v.value, bounds.warn_rms_px, bounds.fail_rms_px);
+    v.level = VerdictAbove(v.value, bounds.warn_rms_px, bounds.fail_rms_px);
     v.remedy = "check the camera's intrinsics (align --calibrate with ChArUco photos) and the targets' layout";
     verdicts.push_back(v);
   }
@@ -69,7 +62,7 @@ std::vector<Verdict> AlignmentVerdicts(const Session& input, const AlignResult& 
       v.bound = Format("fitted / stated radius within %.3g-%.3g (warn), ", 1.0 / bounds.warn_radius_ratio,
                        bounds.warn_radius_ratio) +
                 Format("%.3g-%.3g (fail)", 1.0 / bounds.fail_radius_ratio, bounds.fail_radius_ratio);
-      v.level = Above(off, bounds.warn_radius_ratio, bounds.fail_radius_ratio);  // a zero radius: inf, fails
+      v.level = VerdictAbove(off, bounds.warn_radius_ratio, bounds.fail_radius_ratio);  // a zero radius: inf, fails
       v.remedy = "state the radius and mark it known (session init --sample-radius-m R --radius-known; sample.radius_known), or add "
                  "photos whose silhouettes see the sphere's limb all around";
       verdicts.push_back(v);
@@ -82,7 +75,7 @@ std::vector<Verdict> AlignmentVerdicts(const Session& input, const AlignResult& 
                           (sphere.center - input.sample.center).norm(), v.value);
       v.bound = Format("warn over %.3g radii, fail over %.3g radii", bounds.warn_center_shift_radii,
                        bounds.fail_center_shift_radii);
-      v.level = Above(v.value, bounds.warn_center_shift_radii, bounds.fail_center_shift_radii);
+      v.level = VerdictAbove(v.value, bounds.warn_center_shift_radii, bounds.fail_center_shift_radii);
       v.remedy = "state the sphere's centre on the platform (sample.center) and check the photos see the sphere";
       verdicts.push_back(v);
     }
@@ -106,7 +99,7 @@ std::vector<Verdict> AlignmentVerdicts(const Session& input, const AlignResult& 
     v.measured = Format("light markers' estimates within %.3g mm of their mean", 1e3 * result.light.spread_m);
     v.bound = Format("warn over %.3g mm, fail over %.3g mm", 1e3 * bounds.warn_light_spread_m,
                      1e3 * bounds.fail_light_spread_m);
-    v.level = Above(v.value, bounds.warn_light_spread_m, bounds.fail_light_spread_m);
+    v.level = VerdictAbove(v.value, bounds.warn_light_spread_m, bounds.fail_light_spread_m);
     v.remedy = "photograph the light's card from more directions, or check its markers' layout (targets.light)";
     verdicts.push_back(v);
   }
@@ -117,7 +110,7 @@ std::vector<Verdict> AlignmentVerdicts(const Session& input, const AlignResult& 
     v.measured = Format("corner RMS %.3g mm over %.0f markers", 1e3 * registration->rms_m,
                         double(registration->used_markers));
     v.bound = Format("warn over %.3g mm, fail over %.3g mm", 1e3 * bounds.warn_mesh_rms_m, 1e3 * bounds.fail_mesh_rms_m);
-    v.level = Above(v.value, bounds.warn_mesh_rms_m, bounds.fail_mesh_rms_m);
+    v.level = VerdictAbove(v.value, bounds.warn_mesh_rms_m, bounds.fail_mesh_rms_m);
     v.remedy = "check the scan's marker corners (sample.scan_targets) against the platform's layout";
     verdicts.push_back(v);
   }

@@ -335,9 +335,7 @@ std::vector<Verdict> ColourChartVerdicts(const ColourChartFit& fit) {
                 fit.used, 100.0 * fit.max_residual);
   residual.measured = text;
   residual.bound = "warn over 3 %, fail over 10 %";
-  residual.level = VerdictLevel::kOk;
-  if (!(fit.rms_residual <= 0.03)) residual.level = VerdictLevel::kWarn;
-  if (!(fit.rms_residual <= 0.10)) residual.level = VerdictLevel::kFail;
+  residual.level = VerdictAbove(fit.rms_residual, 0.03, 0.10);
   residual.remedy = "check the chart's corner patches (colour_chart.corners) or detect it (--detect); light the chart "
                     "evenly, without glare";
   verdicts.push_back(residual);

@@ -147,20 +147,6 @@ Verdict MakeVerdict(const std::string& check, double value, const std::string& m
   return v;
 }
 
-// kFail when `value` is over `fail` (or not a number), kWarn over `warn`.
-VerdictLevel LevelAbove(double value, double warn, double fail) {
-  if (!(value <= fail)) return VerdictLevel::kFail;
-  if (!(value <= warn)) return VerdictLevel::kWarn;
-  return VerdictLevel::kOk;
-}
-
-// kFail when `value` is under `fail` (or not a number), kWarn under `warn`.
-VerdictLevel LevelBelow(double value, double warn, double fail) {
-  if (!(value >= fail)) return VerdictLevel::kFail;
-  if (!(value >= warn)) return VerdictLevel::kWarn;
-  return VerdictLevel::kOk;
-}
-
 }  // namespace
 
 bool ResponseCalibrationOptions::Check(std::string* why) const {
@@ -385,21 +371,21 @@ std::vector<Verdict> ResponseVerdicts(const ResponseCalibration& r) {
       r.brackets_used < 3 ? VerdictLevel::kWarn : VerdictLevel::kOk,
       "more brackets (poses) average out the noise of each: shoot every pose at 3 or more exposures"));
   verdicts.push_back(MakeVerdict("response.span", r.span_ev, FormatNumbers("%.1f EV between exposures", r.span_ev),
-                                 "warn under 4 EV, fail under 2 EV", LevelBelow(r.span_ev, 4.0, 2.0),
+                                 "warn under 4 EV, fail under 2 EV", VerdictBelow(r.span_ev, 4.0, 2.0),
                                  "widen the brackets (e.g. 5 exposures 1.5 EV apart) so that every level is seen "
                                  "together with a much darker and a much brighter exposure"));
   verdicts.push_back(MakeVerdict(
       "response.coverage", r.level_coverage,
       FormatNumbers("%.0f %% of the levels of 5-95 %% of full scale constrained (levels %.0f-%.0f)",
                     100.0 * r.level_coverage, r.lowest_level, r.highest_level),
-      "warn under 90 %, fail under 50 %", LevelBelow(r.level_coverage, 0.9, 0.5),
+      "warn under 90 %, fail under 50 %", VerdictBelow(r.level_coverage, 0.9, 0.5),
       "expose the brackets so that the scene spans the range: the longest exposure clipping its highlights, the "
       "shortest showing them"));
   verdicts.push_back(MakeVerdict(
       "response.uncertainty", r.median_uncertainty,
       FormatNumbers("median standard error %.2f %% (worst %.2f %%) over the constrained levels",
                     100.0 * r.median_uncertainty, 100.0 * r.max_uncertainty),
-      "warn over 1 %, fail over 3 %", LevelAbove(r.median_uncertainty, 0.01, 0.03),
+      "warn over 1 %, fail over 3 %", VerdictAbove(r.median_uncertainty, 0.01, 0.03),
       "more brackets or more pixels per bracket (--pixels); a static scene and light between exposures"));
   verdicts.push_back(MakeVerdict("response.monotonic", r.monotonic ? 1.0 : 0.0,
                                  r.monotonic ? "rises over the constrained levels" : "falls somewhere in the constrained levels",
@@ -409,12 +395,12 @@ std::vector<Verdict> ResponseVerdicts(const ResponseCalibration& r) {
   verdicts.push_back(MakeVerdict(
       "response.channels", r.channel_spread,
       FormatNumbers("channels differ from the combined curve by up to %.2f %%", 100.0 * r.channel_spread),
-      "warn over 3 %, fail over 10 % (one curve serves all channels)", LevelAbove(r.channel_spread, 0.03, 0.10),
+      "warn over 3 %, fail over 10 % (one curve serves all channels)", VerdictAbove(r.channel_spread, 0.03, 0.10),
       "the camera's channels have different curves: this calibration models one curve for all; use RAW photos"));
   verdicts.push_back(MakeVerdict(
       "response.methods", r.robertson_difference,
       FormatNumbers("Robertson's curve differs from Debevec's by up to %.2f %%", 100.0 * r.robertson_difference),
-      "warn over 5 %, fail over 25 %", LevelAbove(r.robertson_difference, 0.05, 0.25),
+      "warn over 5 %, fail over 25 %", VerdictAbove(r.robertson_difference, 0.05, 0.25),
       "the two calibrations disagree: more pixels per bracket or wider brackets"));
   return verdicts;
 }

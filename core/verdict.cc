@@ -77,4 +77,16 @@ VerdictLevel WorstVerdict(const std::vector<Verdict>& verdicts) {
   return worst;
 }
 
+VerdictLevel VerdictAbove(double value, double warn, double fail) {
+  if (!(value <= fail)) return VerdictLevel::kFail;
+  if (!(value <= warn)) return VerdictLevel::kWarn;
+  return VerdictLevel::kOk;
+}
+
+VerdictLevel VerdictBelow(double value, double warn, double fail) {
+  if (!(value >= fail)) return VerdictLevel::kFail;
+  if (!(value >= warn)) return VerdictLevel::kWarn;
+  return VerdictLevel::kOk;
+}
+
 }  // namespace ibrdf

@@ -49,6 +49,11 @@ void EnforceVerdicts(std::vector<Verdict>* verdicts, const AcceptedChecks& accep
 
 // {"check", "verdict", "value", "measured", "bound", "remedy", "accepted"} each.
 nlohmann::json VerdictsToJson(const std::vector<Verdict>& verdicts);
+// ok / warn / fail of `value` against an upper bound pair (larger is worse) and a lower bound pair
+// (smaller is worse); a value that is not a number fails.
+VerdictLevel VerdictAbove(double value, double warn, double fail);
+VerdictLevel VerdictBelow(double value, double warn, double fail);
+
 // The worst level over `verdicts` (kOk for none).
 VerdictLevel WorstVerdict(const std::vector<Verdict>& verdicts);
 
