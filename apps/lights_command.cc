@@ -66,6 +66,11 @@ void AddCalibrateFlags(CLI::App* command, CalibrateArgs* args) {
                       "Write a copy of that session (new folder, its files referenced in place) with the calibrated\n"
                       "lights; for the --diffuse session, also the sphere's fitted centre");
   command->add_flag("--overwrite", args->request.overwrite, "Replace existing outputs");
+  command
+      ->add_option("--accept", args->request.accept.names,
+                   "Proceed although these checks fail (comma-separated, or all); recorded in the report")
+      ->delimiter(',')
+      ->type_name("CHECK[,CHECK...]");
 }
 
 void RunCalibrate(CalibrateArgs& args) {
@@ -107,6 +112,7 @@ void AddWhite(CLI::App& group) {
     std::string session, out;
     LightCalibrationOptions options;
     bool overwrite = false;
+    AcceptedChecks accept;
   };
   auto args = std::make_shared<Args>();
   command->add_option("session", args->session, "Session folder or session.json with a white reference")->required();
@@ -114,12 +120,18 @@ void AddWhite(CLI::App& group) {
   command->add_option("--min-signal", args->options.min_signal, "Signal floor, linear normalized file units")
       ->capture_default_str();
   command->add_flag("--overwrite", args->overwrite, "Replace an existing output folder");
+  command
+      ->add_option("--accept", args->accept.names,
+                   "Proceed although these checks fail (comma-separated, or all); recorded in white-reference.json")
+      ->delimiter(',')
+      ->type_name("CHECK[,CHECK...]");
   command->callback([args] {
     StageLog stage("lights white");
     RequireValidOptions(args->options, "--min-signal");
     const Session session = Session::Load(args->session);
     RequireWritableOutput(args->out, args->overwrite, SessionInputs(session));
-    const LightCalibrationReport report = WriteLightCalibrationStage(session, args->options, args->out, args->overwrite);
+    const LightCalibrationReport report =
+        WriteLightCalibrationStage(session, args->options, args->out, args->overwrite, args->accept);
     Log(1, report.BriefReport());
     Log(1, "session with the calibrated lights written to " + args->out + "/session.json");
   });

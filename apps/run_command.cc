@@ -42,15 +42,17 @@ IBRDF_COMMAND(80, Run) {
   // Arguments passed to a stage: in the order of these options (CLI11 runs their callbacks so), the
   // --STAGE-args words before the named options.
   using StageArgs = std::vector<std::string> MeasurementOptions::*;
-  const StageArgs scan = &MeasurementOptions::scan_args, align = &MeasurementOptions::align_args,
-                  lights = &MeasurementOptions::lights_args, colour = &MeasurementOptions::colour_args,
-                  derender = &MeasurementOptions::derender_args, check = &MeasurementOptions::check_args,
-                  reconstruct = &MeasurementOptions::reconstruct_args, report = &MeasurementOptions::report_args;
+  const StageArgs scan = &MeasurementOptions::scan_args, response = &MeasurementOptions::response_args,
+                  align = &MeasurementOptions::align_args, lights = &MeasurementOptions::lights_args,
+                  colour = &MeasurementOptions::colour_args, derender = &MeasurementOptions::derender_args,
+                  check = &MeasurementOptions::check_args, reconstruct = &MeasurementOptions::reconstruct_args,
+                  report = &MeasurementOptions::report_args;
   const struct {
     const char* flag;
     StageArgs target;
     const char *stage, *help;
   } more[] = {{"--scan-args", scan, "scan", "--no-outliers --radius-factor 3"},
+              {"--response-args", response, "response", "--pixels 800 --smoothness 30"},
               {"--align-args", align, "align", "--max-rms-px 2 --no-cylinder"},
               {"--lights-args", lights, "lights white", "--min-signal 0.02"},
               {"--colour-args", colour, "colour", "--min-patches 12 --detect"},
@@ -90,14 +92,14 @@ IBRDF_COMMAND(80, Run) {
         ->type_name("VALUE");
   }
   c->add_option("--stop-after", o.stop_after,
-                "Stop after this stage (synth, scan, align, lights, colour, derender, check,\n"
+                "Stop after this stage (synth, scan, response, align, lights, colour, derender, check,\n"
                 "compare, reconstruct, report); later stages are left as they are");
   c->callback([args] {
     Timer wall;
     RequireValidOptions(args->o, "ibrdf run");
     const int threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-    const nlohmann::json summary =
-        RunInFolder(args->input, args->out, args->o, args->overwrite, ChildStageLauncher(threads), kIbrdfVersionLine, wall);
+    const nlohmann::json summary = RunInFolder(args->input, args->out, args->o, args->overwrite,
+                                               ChildStageLauncher(threads), kIbrdfVersionLine, wall);
     for (const std::string& line : RunFolderReport(summary, args->out, wall.ElapsedSeconds())) Log(1, line);
   });
 }

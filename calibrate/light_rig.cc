@@ -1,8 +1,10 @@
 #include "calibrate/light_rig.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
+#include "calibrate/report_format.h"
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/json_reader.h"
@@ -25,6 +27,7 @@ nlohmann::json LightRigCalibration::LightsFileJson() const {
 nlohmann::json LightRigCalibration::ReportJson() const {
   nlohmann::json report = probe.ReportJson();
   if (intensities) report["diffuse_sphere"] = intensities->ToJson();
+  report["verdicts"] = VerdictsToJson(verdicts);
   report["inputs"] = inputs;
   return report;
 }
@@ -64,6 +67,7 @@ LightRigCalibration CalibrateLightRig(const std::vector<Session>& placements, co
     calibration.intensity_reference =
         "relative: not measured (no diffuse reference); every intensity is 1, so the BRDF's scale and the "
         "lights' ratios are unknown";
+    result.verdicts = LightRigVerdicts(result, options);
     return result;
   }
   std::vector<Light> lights;
@@ -76,7 +80,53 @@ LightRigCalibration CalibrateLightRig(const std::vector<Session>& placements, co
           : "relative: a diffuse sphere of unknown albedo (" + diffuse->manifest_path +
                 "); the lights' ratios are measured, their common scale (and so the BRDF's) is not: the mean "
                 "intensity is set to 1";
+  result.verdicts = LightRigVerdicts(result, options);
   return result;
+}
+
+std::vector<Verdict> LightRigVerdicts(const LightRigCalibration& calibration, const LightRigOptions& options) {
+  constexpr double kFailSigmaDeg = 2.0, kWarnNominalDeg = 10.0, kFailNominalDeg = 30.0;
+  constexpr double kWarnExponent = 0.05, kFailExponent = 0.1, kWarnSpread = 0.05, kFailSpread = 0.15;
+  const LightProbeCalibration& probe = calibration.probe;
+  std::string least_certain, farthest;
+  double max_sigma = 0.0, max_nominal = 0.0;
+  for (const CalibratedLight& c : probe.lights) {
+    if (c.sigma_deg >= max_sigma) max_sigma = c.sigma_deg, least_certain = c.light.id;
+    if (c.angle_from_nominal_deg >= max_nominal) max_nominal = c.angle_from_nominal_deg, farthest = c.light.id;
+  }
+  std::vector<Verdict> verdicts;
+  verdicts.push_back(MakeVerdict(
+      "lights.direction_sigma", max_sigma,
+      FormatNumbers("largest direction sigma %.3f deg (", max_sigma) + least_certain + ")",
+      FormatNumbers("warn over %.2f deg, fail over %.1f deg", options.probe.warn_sigma_deg, kFailSigmaDeg),
+      VerdictAbove(max_sigma, options.probe.warn_sigma_deg, kFailSigmaDeg),
+      "a sharper highlight: an exposure that does not clip it, a larger mirror sphere in the frame, or a second "
+      "placement of the sphere"));
+  verdicts.push_back(MakeVerdict(
+      "lights.nominal", max_nominal,
+      FormatNumbers("largest angle from the session's stated light %.2f deg (", max_nominal) + farthest + ")",
+      FormatNumbers("warn over %.0f deg, fail over %.0f deg", kWarnNominalDeg, kFailNominalDeg),
+      VerdictAbove(max_nominal, kWarnNominalDeg, kFailNominalDeg),
+      "check that each photo names the light it was taken under and that the session's lights describe this "
+      "rig; if the stated lights are only placeholders, accept this check"));
+  if (calibration.intensities) {
+    const DiffuseSphereIntensities& diffuse = *calibration.intensities;
+    const double exponent_error = std::abs(diffuse.median_cosine_exponent - 1.0);
+    verdicts.push_back(MakeVerdict(
+        "lights.response_linearity", exponent_error,
+        FormatNumbers("the diffuse sphere's signal goes as cos(theta_i)^%.3f", diffuse.median_cosine_exponent),
+        FormatNumbers("exponent within 1 +- %.2f (warn), 1 +- %.2f (fail)", kWarnExponent, kFailExponent),
+        VerdictAbove(exponent_error, kWarnExponent, kFailExponent),
+        "the photos do not read linearly: measure the camera's response from exposure brackets (`ibrdf "
+        "response`) or state it (radiometry.response); every BRDF value is otherwise off by the same power"));
+    verdicts.push_back(
+        MakeVerdict("lights.intensity_spread", diffuse.median_spread,
+                    FormatNumbers("median per-pixel spread of the intensities %.2f %%", 100.0 * diffuse.median_spread),
+                    FormatNumbers("warn over %.0f %%, fail over %.0f %%", 100.0 * kWarnSpread, 100.0 * kFailSpread),
+                    VerdictAbove(diffuse.median_spread, kWarnSpread, kFailSpread),
+                    "check the diffuse sphere's mask and that it is matte (Lambertian), and the light directions"));
+  }
+  return verdicts;
 }
 
 std::string LightRigReportPath(const std::string& lights_path) {
@@ -149,8 +199,10 @@ LightRigCalibration RunLightRigStage(const LightRigStageRequest& request, const 
     ThrowError("--apply-to", "needs --write-session (where to write the session with the calibrated lights)");
   }
 
-  const LightRigCalibration calibration = CalibrateLightRig(placements, diffuse ? &*diffuse : nullptr, options);
+  LightRigCalibration calibration = CalibrateLightRig(placements, diffuse ? &*diffuse : nullptr, options);
   if (calibration.intensities) Log(1, calibration.intensities->BriefReport());
+  // Nothing is written when the lights cannot be trusted, unless the user accepted the check by name.
+  EnforceVerdicts(&calibration.verdicts, request.accept, request.placements.front() + ": lights");
   WriteLightRig(calibration, request.out);
   Log(1, calibration.probe.BriefReport());
   for (const std::string& line : calibration.LightLines()) Log(1, line);

@@ -15,6 +15,7 @@
 #include "calibrate/diffuse_sphere_intensity.h"
 #include "calibrate/light_probe_calibration.h"
 #include "core/session.h"
+#include "core/verdict.h"
 
 namespace ibrdf {
 
@@ -27,13 +28,14 @@ struct LightRigOptions {
 };
 
 struct LightRigCalibration {
-  LightProbeCalibration probe;                         // the lights, intensities included
+  LightProbeCalibration probe;                          // the lights, intensities included
   std::optional<DiffuseSphereIntensities> intensities;  // with a diffuse sphere
-  std::vector<std::string> inputs;                     // the sessions' manifests, placements then diffuse
+  std::vector<std::string> inputs;                      // the sessions' manifests, placements then diffuse
+  std::vector<Verdict> verdicts;                        // LightRigVerdicts
 
   // "ibrdf-lights" version 1: the lights as the session format writes them, and intensity_reference.
   nlohmann::json LightsFileJson() const;
-  // <out>.calibration.json: the probe's report, the diffuse sphere's, the inputs.
+  // <out>.calibration.json: the probe's report, the diffuse sphere's, the verdicts, the inputs.
   nlohmann::json ReportJson() const;
   // One line per light: "  L01    to (+0.1000, ...)  +- 0.020 deg  0.310 deg from the nominal".
   std::vector<std::string> LightLines() const;
@@ -44,6 +46,21 @@ struct LightRigCalibration {
 // diffuse_sphere_intensity.h), and naming "--albedo" for an albedo without a diffuse sphere.
 LightRigCalibration CalibrateLightRig(const std::vector<Session>& placements, const Session* diffuse,
                                       const LightRigOptions& options);
+
+// The calibration's verdicts (docs/verdicts.md, "lights"):
+//  - lights.direction_sigma: the least certain light's direction, one sigma (warn over the probe's
+//    warn_sigma_deg, fail over 2 degrees: a light that far off moves a sharp highlight's samples by
+//    twice that in theta_h);
+//  - lights.nominal: the largest angle between a calibrated light and the session's stated one (warn
+//    over 10, fail over 30 degrees: a light that far from where the rig says is a photo named for the
+//    wrong light, or a rig description of another rig);
+//  - with a diffuse sphere, lights.response_linearity: the cosine exponent k of its signal against
+//    cos(theta_i), |k - 1| (warn over 0.05, fail over 0.1: the photos do not read linearly, and every
+//    BRDF value is off by the same power);
+//  - with a diffuse sphere, lights.intensity_spread: the median over lights of the per-pixel spread of
+//    the intensity (warn over 5 %, fail over 15 %: the sphere is not Lambertian, its mask is wrong, or
+//    the directions are).
+std::vector<Verdict> LightRigVerdicts(const LightRigCalibration& calibration, const LightRigOptions& options);
 
 // "lights.json" -> "lights.calibration.json": the calibration's report beside the lights.
 std::string LightRigReportPath(const std::string& lights_path);
@@ -67,11 +84,13 @@ struct LightRigStageRequest {
   std::string apply_to;                 // that session ("": the diffuse one)
   bool known_sphere = false;            // the sessions' spheres are exact: no silhouette fit, no new centre
   bool overwrite = false;
+  AcceptedChecks accept;  // failed verdicts to proceed with (--accept)
 };
 
 // Loads the sessions, checks every output against every input before anything is read or written
 // (core/output_guard.h: the lights, their report and the session folder, which is replaced whole),
-// calibrates, writes the lights and their report and, with write_session, the session with the
+// calibrates, enforces the verdicts (nothing is written when one fails and is not accepted), writes the
+// lights and their report and, with write_session, the session with the
 // calibrated lights (for the diffuse session, its fitted centre too). Logs each result's brief report.
 // Throws Error naming the flag for an inconsistent request (--albedo without --diffuse, --apply-to
 // without --write-session).

@@ -26,8 +26,8 @@ namespace {
 constexpr int kLevels = 256;  // OpenCV's calibrations work on 8-bit images (LDR_SIZE)
 constexpr int kTopLevel = kLevels - 1;
 // The levels of 5-95 % of full scale, where the curve is held to its bounds.
-constexpr int kFirstJudgedLevel = 13;   // ceil(0.05 * 255)
-constexpr int kLastJudgedLevel = 242;   // floor(0.95 * 255)
+constexpr int kFirstJudgedLevel = 13;  // ceil(0.05 * 255)
+constexpr int kLastJudgedLevel = 242;  // floor(0.95 * 255)
 // A pixel's exposure is usable evidence between these levels (neither black nor clipped).
 constexpr int kLowestUsable = 1, kHighestUsable = 254;
 
@@ -135,18 +135,6 @@ bool AlignmentOffset(const std::vector<double>& reference, const ChannelCurve& r
 
 double RelativeDifference(double log_a, double log_b) { return std::abs(std::expm1(log_a - log_b)); }
 
-Verdict MakeVerdict(const std::string& check, double value, const std::string& measured, const std::string& bound,
-                    VerdictLevel level, const std::string& remedy) {
-  Verdict v;
-  v.check = check;
-  v.value = value;
-  v.measured = measured;
-  v.bound = bound;
-  v.level = level;
-  v.remedy = level == VerdictLevel::kOk ? "" : remedy;
-  return v;
-}
-
 }  // namespace
 
 bool ResponseCalibrationOptions::Check(std::string* why) const {
@@ -162,6 +150,7 @@ ResponseCalibration CalibrateResponse(const Session& session, const ResponseCali
   if (!options.Check(&why)) ThrowError("response options", why);
   ResponseCalibration result;
   std::vector<std::vector<size_t>> usable_groups;
+  std::vector<size_t> usable_bracket;  // usable_groups[k]'s entry in result.brackets
   for (const std::vector<size_t>& group : ExposureGroups(session)) {
     ResponseBracket bracket;
     bracket.first_photo = session.photos[group.front()].file;
@@ -175,6 +164,7 @@ ResponseCalibration CalibrateResponse(const Session& session, const ResponseCali
       bracket.left_out = "one exposure";
     } else {
       usable_groups.push_back(group);
+      usable_bracket.push_back(result.brackets.size());
     }
     result.brackets.push_back(bracket);
   }
@@ -195,12 +185,8 @@ ResponseCalibration CalibrateResponse(const Session& session, const ResponseCali
       const PhotoSpec& photo = session.photos[i];
       exposures.push_back({photo.exposure_s * photo.gain, ReadLevels(session.PhotoPath(i))});
     }
-    std::sort(exposures.begin(), exposures.end(),
-              [](const Exposure& a, const Exposure& b) { return a.time < b.time; });
-    ResponseBracket* bracket = nullptr;
-    for (ResponseBracket& b : result.brackets) {
-      if (b.first_photo == session.photos[group.front()].file) bracket = &b;
-    }
+    std::sort(exposures.begin(), exposures.end(), [](const Exposure& a, const Exposure& b) { return a.time < b.time; });
+    ResponseBracket* bracket = &result.brackets[usable_bracket[k]];
     std::vector<float> times;
     for (const Exposure& e : exposures) times.push_back(static_cast<float>(e.time));
     const cv::Mat times_mat(times, true);
@@ -366,10 +352,10 @@ ResponseCalibration CalibrateResponse(const Session& session, const ResponseCali
 
 std::vector<Verdict> ResponseVerdicts(const ResponseCalibration& r) {
   std::vector<Verdict> verdicts;
-  verdicts.push_back(MakeVerdict(
-      "response.brackets", r.brackets_used, std::to_string(r.brackets_used) + " brackets used", "warn under 3",
-      r.brackets_used < 3 ? VerdictLevel::kWarn : VerdictLevel::kOk,
-      "more brackets (poses) average out the noise of each: shoot every pose at 3 or more exposures"));
+  verdicts.push_back(
+      MakeVerdict("response.brackets", r.brackets_used, std::to_string(r.brackets_used) + " brackets used",
+                  "warn under 3", r.brackets_used < 3 ? VerdictLevel::kWarn : VerdictLevel::kOk,
+                  "more brackets (poses) average out the noise of each: shoot every pose at 3 or more exposures"));
   verdicts.push_back(MakeVerdict("response.span", r.span_ev, FormatNumbers("%.1f EV between exposures", r.span_ev),
                                  "warn under 4 EV, fail under 2 EV", VerdictBelow(r.span_ev, 4.0, 2.0),
                                  "widen the brackets (e.g. 5 exposures 1.5 EV apart) so that every level is seen "
@@ -381,17 +367,18 @@ std::vector<Verdict> ResponseVerdicts(const ResponseCalibration& r) {
       "warn under 90 %, fail under 50 %", VerdictBelow(r.level_coverage, 0.9, 0.5),
       "expose the brackets so that the scene spans the range: the longest exposure clipping its highlights, the "
       "shortest showing them"));
-  verdicts.push_back(MakeVerdict(
-      "response.uncertainty", r.median_uncertainty,
-      FormatNumbers("median standard error %.2f %% (worst %.2f %%) over the constrained levels",
-                    100.0 * r.median_uncertainty, 100.0 * r.max_uncertainty),
-      "warn over 1 %, fail over 3 %", VerdictAbove(r.median_uncertainty, 0.01, 0.03),
-      "more brackets or more pixels per bracket (--pixels); a static scene and light between exposures"));
-  verdicts.push_back(MakeVerdict("response.monotonic", r.monotonic ? 1.0 : 0.0,
-                                 r.monotonic ? "rises over the constrained levels" : "falls somewhere in the constrained levels",
-                                 "must rise", r.monotonic ? VerdictLevel::kOk : VerdictLevel::kFail,
-                                 "the scene or light moved between exposures, or the exposures are misstated "
-                                 "(exposure_s, gain): check the bracket's photos"));
+  verdicts.push_back(
+      MakeVerdict("response.uncertainty", r.median_uncertainty,
+                  FormatNumbers("median standard error %.2f %% (worst %.2f %%) over the constrained levels",
+                                100.0 * r.median_uncertainty, 100.0 * r.max_uncertainty),
+                  "warn over 1 %, fail over 3 %", VerdictAbove(r.median_uncertainty, 0.01, 0.03),
+                  "more brackets or more pixels per bracket (--pixels); a static scene and light between exposures"));
+  verdicts.push_back(
+      MakeVerdict("response.monotonic", r.monotonic ? 1.0 : 0.0,
+                  r.monotonic ? "rises over the constrained levels" : "falls somewhere in the constrained levels",
+                  "must rise", r.monotonic ? VerdictLevel::kOk : VerdictLevel::kFail,
+                  "the scene or light moved between exposures, or the exposures are misstated "
+                  "(exposure_s, gain): check the bracket's photos"));
   verdicts.push_back(MakeVerdict(
       "response.channels", r.channel_spread,
       FormatNumbers("channels differ from the combined curve by up to %.2f %%", 100.0 * r.channel_spread),
@@ -427,8 +414,9 @@ nlohmann::json ResponseCalibration::ToJson() const {
   }
   return {{"format", "ibrdf-response"},
           {"version", 1},
-          {"method", "Debevec and Malik 1997 (OpenCV createCalibrateDebevec), per bracket, median over brackets "
-                     "and channels; Robertson (createCalibrateRobertson) as a cross-check"},
+          {"method",
+           "Debevec and Malik 1997 (OpenCV createCalibrateDebevec), per bracket, median over brackets "
+           "and channels; Robertson (createCalibrateRobertson) as a cross-check"},
           {"levels", kLevels},
           {"table", response.table},
           {"uncertainty", response.uncertainty},

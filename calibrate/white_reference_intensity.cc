@@ -97,7 +97,11 @@ nlohmann::json LightCalibrationReport::ToJson() const {
     entry["stated_intensity"] = light.stated ? ibrdf::ToJson(light.stated_intensity) : nlohmann::json(nullptr);
     per_light.push_back(entry);
   }
-  return {{"summary", BriefReport()}, {"photos", photos}, {"lights", per_light}, {"total_s", total_s}};
+  return {{"summary", BriefReport()},
+          {"photos", photos},
+          {"lights", per_light},
+          {"verdicts", VerdictsToJson(verdicts)},
+          {"total_s", total_s}};
 }
 
 namespace {
@@ -249,18 +253,49 @@ Session ApplyLightCalibration(const Session& session, LightCalibrationReport* re
   }
   report->photos = static_cast<int>(white.photos.size());
   report->calibrated = true;
+  report->verdicts = WhiteReferenceVerdicts(*report);
   report->total_s = timer.ElapsedSeconds();
   report->success = true;
   return calibrated;
 }
 
+std::vector<Verdict> WhiteReferenceVerdicts(const LightCalibrationReport& report) {
+  constexpr double kWarnSpread = 0.05, kFailSpread = 0.15, kWarnPixels = 1000;
+  if (report.lights.empty()) return {};
+  const auto label = [](const LightIntensityReport& l) { return l.light.empty() ? std::string("the light") : l.light; };
+  const LightIntensityReport* widest = &report.lights.front();
+  const LightIntensityReport* fewest = &report.lights.front();
+  for (const LightIntensityReport& l : report.lights) {
+    if (l.spread.maxCoeff() > widest->spread.maxCoeff()) widest = &l;
+    if (l.pixels_used < fewest->pixels_used) fewest = &l;
+  }
+  char measured[160];
+  std::vector<Verdict> verdicts;
+  std::snprintf(measured, sizeof(measured), "largest per-pixel spread %.2f %% (%s)", 100.0 * widest->spread.maxCoeff(),
+                label(*widest).c_str());
+  verdicts.push_back(MakeVerdict(
+      "white.spread", widest->spread.maxCoeff(), measured, "warn over 5 %, fail over 15 %",
+      VerdictAbove(widest->spread.maxCoeff(), kWarnSpread, kFailSpread),
+      "an uneven white reference: check its pose (center, normal; `ibrdf align` from its card's markers), that it "
+      "is flat and matte, and the light's position"));
+  std::snprintf(measured, sizeof(measured), "%llu pixels used (%s)",
+                static_cast<unsigned long long>(fewest->pixels_used), label(*fewest).c_str());
+  verdicts.push_back(MakeVerdict("white.pixels", double(fewest->pixels_used), measured, "warn under 1000",
+                                 double(fewest->pixels_used) < kWarnPixels ? VerdictLevel::kWarn : VerdictLevel::kOk,
+                                 "a larger white reference in the frame, or less of it clipped or too dark"));
+  return verdicts;
+}
+
 LightCalibrationReport WriteLightCalibrationStage(const Session& session, const LightCalibrationOptions& options,
-                                                  const std::string& out_dir, bool overwrite) {
+                                                  const std::string& out_dir, bool overwrite,
+                                                  const AcceptedChecks& accept) {
   if (!session.calibration || !session.calibration->white_reference) {
     ThrowError(session.manifest_path, "has no white reference (calibration.white_reference): nothing to calibrate");
   }
   LightCalibrationReport report;
   Session calibrated = ApplyLightCalibration(session, &report, options);
+  // Nothing is written when the intensities cannot be trusted, unless the user accepted the check.
+  EnforceVerdicts(&report.verdicts, accept, session.manifest_path + ": /calibration/white_reference");
   calibrated.calibration.reset();  // the white reference is its only step, now applied
   calibrated.MarkApplied(SessionStage::kLights);
   AtomicDirectory directory(out_dir, overwrite);

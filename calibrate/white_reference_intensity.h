@@ -17,6 +17,7 @@
 
 #include "core/logging.h"
 #include "core/session.h"
+#include "core/verdict.h"
 
 namespace ibrdf {
 
@@ -59,14 +60,23 @@ struct LightCalibrationReport {
   int photos = 0;           // white-reference photos, all lights together
   // One entry per light that has white-reference photos, in the session's order of lights.
   std::vector<LightIntensityReport> lights;
+  std::vector<Verdict> verdicts;  // WhiteReferenceVerdicts, filled by ApplyLightCalibration
   double total_s = 0.0;
   // "light calibration: white reference, 2 photos, 4210 pixels: intensity (1, 1, 1) -> (0.41, ...)"
   // (one clause per light).
   std::string BriefReport() const;
   // OUT/white-reference.json: the summary, and per light its photos, pixels, rejections, stated and
-  // calibrated intensity and spread.
+  // calibrated intensity and spread; the verdicts.
   nlohmann::json ToJson() const;
 };
+
+// The white reference's verdicts (docs/verdicts.md, "lights white"):
+//  - white.spread: the largest per-pixel spread of a light's estimate over the target (warn over 5 %,
+//    fail over 15 %: noise alone gives about 1 %; an uneven target means a wrong pose, a target that
+//    is not flat or not Lambertian, or a light that is not where the session says);
+//  - white.pixels: the fewest pixels a light's estimate used (warn under 1000: the median's own noise
+//    then exceeds a tenth of the spread).
+std::vector<Verdict> WhiteReferenceVerdicts(const LightCalibrationReport& report);
 
 // The session with each light's intensity replaced by the white reference's measurement under that
 // light (the white-reference photos that name it), when the session has a white reference
@@ -84,9 +94,11 @@ Session ApplyLightCalibration(const Session& session, LightCalibrationReport* re
 // session with the measured intensities and its white reference consumed: the block is left out, so
 // that the derenderer, which refuses a session with a white reference, reads the lights as stated;
 // paths rebased to name the same files) and OUT/white-reference.json (LightCalibrationReport::ToJson),
-// as one folder that appears complete. Throws Error naming the manifest for a session without a white
-// reference, and as ApplyLightCalibration.
+// as one folder that appears complete, once the verdicts hold (a failed one not in `accept` stops it
+// with nothing written). Throws Error naming the manifest for a session without a white reference,
+// and as ApplyLightCalibration.
 LightCalibrationReport WriteLightCalibrationStage(const Session& session, const LightCalibrationOptions& options,
-                                                  const std::string& out_dir, bool overwrite);
+                                                  const std::string& out_dir, bool overwrite,
+                                                  const AcceptedChecks& accept = AcceptedChecks());
 
 }  // namespace ibrdf

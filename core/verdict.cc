@@ -22,8 +22,8 @@ const char* VerdictLevelName(VerdictLevel level) {
 }
 
 std::string Verdict::Line() const {
-  std::string line = check + ": " + VerdictLevelName(level) + (accepted ? " (accepted)" : "") + ": " + measured +
-                     "; bound: " + bound;
+  std::string line =
+      check + ": " + VerdictLevelName(level) + (accepted ? " (accepted)" : "") + ": " + measured + "; bound: " + bound;
   if (!remedy.empty() && level != VerdictLevel::kOk) line += "; remedy: " + remedy;
   return line;
 }
@@ -67,6 +67,18 @@ nlohmann::json VerdictsToJson(const std::vector<Verdict>& verdicts) {
                     {"accepted", verdict.accepted}});
   }
   return json;
+}
+
+Verdict MakeVerdict(const std::string& check, double value, const std::string& measured, const std::string& bound,
+                    VerdictLevel level, const std::string& remedy) {
+  Verdict v;
+  v.check = check;
+  v.value = value;
+  v.measured = measured;
+  v.bound = bound;
+  v.level = level;
+  v.remedy = level == VerdictLevel::kOk ? "" : remedy;
+  return v;
 }
 
 VerdictLevel WorstVerdict(const std::vector<Verdict>& verdicts) {

@@ -54,6 +54,10 @@ nlohmann::json VerdictsToJson(const std::vector<Verdict>& verdicts);
 VerdictLevel VerdictAbove(double value, double warn, double fail);
 VerdictLevel VerdictBelow(double value, double warn, double fail);
 
+// A verdict of `check` at `level`; the remedy is kept for warn and fail only.
+Verdict MakeVerdict(const std::string& check, double value, const std::string& measured, const std::string& bound,
+                    VerdictLevel level, const std::string& remedy);
+
 // The worst level over `verdicts` (kOk for none).
 VerdictLevel WorstVerdict(const std::vector<Verdict>& verdicts);
 

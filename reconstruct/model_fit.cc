@@ -129,9 +129,28 @@ std::vector<double> BandRelativeRms(const BrdfModel& model, const std::vector<Fi
   return rms;
 }
 
+// The exitant hemisphere as rings x sectors cells of equal projected solid angle: midpoints in
+// (u = cos^2 theta_o, phi_o), where cos theta_o d omega = du dphi / 2, so every cell weighs
+// pi / (rings sectors) and the weights sum to pi. DirectionalAlbedo and the albedo penalty share it.
+std::vector<Eigen::Vector3d> ProjectedSolidAngleCells(int rings, int sectors) {
+  std::vector<Eigen::Vector3d> cells;
+  cells.reserve(size_t(rings) * sectors);
+  for (int r = 0; r < rings; ++r) {
+    const double u = (r + 0.5) / rings;
+    const double cos_o = std::sqrt(u), sin_o = std::sqrt(1.0 - u);
+    for (int k = 0; k < sectors; ++k) {
+      const double phi = 2.0 * M_PI * (k + 0.5) / sectors;
+      cells.emplace_back(sin_o * std::cos(phi), sin_o * std::sin(phi), cos_o);
+    }
+  }
+  return cells;
+}
+
+double ProjectedSolidAngleCellWeight(int rings, int sectors) { return M_PI / (double(rings) * sectors); }
+
 // The albedo penalty's fixed quadrature: incidence directions (in the x-z plane: the models are
-// isotropic) and exitant points, midpoints of 16 x 32 cells in (cos^2 theta_o, phi_o) as
-// DirectionalAlbedo's, with weights cos theta_o d omega summing to pi.
+// isotropic) and 16 x 32 ProjectedSolidAngleCells, coarser than DirectionalAlbedo's 48 x 96 since
+// the solver evaluates it at every step.
 struct AlbedoQuadrature {
   std::vector<Eigen::Vector3d> wi, wo;
   std::vector<double> weights;
@@ -144,15 +163,8 @@ AlbedoQuadrature MakeAlbedoQuadrature() {
     const double theta = theta_deg * M_PI / 180.0;
     q.wi.emplace_back(std::sin(theta), 0.0, std::cos(theta));
   }
-  for (int r = 0; r < kRings; ++r) {
-    const double u = (r + 0.5) / kRings;
-    const double cos_o = std::sqrt(u), sin_o = std::sqrt(1.0 - u);
-    for (int k = 0; k < kSectors; ++k) {
-      const double phi = 2.0 * M_PI * (k + 0.5) / kSectors;
-      q.wo.emplace_back(sin_o * std::cos(phi), sin_o * std::sin(phi), cos_o);
-      q.weights.push_back(0.5 * (1.0 / kRings) * (2.0 * M_PI / kSectors));
-    }
-  }
+  q.wo = ProjectedSolidAngleCells(kRings, kSectors);
+  q.weights.assign(q.wo.size(), ProjectedSolidAngleCellWeight(kRings, kSectors));
   return q;
 }
 
@@ -625,18 +637,11 @@ nlohmann::json ToJson(const ModelFitResult& fit) {
 
 Eigen::Vector3d DirectionalAlbedo(const BrdfModel& brdf, double theta_i) {
   constexpr int kRings = 48, kSectors = 96;
+  static const std::vector<Eigen::Vector3d> cells = ProjectedSolidAngleCells(kRings, kSectors);
   const Eigen::Vector3d wi(std::sin(theta_i), 0.0, std::cos(theta_i));
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  // With u = cos^2 theta_o, cos theta_o d omega = du dphi / 2.
-  for (int r = 0; r < kRings; ++r) {
-    const double u = (r + 0.5) / kRings;
-    const double cos_o = std::sqrt(u), sin_o = std::sqrt(1.0 - u);
-    for (int k = 0; k < kSectors; ++k) {
-      const double phi = 2.0 * M_PI * (k + 0.5) / kSectors;
-      sum += brdf.Eval(wi, Eigen::Vector3d(sin_o * std::cos(phi), sin_o * std::sin(phi), cos_o));
-    }
-  }
-  return sum * (0.5 * (1.0 / kRings) * (2.0 * M_PI / kSectors));
+  for (const Eigen::Vector3d& wo : cells) sum += brdf.Eval(wi, wo);
+  return sum * ProjectedSolidAngleCellWeight(kRings, kSectors);
 }
 
 Eigen::Vector3d MaxDirectionalAlbedoPerChannel(const BrdfModel& brdf) {

@@ -71,6 +71,7 @@ struct StageArgsKey {
   std::vector<std::string> MeasurementOptions::*member;
 };
 const StageArgsKey kStageArgs[] = {{"scan_args", "--scan-args", &MeasurementOptions::scan_args},
+                                   {"response_args", "--response-args", &MeasurementOptions::response_args},
                                    {"align_args", "--align-args", &MeasurementOptions::align_args},
                                    {"lights_args", "--lights-args", &MeasurementOptions::lights_args},
                                    {"colour_args", "--colour-args", &MeasurementOptions::colour_args},

@@ -69,6 +69,7 @@ class Planner {
 
   void Synth(const Recipe& recipe);
   void Scan();
+  void Response();
   void Align();
   void Lights();
   void Colour();
@@ -125,6 +126,27 @@ void Planner::Scan() {
   const bool applies = scan.not_applicable.empty();
   Execute(scan);
   if (applies) current = At("scan/session.json");
+}
+
+// Sessions whose camera response is unknown (radiometry.response kind "unknown"): `ibrdf response`
+// measures it from the exposure brackets into DIR/response/session.json. It runs before align, as
+// every later stage that reads a photo's values linearly (the light fits, the white reference, the
+// derenderer) needs the curve; a session whose response is stated, measured or not, is used as it is.
+void Planner::Response() {
+  const std::optional<Session> session = SessionAt(current);
+  Stage response = MakeStage("response", {"response", current, "--out", At("response"), "--overwrite"}, {current},
+                             {At("response/session.json"), At("response/response.json")});
+  if (session) {
+    for (const std::string& file : session->InputFiles()) response.inputs.push_back(file);
+  }
+  response.arguments.insert(response.arguments.end(), options_.response_args.begin(), options_.response_args.end());
+  if (!session || session->radiometry.response.kind != Response::Kind::kUnknown) {
+    if (options_.stop_after != "response") return;
+    response.not_applicable = "the session states its camera response (radiometry.response)";
+  }
+  const bool applies = response.not_applicable.empty();
+  Execute(response);
+  if (applies) current = At("response/session.json");
 }
 
 // Sessions with coded targets; otherwise every photo needs its pose.
@@ -186,7 +208,8 @@ void Planner::Colour() {
   if (!session || !session->colour_chart) {
     colour.not_applicable = "the session has no colour_chart";
   } else if (session->colour_chart->matrix) {
-    colour.not_applicable = "the session's colour chart is fitted already (colour_chart.matrix); it is applied as it is";
+    colour.not_applicable =
+        "the session's colour chart is fitted already (colour_chart.matrix); it is applied as it is";
   }
   const bool applies = colour.not_applicable.empty();
   Execute(colour);
@@ -279,8 +302,8 @@ void Planner::SampleStages() {
 }  // namespace
 
 const std::vector<std::string>& MeasurementStageNames() {
-  static const std::vector<std::string> kStages = {"synth",    "scan",  "align",   "lights",      "colour",
-                                                   "derender", "check", "compare", "reconstruct", "report"};
+  static const std::vector<std::string> kStages = {"synth",    "scan",  "response", "align",       "lights", "colour",
+                                                   "derender", "check", "compare",  "reconstruct", "report"};
   return kStages;
 }
 
@@ -300,7 +323,7 @@ bool MeasurementOptions::Check(std::string* why) const {
   const std::vector<std::string>& stages = MeasurementStageNames();
   if (!stop_after.empty() && std::find(stages.begin(), stages.end(), stop_after) == stages.end()) {
     *why = "--stop-after: unknown stage \"" + stop_after +
-           "\" (synth, scan, align, lights, colour, derender, check, compare, reconstruct, report)";
+           "\" (synth, scan, response, align, lights, colour, derender, check, compare, reconstruct, report)";
     return false;
   }
   return true;
@@ -339,6 +362,7 @@ std::string RunMeasurement(const MeasurementInput& input, const MeasurementOptio
   if (fs::exists(session_dir / "truth.json")) plan.truth_path = (session_dir / "truth.json").string();
   plan.current = plan.manifest_path;
   plan.Scan();
+  plan.Response();
   plan.Align();
   plan.Lights();
   plan.Colour();

@@ -98,14 +98,16 @@ void AddTruth(const fs::path& dir, const std::string& truth_path, nlohmann::json
   (*summary)["truth"] = truth;
 }
 
-// The calibration stages' verdicts (align/alignment.json and colour/colour.json "verdicts",
-// core/verdict.h), each with its
-// stage, and every stage's warnings in one list: the verdicts that are not ok (an accepted failure
-// included, marked so), align's own warnings and derender's exposure advice.
+// The calibration stages' verdicts (response/response.json, align/alignment.json,
+// lights/white-reference.json and colour/colour.json "verdicts", core/verdict.h), each with its stage, and every
+// stage's warnings in one list: the verdicts that are not ok (an accepted failure included, marked so), align's own
+// warnings and derender's exposure advice.
 void AddVerdicts(const fs::path& dir, nlohmann::json* summary) {
   nlohmann::json verdicts = nlohmann::json::array(), warnings = nlohmann::json::array();
-  for (const auto& [stage, file] : {std::pair<std::string, std::string>{"align", "align/alignment.json"},
-                                     std::pair<std::string, std::string>{"colour", "colour/colour.json"}}) {
+  for (const auto& [stage, file] : {std::pair<std::string, std::string>{"response", "response/response.json"},
+                                    std::pair<std::string, std::string>{"align", "align/alignment.json"},
+                                    std::pair<std::string, std::string>{"lights", "lights/white-reference.json"},
+                                    std::pair<std::string, std::string>{"colour", "colour/colour.json"}}) {
     const std::optional<StageJson> stage_json = StageJson::ReadIfExists((dir / file).string());
     if (!stage_json) continue;
     const nlohmann::json list = stage_json->ValueOr("/verdicts", nlohmann::json::array());
@@ -131,7 +133,8 @@ void AddVerdicts(const fs::path& dir, nlohmann::json* summary) {
     }
   }
   if (summary->contains("samples")) {
-    for (const nlohmann::json& w : (*summary)["samples"]["exposure_warnings"]) warnings.push_back("derender: " + w.get<std::string>());
+    for (const nlohmann::json& w : (*summary)["samples"]["exposure_warnings"])
+      warnings.push_back("derender: " + w.get<std::string>());
   }
   (*summary)["verdicts"] = verdicts;
   (*summary)["warnings"] = warnings;

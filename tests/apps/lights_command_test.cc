@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -42,6 +43,51 @@ TEST(LightsCommand, SyntheticMirrorSphereAgainstTheTruth) {
   const auto again = RunIbrdf("lights calibrate " + scratch / "m" + " --out " + scratch / "lights.json");
   EXPECT_NE(again.exit_code, 0);
   EXPECT_NE(again.output.find("--overwrite"), std::string::npos) << again.output;
+}
+
+// A photo named for the wrong light: the calibrated light lies far from the stated one, and the
+// lights.nominal verdict stops the stage with nothing written, unless accepted by name (recorded).
+TEST(LightsCommand, ALightFarFromItsStatedDirectionFailsUnlessAccepted) {
+  testing::ScratchDir scratch;
+  ASSERT_EQ(RunIbrdf("lights synth --out " + scratch / "m" + " --lights 4").exit_code, 0);
+  const std::string manifest = scratch / "m/session.json";
+  {
+    nlohmann::json session = ReadJson(manifest);
+    // L01's stated direction tilted 40 degrees away from its true one (about the axis perpendicular to
+    // it and to the camera's z).
+    std::vector<double> d = session["lights"][1]["direction"].get<std::vector<double>>();
+    const double tilt = 40.0 * M_PI / 180.0;
+    const double ax = -d[1], ay = d[0], norm = std::hypot(ax, ay);
+    const double kx = ax / norm, ky = ay / norm;  // rotation axis (kx, ky, 0), Rodrigues' formula
+    const double dot = kx * d[0] + ky * d[1];
+    const double cx = ky * d[2], cy = -kx * d[2], cz = kx * d[1] - ky * d[0];
+    for (int i = 0; i < 3; ++i) {
+      const double k[3] = {kx, ky, 0.0}, c[3] = {cx, cy, cz};
+      d[i] = d[i] * std::cos(tilt) + c[i] * std::sin(tilt) + k[i] * dot * (1 - std::cos(tilt));
+    }
+    session["lights"][1]["direction"] = d;
+    std::ofstream(manifest) << session.dump(1);
+  }
+  const auto refused = RunIbrdf("lights calibrate " + scratch / "m" + " --out " + scratch / "l.json");
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.output.find("lights.nominal"), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("L01"), std::string::npos) << refused.output;
+  EXPECT_FALSE(fs::exists(scratch / "l.json"));
+  EXPECT_FALSE(fs::exists(scratch / "l.calibration.json"));
+
+  const auto accepted =
+      RunIbrdf("lights calibrate " + scratch / "m" + " --out " + scratch / "l.json --accept lights.nominal");
+  ASSERT_EQ(accepted.exit_code, 0) << accepted.output;
+  const nlohmann::json report = ReadJson(scratch / "l.calibration.json");
+  bool found = false;
+  for (const auto& v : report["verdicts"]) {
+    if (v["check"] != "lights.nominal") continue;
+    found = true;
+    EXPECT_EQ(v["verdict"], "fail");
+    EXPECT_TRUE(v["accepted"].get<bool>());
+    EXPECT_NEAR(v["value"].get<double>(), 40.0, 0.5);
+  }
+  EXPECT_TRUE(found) << report["verdicts"].dump(1);
 }
 
 TEST(LightsCommand, PointLightsFromTwoPlacements) {

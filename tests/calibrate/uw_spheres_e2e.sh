@@ -30,6 +30,10 @@ for fit in ("lafortune", "ggx"):
 page = open(f"{out}/run/report/index.html").read()
 if "relative scale" not in page: fail.append("the report does not say relative scale")
 if not os.path.exists(f"{out}/held-out.json"): fail.append("no held-out check")
+verdicts = {v["check"]: v for v in json.load(open(f"{out}/lights.calibration.json"))["verdicts"]}
+linearity = verdicts.get("lights.response_linearity", {})
+if linearity.get("verdict") != "fail" or not linearity.get("accepted"):
+    fail.append(f"the grey sphere's cosine exponent should fail lights.response_linearity, accepted: {linearity}")
 print("uw-spheres end to end:", "ok" if not fail else "FAILED: " + "; ".join(fail))
 sys.exit(1 if fail else 0)
 PY
