@@ -103,6 +103,34 @@ std::vector<Verdict> AlignmentVerdicts(const Session& input, const AlignResult& 
     v.remedy = "photograph the light's card from more directions, or check its markers' layout (targets.light)";
     verdicts.push_back(v);
   }
+  // A cylinder whose session names markers on it: align was to place it from them.
+  const bool cylinder_markers = input.sample.kind == SampleSpec::Kind::kCylinder && input.targets &&
+                                input.targets->sample;
+  if (cylinder_markers && !result.cylinder.fitted && !result.cylinder.reason.empty()) {
+    Verdict v;
+    v.check = "cylinder.fitted";
+    v.value = 0.0;
+    v.measured = "not fitted: " + result.cylinder.reason;
+    v.bound = "the cylinder's markers (targets.sample) must place it";
+    v.level = VerdictLevel::kFail;
+    v.remedy = "photograph the cylinder's markers from more views, or state its pose (sample.center, sample.axis) "
+               "as measured and accept cylinder.fitted";
+    verdicts.push_back(v);
+  }
+  if (result.cylinder.fitted) {
+    Verdict v;
+    v.check = "cylinder.marker_rms";
+    v.value = result.cylinder.rms_m;
+    v.measured = Format("corner RMS %.3g mm over %.0f markers (%.0f left out)", 1e3 * result.cylinder.rms_m,
+                        double(result.cylinder.markers), double(result.cylinder.rejected_markers));
+    v.bound = Format("warn over %.3g mm, fail over %.3g mm", 1e3 * bounds.warn_cylinder_rms_m,
+                     1e3 * bounds.fail_cylinder_rms_m);
+    v.level = VerdictAbove(v.value, bounds.warn_cylinder_rms_m, bounds.fail_cylinder_rms_m);
+    if (v.level == VerdictLevel::kOk && result.cylinder.rejected_markers > 0) v.level = VerdictLevel::kWarn;
+    v.remedy = "check the cylinder's marker corners (targets.sample) against the cylinder's radius and the "
+               "markers' placement; markers left out disagreed with the others";
+    verdicts.push_back(v);
+  }
   if (registration) {
     Verdict v;
     v.check = "mesh.registration_rms";

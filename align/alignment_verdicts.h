@@ -1,6 +1,7 @@
 // The verdicts of an alignment (core/verdict.h; bounds in docs/verdicts.md): photos posed, the
 // reprojection RMS, the sphere's radius against the stated one and its centre against the stated
-// centre, the limb evidence's balance, the light's marker spread, the mesh registration's RMS.
+// centre, the limb evidence's balance, the light's marker spread, the mesh registration's RMS, and a
+// cylinder's fit to its markers (fitted at all, its corner RMS, markers left out).
 #pragma once
 
 #include <optional>
@@ -26,6 +27,8 @@ struct AlignmentVerdictBounds {
   double fail_light_spread_m = 10e-3;    // more: fail
   double warn_mesh_rms_m = 0.5e-3;       // mesh registration's corner RMS over this: warn
   double fail_mesh_rms_m = 2e-3;         // over this: fail
+  double warn_cylinder_rms_m = 0.5e-3;   // cylinder fit's corner RMS over this: warn
+  double fail_cylinder_rms_m = 2e-3;     // over this: fail
 };
 
 // The verdicts over `result`, the alignment of `input` (whose sample and photos are the stated

@@ -414,6 +414,7 @@ nlohmann::json ResponseCalibration::ToJson() const {
   }
   return {{"format", "ibrdf-response"},
           {"version", 1},
+          {"summary", BriefReport()},
           {"method",
            "Debevec and Malik 1997 (OpenCV createCalibrateDebevec), per bracket, median over brackets "
            "and channels; Robertson (createCalibrateRobertson) as a cross-check"},

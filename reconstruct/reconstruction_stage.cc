@@ -353,21 +353,40 @@ std::string BsdfDescription(const std::string& name, const std::string& samples_
   return text.str();
 }
 
-// Relative errors of the written file, read back as a reader does, against the table over its
-// measured cells (theta <= 80 degrees, a sample of at most ~200 000 cells), each channel: all of them
-// and by theta_max band (0-25, 25-50, 50-80 degrees), each list sorted.
-void CompareWithTable(const RglBsdf& written, const MerlTable& table, const std::vector<uint8_t>& domain,
-                      std::vector<double>* errors, std::vector<std::vector<double>>* band_errors) {
+std::string Percent(double fraction) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.2f %%", 100.0 * fraction);
+  return text;
+}
+
+std::string BandFigures(double median, double p99, double max) {
+  return "median " + Percent(median) + ", p99 " + Percent(p99) + ", max " + Percent(max);
+}
+
+// The written file, read back as a reader does, over the table's measured cells (theta <= 80 degrees,
+// a sample of at most ~200 000 cells), each channel: its relative error against the table, and its
+// reciprocity |f(wi, wo) - f(wo, wi)| / their mean (the table is reciprocal by construction, the
+// file's interpolation in its warped grids is not), all cells and by theta_max band (0-25, 25-50,
+// 50-80 degrees), each list sorted.
+struct TableReadBack {
+  std::vector<double> errors, reciprocity;
+  std::vector<std::vector<double>> band_errors, band_reciprocity;
+  // The worst cell against the table: file / table there, and where (theta_i, theta_e, delta_phi, degrees).
+  double worst_ratio = 1.0;
+  Eigen::Vector3d worst_at_deg = Eigen::Vector3d::Zero();
+};
+
+TableReadBack CompareWithTable(const RglBsdf& written, const MerlTable& table, const std::vector<uint8_t>& domain) {
   std::vector<size_t> cells;
   for (size_t flat = 0; flat < domain.size(); ++flat) {
     if (domain[flat] == uint8_t(DomainClass::kMeasured)) cells.push_back(flat);
   }
   const size_t stride = std::max<size_t>(1, cells.size() / 200000);
-  // Each checked cell's band (-1: beyond 80 degrees) and relative errors (-1: no positive table value),
-  // TBB-parallel; gathered in cell order after.
+  // Each checked cell's band (-1: beyond 80 degrees), relative errors and reciprocity (-1: no positive
+  // table value), TBB-parallel; gathered in cell order after.
   const size_t checked = (cells.size() + stride - 1) / stride;
   std::vector<int8_t> cell_band(checked, -1);
-  std::vector<Eigen::Vector3d> cell_errors(checked);
+  std::vector<Eigen::Vector3d> cell_errors(checked), cell_reciprocity(checked);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, checked, 1024), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t m = range.begin(); m != range.end(); ++m) {
       const size_t flat = cells[m * stride];
@@ -377,26 +396,52 @@ void CompareWithTable(const RglBsdf& written, const MerlTable& table, const std:
       FromHalfDiff(MerlCellCentre(i_h, i_d, i_p), &wi, &wo);
       const double theta_max = std::acos(std::min(wi.z(), wo.z())) * 180 / M_PI;
       if (theta_max > 80.0) continue;
-      const Eigen::Vector3d t = table.Cell(flat), g = written.Eval(wi, wo);
+      const Eigen::Vector3d t = table.Cell(flat), g = written.Eval(wi, wo), swapped = written.Eval(wo, wi);
       cell_band[m] = static_cast<int8_t>(theta_max < 25.0 ? 0 : theta_max < 50.0 ? 1 : 2);
-      for (int c = 0; c < 3; ++c) cell_errors[m][c] = t[c] > 0.0 ? std::abs(g[c] - t[c]) / t[c] : -1.0;
+      for (int c = 0; c < 3; ++c) {
+        cell_errors[m][c] = t[c] > 0.0 ? std::abs(g[c] - t[c]) / t[c] : -1.0;
+        cell_reciprocity[m][c] =
+            t[c] > 0.0 && g[c] + swapped[c] > 0.0 ? 2.0 * std::abs(g[c] - swapped[c]) / (g[c] + swapped[c]) : -1.0;
+      }
     }
   });
-  errors->clear();
-  band_errors->assign(3, {});
+  TableReadBack back;
+  double worst = -1.0;
+  for (size_t m = 0; m < checked; ++m) {
+    for (int c = 0; c < 3 && cell_band[m] >= 0; ++c) {
+      if (cell_errors[m][c] <= worst) continue;
+      worst = cell_errors[m][c];
+      const size_t flat = cells[m * stride];
+      Eigen::Vector3d wi, wo;
+      FromHalfDiff(MerlCellCentre(int(flat / (size_t(kMerlThetaD) * kMerlPhiD)), int(flat / kMerlPhiD % kMerlThetaD),
+                                  int(flat % kMerlPhiD)),
+                   &wi, &wo);
+      const double t = table.Cell(flat)[c];
+      back.worst_ratio = written.Eval(wi, wo)[c] / t;
+      const double dphi = std::abs(std::remainder(std::atan2(wo.y(), wo.x()) - std::atan2(wi.y(), wi.x()), 2 * M_PI));
+      back.worst_at_deg = Eigen::Vector3d(std::acos(wi.z()), std::acos(wo.z()), dphi) * (180.0 / M_PI);
+    }
+  }
+  back.band_errors.assign(3, {});
+  back.band_reciprocity.assign(3, {});
   for (size_t m = 0; m < checked; ++m) {
     if (cell_band[m] < 0) continue;
     for (int c = 0; c < 3; ++c) {
-      if (cell_errors[m][c] < 0.0) continue;
-      errors->push_back(cell_errors[m][c]);
-      (*band_errors)[cell_band[m]].push_back(errors->back());
+      if (cell_errors[m][c] >= 0.0) {
+        back.errors.push_back(cell_errors[m][c]);
+        back.band_errors[cell_band[m]].push_back(cell_errors[m][c]);
+      }
+      if (cell_reciprocity[m][c] >= 0.0) {
+        back.reciprocity.push_back(cell_reciprocity[m][c]);
+        back.band_reciprocity[cell_band[m]].push_back(cell_reciprocity[m][c]);
+      }
     }
   }
-  // Each list sorted once (the bands beside the whole), then read at its quantiles.
-  tbb::parallel_for(0, 4, [&](int list) {
-    std::vector<double>& sorted = list < 3 ? (*band_errors)[list] : *errors;
-    std::sort(sorted.begin(), sorted.end());
-  });
+  // Each list sorted once, then read at its quantiles.
+  std::vector<std::vector<double>*> lists = {&back.errors, &back.reciprocity};
+  for (int b = 0; b < 3; ++b) lists.insert(lists.end(), {&back.band_errors[b], &back.band_reciprocity[b]});
+  tbb::parallel_for(size_t(0), lists.size(), [&](size_t list) { std::sort(lists[list]->begin(), lists[list]->end()); });
+  return back;
 }
 
 // NAME.bsdf from the regression (measured and interpolated nodes) and, where it has no data, the chosen
@@ -466,23 +511,31 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
 
   // Read back as a reader does and compare with the table over its measured cells (theta <= 80).
   const RglBsdf written(tmp + "/" + file_name);
-  std::vector<double> errors;
-  std::vector<std::vector<double>> band_errors;
-  CompareWithTable(written, table, domain, &errors, &band_errors);
+  const TableReadBack back = CompareWithTable(written, table, domain);
   auto quantile = [](const std::vector<double>& sorted, double q) {
     if (sorted.empty()) return 0.0;
     return sorted[std::min(sorted.size() - 1, size_t(q * double(sorted.size())))];
   };
-  nlohmann::json bands = nlohmann::json::object();
+  auto figures = [&](const std::vector<double>& sorted) -> nlohmann::json {
+    return {{"median", quantile(sorted, 0.5)},
+            {"p95", quantile(sorted, 0.95)},
+            {"p99", quantile(sorted, 0.99)},
+            {"max", sorted.empty() ? 0.0 : sorted.back()},
+            {"values", sorted.size()}};
+  };
+  nlohmann::json bands = nlohmann::json::object(), reciprocity_bands = nlohmann::json::object();
   const char* band_names[] = {"0-25", "25-50", "50-80"};
   for (int b = 0; b < 3; ++b) {
-    bands[band_names[b]] = {{"median", quantile(band_errors[b], 0.5)},
-                            {"p95", quantile(band_errors[b], 0.95)},
-                            {"values", band_errors[b].size()}};
+    bands[band_names[b]] = figures(back.band_errors[b]);
+    reciprocity_bands[band_names[b]] = figures(back.band_reciprocity[b]);
   }
+  const std::vector<double>& errors = back.errors;
   result->bsdf_written = true;
   result->bsdf_median_error = quantile(errors, 0.5);
   result->bsdf_p95_error = quantile(errors, 0.95);
+  result->bsdf_p99_error = quantile(errors, 0.99);
+  result->bsdf_max_error = errors.empty() ? 0.0 : errors.back();
+  result->bsdf_p99_reciprocity = quantile(back.reciprocity, 0.99);
   (*timings)["bsdf_s"] = timer.ElapsedSeconds();
   const BsdfExportOptions& o = options.bsdf_export;
   result->summary["bsdf"] = {
@@ -505,16 +558,29 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
        {{"domain", "measured cells (domain.npy 2), theta_i, theta_e <= 80 deg, every channel"},
         {"median", result->bsdf_median_error},
         {"p95", result->bsdf_p95_error},
+        {"p99", result->bsdf_p99_error},
+        {"max", result->bsdf_max_error},
         {"values", errors.size()},
+        {"worst", {{"file_over_table", back.worst_ratio},
+                   {"theta_i_deg", back.worst_at_deg[0]},
+                   {"theta_e_deg", back.worst_at_deg[1]},
+                   {"delta_phi_deg", back.worst_at_deg[2]}}},
         {"by_theta_max_deg", bands}}},
+      {"reciprocity",
+       {{"domain", "the same cells: |f(wi, wo) - f(wo, wi)| / their mean, as read back from the file"},
+        {"median", quantile(back.reciprocity, 0.5)},
+        {"p99", result->bsdf_p99_reciprocity},
+        {"max", back.reciprocity.empty() ? 0.0 : back.reciprocity.back()},
+        {"values", back.reciprocity.size()},
+        {"by_theta_max_deg", reciprocity_bands}}},
       {"build_s", build_s}};
   Log(1, "wrote " + file_name + " (RGL .bsdf; " + std::to_string(classes.unmeasured) + " of " + std::to_string(nodes) +
              " nodes unmeasured" +
              (classes.unmeasured ? chosen ? ", filled with the " + chosen->ModelName() + " fit" : ", extrapolated or 0"
                                  : std::string()) +
-             "); read back against the table's measured cells: median " +
-             std::to_string(100 * result->bsdf_median_error) + " %, 95th percentile " +
-             std::to_string(100 * result->bsdf_p95_error) + " %");
+             "); read back against the table's measured cells: " + BandFigures(result->bsdf_median_error,
+             result->bsdf_p99_error, result->bsdf_max_error) + "; the file's reciprocity p99 " +
+             Percent(result->bsdf_p99_reciprocity));
 }
 
 nlohmann::json RegressionJson(const ReconstructOptions& options, const LocalRegressionOptions& r,

@@ -80,6 +80,9 @@ struct ReconstructResult {
   bool bsdf_written = false;                // NAME.bsdf was written
   double bsdf_median_error = 0.0;           // the .bsdf against the table over the measured cells: median
   double bsdf_p95_error = 0.0;              // and 95th percentile relative error (all channels)
+  double bsdf_p99_error = 0.0;              // 99th percentile
+  double bsdf_max_error = 0.0;              // largest
+  double bsdf_p99_reciprocity = 0.0;        // the file's reciprocity over the same cells, 99th percentile
   double total_s = 0.0;                     // wall time of the stage
   nlohmann::json summary;                   // summary.json as written
   // One line: samples, points, cells, fit and truth errors, time.

@@ -917,14 +917,17 @@ def _fmt(value, scale=1.0, digits=3):
 
 
 def acquisition_html(run_dir, side):
-    """What the calibration stages found (align/alignment.json, lights/white-reference.json,
-    colour/colour.json): the verdicts as a pass/fail table, each photo's markers and residual, the
+    """What the calibration stages found (response/response.json, align/alignment.json,
+    lights/white-reference.json, colour/colour.json): the verdicts as a pass/fail table, each photo's markers and residual, the
     sample's fit, the light, the white reference, the colour fit per patch, and the clipped pixels."""
     align = load_json(os.path.join(run_dir, "align", "alignment.json"))
     white = load_json(os.path.join(run_dir, "lights", "white-reference.json"))
     colour = load_json(os.path.join(run_dir, "colour", "colour.json"))
+    response = load_json(os.path.join(run_dir, "response", "response.json"))
     parts = []
-    verdicts = (align or {}).get("verdicts", []) + (colour or {}).get("verdicts", [])
+    verdicts = []
+    for stage_json in (response, align, white, colour):
+        verdicts += (stage_json or {}).get("verdicts", [])
     if verdicts:
         names = {"ok": "pass", "warn": "warn", "fail": "FAIL"}
         parts.append("<h3>Checks</h3>" + _table(
@@ -964,6 +967,9 @@ def acquisition_html(run_dir, side):
                     [[", ".join(_fmt(v, 1, 5) for v in light.get("position", [])), _fmt(light.get("spread_m"), 1e3)]]))
             else:
                 parts.append(f"<h3>Light</h3><p>As the session states it ({html.escape(str(light.get('reason', '')))}).</p>")
+    if response:
+        parts.append(f"<h3>Camera response</h3><p>Measured from exposure brackets (ibrdf response): "
+                     f"{html.escape(str(response.get('summary', '')))}</p>")
     if white:
         scalars = [[k, v] for k, v in white.items() if isinstance(v, (int, float, str)) and k not in ("format", "version")]
         parts.append("<h3>White reference</h3>" + _table(["field", "value"], scalars))
@@ -991,7 +997,7 @@ def acquisition_html(run_dir, side):
 
 
 def notices_html(run_dir, side):
-    """Every calibration verdict that is not ok (align/alignment.json), the stages' warnings and the
+    """Every calibration verdict that is not ok (response, align, lights white, colour), the stages' warnings and the
     samples' scale, at the top of the report: what the run could not trust, or had to be told."""
     items = []
     if side.get("intensity_scale") == "relative":
@@ -999,8 +1005,10 @@ def notices_html(run_dir, side):
                       "measured, the scale not): every BRDF value here, the table and the fits are the material's "
                       "times one unknown constant"))
     align = load_json(os.path.join(run_dir, "align", "alignment.json")) or {}
-    colour = load_json(os.path.join(run_dir, "colour", "colour.json")) or {}
-    for stage, stage_json in (("align", align), ("colour", colour)):
+    stage_jsons = [("response", load_json(os.path.join(run_dir, "response", "response.json")) or {}), ("align", align),
+                   ("lights", load_json(os.path.join(run_dir, "lights", "white-reference.json")) or {}),
+                   ("colour", load_json(os.path.join(run_dir, "colour", "colour.json")) or {})]
+    for stage, stage_json in stage_jsons:
         for v in stage_json.get("verdicts", []):
             if v.get("verdict") == "ok":
                 continue

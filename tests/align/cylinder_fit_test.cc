@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "align/aligner.h"
+#include "align/alignment_verdicts.h"
 #include "core/math.h"
 #include "derender/derenderer.h"
 #include "reconstruct/truth_comparison.h"
@@ -100,6 +101,25 @@ TEST(CylinderFit, CylinderSessionFromItsOwnPhotos) {
   const double axis_error_deg = std::acos(std::min(1.0, result.session.sample.axis.dot(truth.sample.axis))) / kDegree;
   EXPECT_LT(centre_error, 0.2e-3);
   EXPECT_LT(axis_error_deg, 0.2);
+  // The fit's verdicts: placed, corners within 0.5 mm. With the cylinder's markers out of every view
+  // the fit fails, and so does its verdict: the guessed pose is never used silently.
+  const auto verdict_of = [](const std::vector<Verdict>& verdicts, const std::string& check) {
+    for (const Verdict& v : verdicts) {
+      if (v.check == check) return v.level;
+    }
+    return VerdictLevel::kOk;
+  };
+  const std::vector<Verdict> verdicts = AlignmentVerdicts(guess, result, std::nullopt);
+  EXPECT_EQ(verdict_of(verdicts, "cylinder.marker_rms"), VerdictLevel::kOk);
+  EXPECT_EQ(verdict_of(verdicts, "cylinder.fitted"), VerdictLevel::kOk);
+  AlignResult unplaced = result;
+  unplaced.cylinder = CylinderFit();
+  unplaced.cylinder.reason = "only 1 of the sample's markers posed (need 2)";
+  EXPECT_EQ(verdict_of(AlignmentVerdicts(guess, unplaced, std::nullopt), "cylinder.fitted"), VerdictLevel::kFail);
+  AlignResult loose = result;
+  loose.cylinder.rms_m = 3e-3;
+  EXPECT_EQ(verdict_of(AlignmentVerdicts(guess, loose, std::nullopt), "cylinder.marker_rms"), VerdictLevel::kFail);
+
   std::cout << "cylinder: cameras within " << 1e3 * worst_position << " mm and " << worst_rotation << " deg; centre "
             << 1e3 * centre_error << " mm, axis " << axis_error_deg << " deg\n";
 
