@@ -10,7 +10,6 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
-#include <Eigen/Cholesky>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -189,9 +188,6 @@ class PairFit {
   static constexpr int kParams = 11;  // 1, d (3), d d^T (6), the A-side offset
   static constexpr int kMaxSamples = 128;  // samples a fit holds (FindPartner takes at most 64 a side)
   static constexpr double kCurvaturePrior = 1e-5;
-  using Vector = Eigen::Matrix<double, kParams, 1>;
-  using Matrix = Eigen::Matrix<double, kParams, kParams>;
-
   PairFit(const Eigen::Vector3d& q, double radius) : q_(q), inv_radius_(1.0 / radius) {}
 
   // A sample at `point` (near q) with weight `weight`. Only its design row is kept: Solve forms the
@@ -243,17 +239,29 @@ class PairFit {
         for (int j = 0; j < kParams; ++j) rhs[c][j] += wl * x[j];
       }
     }
-    Matrix penalized;
-    for (int i = 0; i < kParams; ++i) {
-      for (int j = i; j < kParams; ++j) penalized(j, i) = normal[i][j];
-    }
     const double prior = kCurvaturePrior * normal[0][0];  // times the summed weight
-    for (int i = 4; i < 10; ++i) penalized(i, i) += prior;
-    const Eigen::LLT<Matrix, Eigen::Lower> llt(penalized);
-    if (llt.info() != Eigen::Success) return false;
-    Vector unit = Vector::Zero();
-    unit[kParams - 1] = 1.0;
-    const Vector column = llt.solve(unit);  // the inverse's last column
+    for (int i = 4; i < 10; ++i) normal[i][i] += prior;
+    // The inverse's last column M^-1 e by Cholesky, M = L L^T, written out for the one right-hand side:
+    // L y = e is y = e / L(10, 10), and L^T column = y is one back substitution.
+    double l[kParams][kParams];  // l[i][j] = L(i, j), j <= i
+    for (int j = 0; j < kParams; ++j) {
+      double pivot = normal[j][j];
+      for (int k = 0; k < j; ++k) pivot -= l[j][k] * l[j][k];
+      if (!(pivot > 0.0)) return false;  // not positive definite: singular
+      l[j][j] = std::sqrt(pivot);
+      const double inv = 1.0 / l[j][j];
+      for (int i = j + 1; i < kParams; ++i) {
+        double sum = normal[j][i];  // M(i, j), i > j
+        for (int k = 0; k < j; ++k) sum -= l[i][k] * l[j][k];
+        l[i][j] = sum * inv;
+      }
+    }
+    double column[kParams];
+    for (int i = kParams - 1; i >= 0; --i) {
+      double sum = i == kParams - 1 ? 1.0 / l[i][i] : 0.0;
+      for (int k = i + 1; k < kParams; ++k) sum -= l[k][i] * column[k];
+      column[i] = sum / l[i][i];
+    }
     double v = 0.0;
     for (int r = 0; r < rows_; ++r) {
       double projection = 0.0;
