@@ -152,9 +152,9 @@ class SampleGrid {
       for (int y = c.y() - 1; y <= c.y() + 1; ++y) {
         if (y < lo_.y() || y > hi_.y()) continue;
         const size_t column = Column(Eigen::Vector3i(x, y, 0));
-        const auto begin = z_.begin() + columns_[column], end = z_.begin() + columns_[column + 1];
-        for (auto it = std::lower_bound(begin, end, c.z() - 1); it != end && *it <= c.z() + 1; ++it) {
-          const size_t k = size_t(it - z_.begin());
+        const int *const begin = z_.data() + columns_[column], *const end = z_.data() + columns_[column + 1];
+        for (const int* it = LowerBound(begin, end, c.z() - 1); it != end && *it <= c.z() + 1; ++it) {
+          const size_t k = size_t(it - z_.data());
           const double squared_distance = (points_[k].cast<double>() - center).squaredNorm();
           if (squared_distance <= radius * radius) visit(entries_[k], squared_distance);
         }
@@ -163,6 +163,20 @@ class SampleGrid {
   }
 
  private:
+  // std::lower_bound without the branch per step (its mispredictions cost more than the columns' few
+  // dozen entries): the first of [begin, end) not below `key`.
+  static const int* LowerBound(const int* begin, const int* end, int key) {
+    size_t n = size_t(end - begin);
+    if (n == 0) return end;
+    const int* base = begin;
+    while (n > 1) {
+      const size_t half = n / 2;
+      base = base[half] < key ? base + half : base;
+      n -= half;
+    }
+    return base + (*base < key ? 1 : 0);
+  }
+
   Eigen::Vector3i Cell(const Eigen::Vector3d& p) const {
     // The embedding is bounded by pi/2 in every coordinate, so the cells fit an int.
     return {int(std::floor(p[0] / cell_)), int(std::floor(p[1] / cell_)), int(std::floor(p[2] / cell_))};
