@@ -9,7 +9,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
-#include <tbb/parallel_sort.h>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -124,12 +123,12 @@ class SampleGrid {
 
   // Single precision: the sample file's angles and values are floats.
   struct Entry {
-    uint32_t index = 0;         // sample index
-    bool positive = false;      // every channel's value > 0 (its log is finite)
-    Eigen::Vector3f point;      // embedded point
+    uint32_t index = 0;          // sample index
+    bool positive = false;       // every channel's value > 0 (its log is finite)
+    Eigen::Vector3f point;       // embedded point
     Eigen::Vector3f reciprocal;  // embedded point of its reciprocal configuration
-    Eigen::Vector3f value;      // brdf per channel
-    Eigen::Vector3f log_value;  // log brdf per channel (0 where not positive)
+    Eigen::Vector3f value;       // brdf per channel
+    Eigen::Vector3f log_value;   // log brdf per channel (0 where not positive)
     // The embedded point of its image under `symmetry` (as Image computes it, in single precision).
     Eigen::Vector3f ImageOf(Symmetry symmetry) const {
       switch (symmetry) {
@@ -199,7 +198,7 @@ class SampleGrid {
 // of A over B at q, is free of both (to third order in the radius).
 class PairFit {
  public:
-  static constexpr int kParams = 11;  // 1, d (3), d d^T (6), the A-side offset
+  static constexpr int kParams = 11;       // 1, d (3), d d^T (6), the A-side offset
   static constexpr int kMaxSamples = 128;  // samples a fit holds (FindPartner takes at most 64 a side)
   static constexpr double kCurvaturePrior = 1e-5;
   PairFit(const Eigen::Vector3d& q, double radius) : q_(q), inv_radius_(1.0 / radius) {}
