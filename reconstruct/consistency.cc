@@ -9,8 +9,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
-#include <tbb/parallel_sort.h>
-#include <Eigen/Cholesky>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -46,17 +44,28 @@ Eigen::Vector3d Image(Symmetry symmetry, const BrdfSample& s) {
 // The samples in a grid of cells `cell` radians wide, for neighbourhood queries: the usable samples
 // sorted by cell (x, y, z) and index, so a column of cells (x, y) is one run of the arrays, found by a
 // dense (x, y) table, and its cells z - 1 .. z + 1 one stretch of it. Each entry keeps its embedded
-// point, the embedded points of its reciprocal and mirrored configurations, and the log of its value.
+// point, the embedded point of its reciprocal configuration (the mirrored one is the point reflected
+// in z), and its value and log.
 class SampleGrid {
  public:
   SampleGrid(const std::vector<BrdfSample>& samples, const std::vector<uint32_t>& usable, double cell) : cell_(cell) {
     const size_t n = usable.size();
-    std::vector<Eigen::Vector3i> cells(n);
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
-      const BrdfSample& s = samples[usable[i]];
-      cells[i] = Cell(Embed(s.theta_i, s.theta_e, s.delta_phi));
-    });
     if (n == 0) return;
+    // One cosine and sine of delta_phi per sample give all three embedded points (Embed, Image): the
+    // point (theta_i, theta_e c, theta_e s), its reciprocal (theta_e, theta_i c, -theta_i s) and its
+    // mirror (theta_i, theta_e c, -theta_e s), bit for bit as Embed computes them (cos is even, sin odd).
+    // Computed twice, for the cells and for the sorted entries, rather than kept in a second copy of
+    // the entries (whose fresh pages cost more than the sines).
+    auto point_of = [&](const BrdfSample& s, double* c, double* sn) {
+      *c = std::cos(double(s.delta_phi));
+      *sn = std::sin(double(s.delta_phi));
+      return Eigen::Vector3d(s.theta_i, s.theta_e * *c, s.theta_e * *sn);
+    };
+    std::vector<Eigen::Vector3i> cells(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
+      double c, sn;
+      for (size_t i = range.begin(); i < range.end(); ++i) cells[i] = Cell(point_of(samples[usable[i]], &c, &sn));
+    });
     lo_ = hi_ = cells[0].head<2>();
     for (const Eigen::Vector3i& c : cells) {
       lo_ = lo_.cwiseMin(c.head<2>());
@@ -64,45 +73,72 @@ class SampleGrid {
     }
     size_x_ = hi_.x() - lo_.x() + 1;
     size_y_ = hi_.y() - lo_.y() + 1;
-    // Sorted by (x, y, z), then by sample index: within a cell the samples keep their file order, so the
-    // sums over a neighbourhood add them in the same order on any thread count (the same bits).
-    std::vector<uint32_t> order(n);
-    for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
-    tbb::parallel_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-      const Eigen::Vector3i &ca = cells[a], &cb = cells[b];
-      if (ca.x() != cb.x()) return ca.x() < cb.x();
-      if (ca.y() != cb.y()) return ca.y() < cb.y();
-      if (ca.z() != cb.z()) return ca.z() < cb.z();
-      return a < b;
-    });
-    entries_.resize(n);
-    z_.resize(n);
-    tbb::parallel_for(size_t(0), n, [&](size_t k) {
-      const uint32_t index = usable[order[k]];
-      const BrdfSample& s = samples[index];
-      Entry& e = entries_[k];
-      e.index = index;
-      z_[k] = cells[order[k]].z();
-      e.point = Embed(s.theta_i, s.theta_e, s.delta_phi).cast<float>();
-      e.image[int(Symmetry::kReciprocity)] = Image(Symmetry::kReciprocity, s).cast<float>();
-      e.image[int(Symmetry::kBilateral)] = Image(Symmetry::kBilateral, s).cast<float>();
-      e.positive = s.brdf[0] > 0.0f && s.brdf[1] > 0.0f && s.brdf[2] > 0.0f;
-      e.value = Eigen::Vector3f(s.brdf[0], s.brdf[1], s.brdf[2]);
-      for (int c = 0; c < 3; ++c) e.log_value[c] = e.positive ? std::log(s.brdf[c]) : 0.0f;
-    });
+    // Sorted by (x, y, z), then by sample index: two stable counting sorts, by z and then by column, so
+    // that within a cell the samples keep their file order and the sums over a neighbourhood add them
+    // in the same order on any thread count (the same bits).
+    int z_lo = cells[0].z(), z_hi = cells[0].z();
+    for (const Eigen::Vector3i& c : cells) {
+      z_lo = std::min(z_lo, c.z());
+      z_hi = std::max(z_hi, c.z());
+    }
+    std::vector<uint32_t> by_z(n), order(n);
+    {
+      std::vector<size_t> next(size_t(z_hi - z_lo) + 2, 0);
+      for (size_t i = 0; i < n; ++i) ++next[size_t(cells[i].z() - z_lo) + 1];
+      for (size_t z = 1; z < next.size(); ++z) next[z] += next[z - 1];
+      for (size_t i = 0; i < n; ++i) by_z[next[size_t(cells[i].z() - z_lo)]++] = uint32_t(i);
+    }
     columns_.assign(size_t(size_x_) * size_y_ + 1, 0);
-    for (size_t k = 0; k < n; ++k) ++columns_[Column(cells[order[k]]) + 1];
+    for (size_t i = 0; i < n; ++i) ++columns_[Column(cells[i]) + 1];
     for (size_t c = 1; c < columns_.size(); ++c) columns_[c] += columns_[c - 1];
+    {
+      std::vector<size_t> next(columns_.begin(), columns_.end() - 1);
+      for (const uint32_t i : by_z) order[next[Column(cells[i])]++] = i;
+    }
+    // The entries filled in file order (reading the samples in sequence), each to its sorted place.
+    std::vector<uint32_t>& rank = by_z;
+    for (size_t k = 0; k < n; ++k) rank[order[k]] = uint32_t(k);
+    entries_.resize(n);
+    points_.resize(n);
+    z_.resize(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i < range.end(); ++i) {
+        const size_t k = rank[i];
+        const uint32_t index = usable[i];
+        const BrdfSample& s = samples[index];
+        double c, sn;
+        const Eigen::Vector3d point = point_of(s, &c, &sn);
+        Entry& e = entries_[k];
+        e.index = index;
+        e.point = point.cast<float>();
+        e.reciprocal = Eigen::Vector3d(s.theta_e, s.theta_i * c, -(s.theta_i * sn)).cast<float>();
+        e.positive = s.brdf[0] > 0.0f && s.brdf[1] > 0.0f && s.brdf[2] > 0.0f;
+        e.value = Eigen::Vector3f(s.brdf[0], s.brdf[1], s.brdf[2]);
+        for (int ch = 0; ch < 3; ++ch) e.log_value[ch] = e.positive ? std::log(s.brdf[ch]) : 0.0f;
+        points_[k] = e.point;
+        z_[k] = cells[i].z();
+      }
+    });
   }
 
   // Single precision: the sample file's angles and values are floats.
   struct Entry {
-    uint32_t index = 0;         // sample index
-    bool positive = false;      // every channel's value > 0 (its log is finite)
-    Eigen::Vector3f point;      // embedded point
-    Eigen::Vector3f image[2];   // embedded point of its image under each Symmetry
-    Eigen::Vector3f value;      // brdf per channel
-    Eigen::Vector3f log_value;  // log brdf per channel (0 where not positive)
+    uint32_t index = 0;          // sample index
+    bool positive = false;       // every channel's value > 0 (its log is finite)
+    Eigen::Vector3f point;       // embedded point
+    Eigen::Vector3f reciprocal;  // embedded point of its reciprocal configuration
+    Eigen::Vector3f value;       // brdf per channel
+    Eigen::Vector3f log_value;   // log brdf per channel (0 where not positive)
+    // The embedded point of its image under `symmetry` (as Image computes it, in single precision).
+    Eigen::Vector3f ImageOf(Symmetry symmetry) const {
+      switch (symmetry) {
+        case Symmetry::kReciprocity:
+          return reciprocal;
+        case Symmetry::kBilateral:
+          return {point[0], point[1], -point[2]};
+      }
+      UnhandledKind("Symmetry", int(symmetry));
+    }
   };
 
   // Calls visit(entry, squared distance) for every entry within `radius` (<= the cell size) of
@@ -115,17 +151,31 @@ class SampleGrid {
       for (int y = c.y() - 1; y <= c.y() + 1; ++y) {
         if (y < lo_.y() || y > hi_.y()) continue;
         const size_t column = Column(Eigen::Vector3i(x, y, 0));
-        const auto begin = z_.begin() + columns_[column], end = z_.begin() + columns_[column + 1];
-        for (auto it = std::lower_bound(begin, end, c.z() - 1); it != end && *it <= c.z() + 1; ++it) {
-          const Entry& e = entries_[size_t(it - z_.begin())];
-          const double squared_distance = (e.point.cast<double>() - center).squaredNorm();
-          if (squared_distance <= radius * radius) visit(e, squared_distance);
+        const int *const begin = z_.data() + columns_[column], *const end = z_.data() + columns_[column + 1];
+        for (const int* it = LowerBound(begin, end, c.z() - 1); it != end && *it <= c.z() + 1; ++it) {
+          const size_t k = size_t(it - z_.data());
+          const double squared_distance = (points_[k].cast<double>() - center).squaredNorm();
+          if (squared_distance <= radius * radius) visit(entries_[k], squared_distance);
         }
       }
     }
   }
 
  private:
+  // std::lower_bound without the branch per step (its mispredictions cost more than the columns' few
+  // dozen entries): the first of [begin, end) not below `key`.
+  static const int* LowerBound(const int* begin, const int* end, int key) {
+    size_t n = size_t(end - begin);
+    if (n == 0) return end;
+    const int* base = begin;
+    while (n > 1) {
+      const size_t half = n / 2;
+      base = base[half] < key ? base + half : base;
+      n -= half;
+    }
+    return base + (*base < key ? 1 : 0);
+  }
+
   Eigen::Vector3i Cell(const Eigen::Vector3d& p) const {
     // The embedding is bounded by pi/2 in every coordinate, so the cells fit an int.
     return {int(std::floor(p[0] / cell_)), int(std::floor(p[1] / cell_)), int(std::floor(p[2] / cell_))};
@@ -138,6 +188,7 @@ class SampleGrid {
   std::vector<size_t> columns_;  // column (x, y) holds entries [columns_[c], columns_[c + 1])
   std::vector<int> z_;           // z cell of each entry (increasing within a column)
   std::vector<Entry> entries_;
+  std::vector<Eigen::Vector3f> points_;  // each entry's point again, packed: what a query scans
 };
 
 // The joint local fit of one pair (see consistency.h): log f = c + g . d + d^T H d / 2 + delta [A side],
@@ -147,22 +198,32 @@ class SampleGrid {
 // of A over B at q, is free of both (to third order in the radius).
 class PairFit {
  public:
-  static constexpr int kParams = 11;  // 1, d (3), d d^T (6), the A-side offset
+  static constexpr int kParams = 11;       // 1, d (3), d d^T (6), the A-side offset
+  static constexpr int kMaxSamples = 128;  // samples a fit holds (FindPartner takes at most 64 a side)
   static constexpr double kCurvaturePrior = 1e-5;
-  using Vector = Eigen::Matrix<double, kParams, 1>;
-  using Matrix = Eigen::Matrix<double, kParams, kParams>;
-
   PairFit(const Eigen::Vector3d& q, double radius) : q_(q), inv_radius_(1.0 / radius) {}
 
-  // A sample at `point` (near q) with weight `weight`.
+  // A sample at `point` (near q) with weight `weight`. Only its design row is kept: Solve forms the
+  // normal equations in one pass over the rows, by hand on the lower triangle (an 11-parameter outer
+  // product per sample through Eigen's general rank update cost several times as much).
   void Add(const Eigen::Vector3f& point, const Eigen::Vector3f& log_value, bool side_a, double weight) {
+    IBRDF_CHECK(rows_ < kMaxSamples);
     const Eigen::Vector3d d = (point.cast<double>() - q_) * inv_radius_;
-    Vector x;
-    x << 1.0, d[0], d[1], d[2], 0.5 * d[0] * d[0], 0.5 * d[1] * d[1], 0.5 * d[2] * d[2], d[0] * d[1], d[0] * d[2],
-        d[1] * d[2], side_a ? 1.0 : 0.0;
-    normal_.selfadjointView<Eigen::Lower>().rankUpdate(x, weight);
-    squared_weights_.selfadjointView<Eigen::Lower>().rankUpdate(x, weight * weight);
-    for (int c = 0; c < 3; ++c) rhs_.col(c) += (weight * log_value[c]) * x;
+    double* x = x_[rows_];
+    x[0] = 1.0;
+    x[1] = d[0];
+    x[2] = d[1];
+    x[3] = d[2];
+    x[4] = 0.5 * d[0] * d[0];
+    x[5] = 0.5 * d[1] * d[1];
+    x[6] = 0.5 * d[2] * d[2];
+    x[7] = d[0] * d[1];
+    x[8] = d[0] * d[2];
+    x[9] = d[1] * d[2];
+    x[10] = side_a ? 1.0 : 0.0;
+    weight_[rows_] = weight;
+    for (int c = 0; c < 3; ++c) log_value_[rows_][c] = log_value[c];
+    ++rows_;
     ++count_[side_a ? 1 : 0];
   }
 
@@ -171,31 +232,72 @@ class PairFit {
   // the samples do not determine (across two sheets of samples) shrinks to none instead of trading
   // against delta, while one they do determine (along the sheets, where a sharp highlight bends) is
   // fitted. The variance is that of the weighted, penalized estimate (M^-1 X^T W^2 X M^-1, M the
-  // penalized X^T W X): 1 when side A is one sample and side B's fit exact, less with more. False
-  // where the fit is singular or the variance exceeds `max_variance`.
+  // penalized X^T W X), e^T M^-1 X^T W^2 X M^-1 e = sum of w^2 (x . M^-1 e)^2: 1 when side A is one
+  // sample and side B's fit exact, less with more. False where the fit is singular or the variance
+  // exceeds `max_variance`.
   bool Solve(double max_variance, Eigen::Vector3d* delta, double* variance) const {
     if (count_[0] + count_[1] < kParams) return false;
-    Matrix penalized = normal_;
-    const double prior = kCurvaturePrior * normal_(0, 0);  // times the summed weight
-    for (int i = 4; i < 10; ++i) penalized(i, i) += prior;
-    const Eigen::LLT<Matrix, Eigen::Lower> llt(penalized);
-    if (llt.info() != Eigen::Success) return false;
-    Vector unit = Vector::Zero();
-    unit[kParams - 1] = 1.0;
-    const Vector column = llt.solve(unit);  // the inverse's last column
-    *variance = column.dot(squared_weights_.selfadjointView<Eigen::Lower>() * column);
+    // X^T W X (lower triangle) and X^T W log f, added sample by sample in Add's order.
+    double normal[kParams][kParams] = {};
+    double rhs[3][kParams] = {};
+    for (int r = 0; r < rows_; ++r) {
+      const double* x = x_[r];
+      const double w = weight_[r];
+      for (int i = 0; i < kParams; ++i) {
+        const double wx = w * x[i];
+        for (int j = i; j < kParams; ++j) normal[i][j] += wx * x[j];  // row i of the transpose: (j, i)
+      }
+      for (int c = 0; c < 3; ++c) {
+        const double wl = w * log_value_[r][c];
+        for (int j = 0; j < kParams; ++j) rhs[c][j] += wl * x[j];
+      }
+    }
+    const double prior = kCurvaturePrior * normal[0][0];  // times the summed weight
+    for (int i = 4; i < 10; ++i) normal[i][i] += prior;
+    // The inverse's last column M^-1 e by Cholesky, M = L L^T, written out for the one right-hand side:
+    // L y = e is y = e / L(10, 10), and L^T column = y is one back substitution.
+    double l[kParams][kParams];  // l[i][j] = L(i, j), j <= i
+    for (int j = 0; j < kParams; ++j) {
+      double pivot = normal[j][j];
+      for (int k = 0; k < j; ++k) pivot -= l[j][k] * l[j][k];
+      if (!(pivot > 0.0)) return false;  // not positive definite: singular
+      l[j][j] = std::sqrt(pivot);
+      const double inv = 1.0 / l[j][j];
+      for (int i = j + 1; i < kParams; ++i) {
+        double sum = normal[j][i];  // M(i, j), i > j
+        for (int k = 0; k < j; ++k) sum -= l[i][k] * l[j][k];
+        l[i][j] = sum * inv;
+      }
+    }
+    double column[kParams];
+    for (int i = kParams - 1; i >= 0; --i) {
+      double sum = i == kParams - 1 ? 1.0 / l[i][i] : 0.0;
+      for (int k = i + 1; k < kParams; ++k) sum -= l[k][i] * column[k];
+      column[i] = sum / l[i][i];
+    }
+    double v = 0.0;
+    for (int r = 0; r < rows_; ++r) {
+      double projection = 0.0;
+      for (int j = 0; j < kParams; ++j) projection += x_[r][j] * column[j];
+      v += weight_[r] * weight_[r] * projection * projection;
+    }
+    *variance = v;
     if (!(*variance > 0.0 && *variance <= max_variance)) return false;
-    for (int c = 0; c < 3; ++c) (*delta)[c] = column.dot(rhs_.col(c));
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0.0;
+      for (int j = 0; j < kParams; ++j) sum += column[j] * rhs[c][j];
+      (*delta)[c] = sum;
+    }
     return std::isfinite(delta->sum());
   }
 
  private:
   Eigen::Vector3d q_;
   double inv_radius_;
-  Matrix normal_ = Matrix::Zero();           // lower triangle of X^T W X
-  Matrix squared_weights_ = Matrix::Zero();  // lower triangle of X^T W^2 X
-  // X^T W log f, a column per channel.
-  Eigen::Matrix<double, kParams, 3> rhs_ = Eigen::Matrix<double, kParams, 3>::Zero();
+  int rows_ = 0;
+  double x_[kMaxSamples][kParams];  // the design rows, Add's order
+  double weight_[kMaxSamples];
+  float log_value_[kMaxSamples][3];
   int count_[2] = {0, 0};
 };
 
@@ -239,6 +341,7 @@ bool FindPartner(const SampleGrid& grid, Symmetry symmetry, const BrdfSample& a,
   constexpr double kMaxCentroidOffset = 0.25;
   constexpr double kMaxDeltaVariance = 2.0;
   constexpr size_t kFitSamples = 64;
+  static_assert(2 * kFitSamples <= size_t(PairFit::kMaxSamples), "a fit holds both sides' samples");
   constexpr double kMaxMeanRadiusDeg = 1.0;
   using Near = std::pair<double, const SampleGrid::Entry*>;  // squared distance, entry
   thread_local std::vector<Near> near_q, near_p;
@@ -282,7 +385,7 @@ bool FindPartner(const SampleGrid& grid, Symmetry symmetry, const BrdfSample& a,
       fit.Add(near_q[i].second->point, near_q[i].second->log_value, /*side_a=*/false, weight(near_q[i].first));
     }
     for (size_t i = 0; i < near_p.size(); i += stride_p) {
-      fit.Add(near_p[i].second->image[int(symmetry)], near_p[i].second->log_value, /*side_a=*/true,
+      fit.Add(near_p[i].second->ImageOf(symmetry), near_p[i].second->log_value, /*side_a=*/true,
               weight(near_p[i].first));
     }
     Eigen::Vector3d delta;
