@@ -65,21 +65,6 @@ nlohmann::json ToJson(const ShotPlan& plan) {
           {"seconds", plan.seconds}};
 }
 
-Rigid3d LookAt(const Eigen::Vector3d& position, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d forward = (target - position).normalized();
-  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d right_raw = forward.cross(up);
-  if (!(right_raw.norm() > 1e-9)) ThrowError("look-at", "the view direction is parallel to world +z");
-  const Eigen::Vector3d right = right_raw.normalized();
-  const Eigen::Vector3d down = forward.cross(right);
-  Eigen::Matrix3d camera_from_world_rotation;
-  camera_from_world_rotation.row(0) = right;
-  camera_from_world_rotation.row(1) = down;
-  camera_from_world_rotation.row(2) = forward;
-  const Eigen::Quaterniond rotation(camera_from_world_rotation);
-  return Rigid3d(rotation, -(rotation * position));
-}
-
 namespace {
 
 // The canonical half of the MERL grid under the regression's folds: phi_d cells 0..89 (reciprocity and
@@ -222,7 +207,7 @@ ShotPlan PlanShots(const Camera& camera, const SampleSpec& sample, const std::ve
   const ViewTracer tracer(camera, sample, coverage);
   tbb::parallel_for(size_t(0), candidates.size(), [&](size_t n) {
     Candidate& c = candidates[n];
-    const CoverageView view{LookAt(c.position, centre), light};
+    const CoverageView view{LookAtCameraFromWorld(c.position, centre, Eigen::Vector3d::UnitZ()), light};
     const double candidate_stride = tracer.Stride(view, options.candidate_samples_per_view);
     const std::vector<BrdfSample> candidate_samples = tracer.Samples(view, candidate_stride, 0);
     c.bits.assign(kWords, 0);
@@ -259,7 +244,7 @@ ShotPlan PlanShots(const Camera& camera, const SampleSpec& sample, const std::ve
     s.azimuth_deg = c.azimuth_deg;
     s.elevation_deg = c.elevation_deg;
     s.distance_m = distance;
-    s.camera_from_world = LookAt(c.position, centre);
+    s.camera_from_world = LookAtCameraFromWorld(c.position, centre, Eigen::Vector3d::UnitZ());
     s.cells_gained = 2 * best_cells;  // each canonical cell and its bilateral mirror
     s.weighted_gain = best_gain;
     plan.suggestions.push_back(s);

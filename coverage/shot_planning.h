@@ -63,10 +63,6 @@ struct ShotPlan {
 };
 nlohmann::json ToJson(const ShotPlan& plan);
 
-// camera_from_world of a camera at `position` looking at `target`, image x to the right and y down with
-// world +z up (OpenCV's camera frame). Throws Error when the view direction is parallel to +z.
-Rigid3d LookAt(const Eigen::Vector3d& position, const Eigen::Vector3d& target);
-
 // Plans options.suggestions photos added to `views` (the light of the first view lights every
 // candidate). Throws Error for no views, a mesh sample or bad options.
 ShotPlan PlanShots(const Camera& camera, const SampleSpec& sample, const std::vector<CoverageView>& views,
