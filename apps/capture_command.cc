@@ -70,6 +70,8 @@ IBRDF_COMMAND(12, Capture) {
   AddOption(*c, "--specular-theta-h-deg", o.specular_theta_h_deg, "Cells below this theta_h weigh more");
   AddOption(*c, "--specular-weight", o.specular_weight, "Their weight in a candidate's gain");
   AddOption(*c, "--samples-per-view", o.coverage.samples_per_view, "Predicted samples per photo (pixel grid)");
+  AddOption(*c, "--candidate-samples-per-view", o.candidate_samples_per_view,
+            "Predicted samples per candidate photo, for its score");
   c->callback([args] {
     const ShotPlanOptions& options = args->o;
     RequireValidOptions(options, "ibrdf capture check");

@@ -20,12 +20,12 @@
 namespace ibrdf {
 
 bool CoverageOptions::Check(std::string* why) const {
-  IBRDF_CHECK_OPTION_GE(samples_per_view, 16);
+  IBRDF_CHECK_OPTION_RANGE(samples_per_view, 16, 1000000);
   IBRDF_CHECK_OPTION_GT(max_theta_i_deg, 0.0);
   IBRDF_CHECK_OPTION_LE(max_theta_i_deg, 90.0);
   IBRDF_CHECK_OPTION_GT(max_theta_e_deg, 0.0);
   IBRDF_CHECK_OPTION_LE(max_theta_e_deg, 90.0);
-  IBRDF_CHECK_OPTION_GT(band_deg, 0.0);
+  IBRDF_CHECK_OPTION_RANGE(band_deg, 1.0, 90.0);
   if (!regression.Check(why)) return false;
   return tabulate.Check(why);
 }

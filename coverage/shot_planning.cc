@@ -18,18 +18,22 @@
 namespace ibrdf {
 
 bool ShotPlanOptions::Check(std::string* why) const {
-  IBRDF_CHECK_OPTION_GE(suggestions, 0);
+  IBRDF_CHECK_OPTION_RANGE(suggestions, 0, 1000);
   IBRDF_CHECK_OPTION_GE(distance_m, 0.0);
+  IBRDF_CHECK_OPTION_LE(distance_m, 1000.0);
   IBRDF_CHECK_OPTION_GE(min_elevation_deg, -89.0);
   IBRDF_CHECK_OPTION_LE(max_elevation_deg, 89.0);
   IBRDF_CHECK_OPTION_LE(min_elevation_deg, max_elevation_deg);
-  IBRDF_CHECK_OPTION_GT(elevation_step_deg, 0.0);
+  IBRDF_CHECK_OPTION_GE(elevation_step_deg, 1.0);
+  IBRDF_CHECK_OPTION_GE(min_azimuth_deg, -360.0);
+  IBRDF_CHECK_OPTION_LE(max_azimuth_deg, 360.0);
   IBRDF_CHECK_OPTION_LE(min_azimuth_deg, max_azimuth_deg);
-  IBRDF_CHECK_OPTION_GT(azimuth_step_deg, 0.0);
-  IBRDF_CHECK_OPTION_GE(min_light_separation_deg, 0.0);
-  IBRDF_CHECK_OPTION_GE(specular_theta_h_deg, 0.0);
+  IBRDF_CHECK_OPTION_GE(azimuth_step_deg, 1.0);
+  IBRDF_CHECK_OPTION_RANGE(min_light_separation_deg, 0.0, 180.0);
+  IBRDF_CHECK_OPTION_RANGE(specular_theta_h_deg, 0.0, 90.0);
   IBRDF_CHECK_OPTION_GT(specular_weight, 0.0);
-  IBRDF_CHECK_OPTION_GE(candidate_samples_per_view, 16);
+  IBRDF_CHECK_OPTION_LE(specular_weight, 1e6);
+  IBRDF_CHECK_OPTION_RANGE(candidate_samples_per_view, 16, 1000000);
   return coverage.Check(why);
 }
 

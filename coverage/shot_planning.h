@@ -23,7 +23,7 @@ struct ShotPlanOptions {
   // The reachable range: camera positions on a shell about the sample's centre at this distance
   // (metres; 0: the mean distance of the session's cameras), at elevations (degrees above the world's
   // xy plane through the centre; world +z is up) and azimuths (degrees about +z from +x) in these ranges,
-  // on a grid of these steps.
+  // on a grid of these steps (at least 1 degree).
   double distance_m = 0.0;
   double min_elevation_deg = 10.0, max_elevation_deg = 80.0, elevation_step_deg = 10.0;
   double min_azimuth_deg = -180.0, max_azimuth_deg = 180.0, azimuth_step_deg = 15.0;
