@@ -72,22 +72,40 @@ nlohmann::json ToJson(const ShotPlan& plan) {
 namespace {
 
 // The canonical half of the MERL grid under the regression's folds: phi_d cells 0..89 (reciprocity and
-// bilateral symmetry map every phi_d into [0, pi/2], reconstruct/local_regression.h); a bitset.
+// bilateral symmetry map every phi_d into [0, pi/2], reconstruct/local_regression.h); a bitset, one
+// row of whole words per theta_d cell, so that a range of theta_d is a range of words.
 constexpr int kCanonicalPhi = kMerlPhiD / 2;
-constexpr size_t kCanonicalCells = size_t(kMerlThetaH) * kMerlThetaD * kCanonicalPhi;
-constexpr size_t kWords = (kCanonicalCells + 63) / 64;
+constexpr size_t kRowWords = (size_t(kMerlThetaH) * kCanonicalPhi + 63) / 64;
+constexpr size_t kWords = kRowWords * kMerlThetaD;
 using CellBits = std::vector<uint64_t>;
 
-inline size_t CanonicalIndex(int i, int j, int k) { return (size_t(i) * kMerlThetaD + j) * kCanonicalPhi + k; }
+inline size_t CanonicalIndex(int i, int j, int k) {
+  return size_t(j) * kRowWords * 64 + size_t(i) * kCanonicalPhi + k;
+}
 inline void SetBit(CellBits* bits, size_t index) { (*bits)[index >> 6] |= uint64_t(1) << (index & 63); }
+
+// The theta_d cells whose centres lie within [low, high] (radians): the reconstruction counts no cell
+// beyond the samples' theta_d range as measured (reconstruct/sample_domain.cc, ClassifyEstimate).
+struct ThetaDRange {
+  double low = 1e9, high = -1e9;
+  void Add(const ThetaDRange& o) {
+    low = std::min(low, o.low);
+    high = std::max(high, o.high);
+  }
+  int FirstCell() const { return std::max(0, int(std::ceil(low / (0.5 * kPi / kMerlThetaD) - 0.5))); }
+  int LastCell() const { return std::min(kMerlThetaD - 1, int(std::floor(high / (0.5 * kPi / kMerlThetaD) - 0.5))); }
+};
 
 // Marks the canonical cells whose centre lies within the measured distance of a sample: the ellipsoid
 // of radii r_h (u, v) and r_d (w), radians, with the folds' mirror images of the sample.
-void MarkCells(const std::vector<BrdfSample>& samples, double r_h, double r_d, CellBits* bits) {
+// `range` gets the samples' theta_d range.
+void MarkCells(const std::vector<BrdfSample>& samples, double r_h, double r_d, CellBits* bits, ThetaDRange* range) {
   const double d_theta_d = 0.5 * kPi / kMerlThetaD, d_phi = kPi / kMerlPhiD;
   for (const BrdfSample& s : samples) {
     HalfDiffAngles a;
     if (!ToHalfDiff(Eigen::Vector3d(s.wi[0], s.wi[1], s.wi[2]), Eigen::Vector3d(s.wo[0], s.wo[1], s.wo[2]), &a)) continue;
+    range->low = std::min(range->low, a.theta_d);
+    range->high = std::max(range->high, a.theta_d);
     double c = std::fmod(a.phi_d, kPi);
     if (c < 0.0) c += kPi;
     if (c > 0.5 * kPi) c = kPi - c;
@@ -130,7 +148,21 @@ struct Candidate {
   double azimuth_deg = 0.0, elevation_deg = 0.0;
   Eigen::Vector3d position;
   CellBits bits;
+  ThetaDRange range;
 };
+
+// Cells of `bits` (with `more` OR-ed in, when given) that count within `range`: plain and specular.
+void CountCells(const CellBits& bits, const CellBits* more, const ThetaDRange& range, const CellBits& valid,
+                const CellBits& specular, uint64_t* plain, uint64_t* peak) {
+  *plain = *peak = 0;
+  const int first = range.FirstCell(), last = range.LastCell();
+  if (first > last) return;
+  for (size_t w = size_t(first) * kRowWords; w < size_t(last + 1) * kRowWords; ++w) {
+    const uint64_t cells = (more ? bits[w] | (*more)[w] : bits[w]) & valid[w];
+    *peak += __builtin_popcountll(cells & specular[w]);
+    *plain += __builtin_popcountll(cells & ~specular[w]);
+  }
+}
 
 // The degree range [low, high] in steps (inclusive, the end once; a full turn without its duplicate).
 std::vector<double> Steps(double low, double high, double step, bool full_turn) {
@@ -189,7 +221,8 @@ ShotPlan PlanShots(const Camera& camera, const SampleSpec& sample, const std::ve
     }
   }
   CellBits covered(kWords, 0);
-  MarkCells(samples, r_h, r_d, &covered);
+  ThetaDRange covered_range;
+  MarkCells(samples, r_h, r_d, &covered, &covered_range);
 
   std::vector<Candidate> candidates;
   const Eigen::Vector3d to_light = DirectionToLight(light, centre);
@@ -215,7 +248,7 @@ ShotPlan PlanShots(const Camera& camera, const SampleSpec& sample, const std::ve
     const double candidate_stride = tracer.Stride(view, options.candidate_samples_per_view);
     const std::vector<BrdfSample> candidate_samples = tracer.Samples(view, candidate_stride, 0);
     c.bits.assign(kWords, 0);
-    MarkCells(candidate_samples, r_h, r_d, &c.bits);
+    MarkCells(candidate_samples, r_h, r_d, &c.bits, &c.range);
   });
 
   std::vector<bool> taken(candidates.size(), false);
@@ -223,18 +256,20 @@ ShotPlan PlanShots(const Camera& camera, const SampleSpec& sample, const std::ve
     double best_gain = 0.0;
     uint64_t best_cells = 0;
     int best = -1;
+    uint64_t plain_now = 0, peak_now = 0;
+    CountCells(covered, nullptr, covered_range, valid, specular, &plain_now, &peak_now);
+    const double score_now = double(plain_now) + options.specular_weight * double(peak_now);
     for (size_t n = 0; n < candidates.size(); ++n) {
       if (taken[n]) continue;
+      // The cells it brings within the measured distance, and those its theta_d range opens to them.
+      ThetaDRange range = covered_range;
+      range.Add(candidates[n].range);
       uint64_t plain = 0, peak = 0;
-      for (size_t w = 0; w < kWords; ++w) {
-        const uint64_t gained = candidates[n].bits[w] & ~covered[w] & valid[w];
-        peak += __builtin_popcountll(gained & specular[w]);
-        plain += __builtin_popcountll(gained & ~specular[w]);
-      }
-      const double gain = double(plain) + options.specular_weight * double(peak);
+      CountCells(covered, &candidates[n].bits, range, valid, specular, &plain, &peak);
+      const double gain = double(plain) + options.specular_weight * double(peak) - score_now;
       if (gain > best_gain) {
         best_gain = gain;
-        best_cells = plain + peak;
+        best_cells = plain + peak - plain_now - peak_now;
         best = int(n);
       }
     }
@@ -242,6 +277,7 @@ ShotPlan PlanShots(const Camera& camera, const SampleSpec& sample, const std::ve
     taken[best] = true;
     const Candidate& c = candidates[best];
     for (size_t w = 0; w < kWords; ++w) covered[w] |= c.bits[w];
+    covered_range.Add(c.range);
     ShotSuggestion s;
     s.position = c.position;
     s.look_at = centre;
