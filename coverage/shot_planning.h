@@ -3,8 +3,9 @@
 // looking at its centre, under the session's light) are scored by the MERL cells they would bring within
 // the reconstruction's "measured" distance (DomainRules::measured_nearest kernel radii of a predicted
 // sample, in the regression's scaled (u, v, w) with its folds, reconstruct/local_regression.h) and
-// within the samples' theta_d range (beyond it no cell is measured), weighted towards the specular region; the best is taken and the step repeated (greedy set cover). The coverage
-// before and after is then the reconstruction's full classification (coverage/coverage.h).
+// within the samples' theta_d range (beyond it no cell is measured), weighted towards the specular
+// region; the best is taken and the step repeated (greedy set cover). The coverage before and after is
+// then the reconstruction's full classification (coverage/coverage.h).
 #pragma once
 
 #include <cstdint>
