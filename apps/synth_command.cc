@@ -6,7 +6,7 @@ namespace ibrdf {
 namespace {
 
 struct SynthArgs {
-  std::string out, material;
+  std::string out, material, camera_positions;
   bool overwrite = false;
   SynthRequest request;
   CLI::Option *elevation = nullptr, *light_photos = nullptr, *merl_lookup = nullptr;
@@ -17,6 +17,7 @@ void RunSynth(SynthArgs& args) {
   request.camera_elevation_given = args.elevation->count() > 0;
   request.light_photos_given = args.light_photos->count() > 0;
   request.merl_lookup_given = args.merl_lookup->count() > 0;
+  if (!args.camera_positions.empty()) request.options.rig.extra_camera_positions = ReadCameraPositions(args.camera_positions);
   const SynthOptions options = SynthOptionsFromRequest(request);
   RequireValidOptions(options, "ibrdf synth");
   StageLog stage("synth");
@@ -48,6 +49,10 @@ IBRDF_COMMAND(10, Synth) {
   AddOption(c, "--rig", r.rig, "arc (cameras on an arc), dome (a light per photo) or turntable (the sample turns)")
       ->check(CLI::IsMember({"arc", "dome", "turntable"}));
   AddOption(c, "--photos", o.rig.num_photos, "Number of photos (arc: cameras; dome: lights; turntable: stops)");
+  c.add_option("--camera-positions", args->camera_positions,
+               "Arc: a camera more at each position of this JSON file (a list of [x, y, z], metres, or a\n"
+               "capture-check.json's suggestions), looking at the sample")
+      ->check(CLI::ExistingFile);
   AddOption(c, "--arc-start-deg", o.rig.arc_start_deg, "First camera azimuth from the light (dome: smallest angle)");
   AddOption(c, "--arc-end-deg", o.rig.arc_end_deg, "Last camera azimuth from the light (dome: largest angle)");
   AddOption(c, "--dome-min-elevation-deg", o.rig.dome_min_elevation_deg, "Dome: the lowest lights' elevation");

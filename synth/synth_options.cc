@@ -1,6 +1,9 @@
 #include "synth/synth_options.h"
 
 #include <cmath>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "core/kind.h"
@@ -108,8 +111,39 @@ bool SynthSceneOptions::Check(std::string* why) const {
   return true;
 }
 
+std::vector<Eigen::Vector3d> ReadCameraPositions(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) ThrowError(path, "cannot open the camera positions");
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(file);
+  } catch (const nlohmann::json::exception& e) {
+    ThrowError(path, std::string("not JSON: ") + e.what());
+  }
+  const bool report = json.is_object();
+  if (report && !json.contains("suggestions")) {
+    ThrowError(path, "an object without \"suggestions\": expected a list of [x, y, z] or a capture-check.json");
+  }
+  const nlohmann::json& list = report ? json["suggestions"] : json;
+  if (!list.is_array()) ThrowError(path, "expected a list of [x, y, z] or a capture-check.json");
+  std::vector<Eigen::Vector3d> positions;
+  for (size_t i = 0; i < list.size(); ++i) {
+    const nlohmann::json& p = report ? (list[i].is_object() && list[i].contains("position") ? list[i]["position"]
+                                                                                           : nlohmann::json())
+                                     : list[i];
+    const std::string where = report ? "/suggestions/" + std::to_string(i) + "/position" : "/" + std::to_string(i);
+    if (!p.is_array() || p.size() != 3 || !p[0].is_number() || !p[1].is_number() || !p[2].is_number()) {
+      ThrowError(path, where + ": expected [x, y, z] in metres");
+    }
+    positions.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+    if (!positions.back().allFinite()) ThrowError(path, where + ": not finite");
+  }
+  return positions;
+}
+
 bool SynthRigOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GT(camera_distance, 0.0);
+  IBRDF_CHECK_OPTION(extra_camera_positions.empty() || rig == SynthRig::kArc);
   IBRDF_CHECK_OPTION_RANGE(num_photos, 1, 100000);
   IBRDF_CHECK_OPTION_RANGE(width, 8, 20000);
   IBRDF_CHECK_OPTION_RANGE(height, 8, 20000);

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -84,6 +85,9 @@ struct SynthRigOptions {
   // turntable_span_deg over the photos (360: a full turn, the last photo one step short of the first).
   double turntable_phase_deg = 60.0;
   double turntable_span_deg = 360.0;
+  // Arc: more cameras after the arc's num_photos, one at each of these positions (world frame, metres)
+  // looking at the sample's centre, image up towards world +z (the photos `ibrdf capture check` suggests).
+  std::vector<Eigen::Vector3d> extra_camera_positions;
   // Camera: OPENCV model with the focal length chosen so the sample (or the platform, with targets)
   // spans `frame_fraction` of the shorter image side.
   int width = 800;   // pixels
@@ -95,6 +99,11 @@ struct SynthRigOptions {
 
   bool Check(std::string* why) const;
 };
+
+// Camera positions for SynthRigOptions::extra_camera_positions from a JSON file: a list of [x, y, z]
+// (metres, world frame), or a capture-check.json (`ibrdf capture check --out`) whose "suggestions"
+// give them. Throws Error naming the file and the entry otherwise.
+std::vector<Eigen::Vector3d> ReadCameraPositions(const std::string& path);
 
 // The camera's curve from linear signal to file value.
 enum class SensorCurve {

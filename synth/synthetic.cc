@@ -109,6 +109,13 @@ std::vector<PhotoSpec> ArcPhotos(const SynthOptions& options) {
                                                     options.scene.origin, Eigen::Vector3d::UnitZ());
     photos.push_back(photo);
   }
+  for (size_t n = 0; n < options.rig.extra_camera_positions.size(); ++n) {
+    PhotoSpec photo;
+    photo.file = PhotoFile(options, options.rig.num_photos + int(n));
+    photo.camera_from_world = LookAtCameraFromWorld(options.rig.extra_camera_positions[n], options.scene.origin,
+                                                    Eigen::Vector3d::UnitZ());
+    photos.push_back(photo);
+  }
   return photos;
 }
 
@@ -704,6 +711,11 @@ nlohmann::json GeneratorJson(const SynthOptions& options) {
           {"camera_distance", options.rig.camera_distance},
           {"camera_elevation_deg", options.rig.camera_elevation_deg},
           {"num_photos", options.rig.num_photos},
+          {"extra_camera_positions", [&] {
+             nlohmann::json list = nlohmann::json::array();
+             for (const Eigen::Vector3d& p : options.rig.extra_camera_positions) list.push_back(ToJson(p));
+             return list;
+           }()},
           {"arc_start_deg", options.rig.arc_start_deg},
           {"arc_end_deg", options.rig.arc_end_deg},
           {"rig", SynthRigName(options.rig.rig)},
@@ -893,7 +905,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   }
   WriteJsonFile((fs::path(directory.temporary_path()) / "truth.json").string(), truth_json);
   directory.Commit();
-  summary.photos = options.rig.num_photos;
+  summary.photos = options.rig.num_photos + int(options.rig.extra_camera_positions.size());
   summary.saturated_pixels = saturated;
   summary.total_s = timer.ElapsedSeconds();
   summary.success = true;

@@ -131,6 +131,8 @@ def make_fixtures(binary, source, tmp):
 BASE = {
     ("targets",): ([], ["--out", "OUT", "--dpi", "72"]),
     ("session", "init"): ([], ["s/photos/000.png", "s/photos/001.png", "--out", "OUT"]),
+    ("capture", "check"): (["--samples-per-view", "400", "--suggest", "1", "--azimuth-step-deg", "60"],
+                           ["s", "--out", "OUT"]),
     ("synth",): (["--width", "32", "--height", "24", "--photos", "3"], ["--material", "m.json", "--out", "OUT"]),
     ("scan",): ([], ["tri.ply", "--out", "OUT.ply"]),
     ("lights", "calibrate"): ([], ["mirror", "--out", "OUT.json"]),
@@ -154,6 +156,8 @@ SLOW = {("batch",): {"--cores", "--slurm", "--profile", "--snakemake-args", "-n"
         ("synth",): {"--shape", "--scan-spacing-m", "--truth-mesh-spacing-m", "--exposure-target"},
         ("lights", "synth"): {"--focal-px", "--radius-m", "--distance-m"},
         ("targets",): {"--dpi"},
+        ("capture", "check"): {"--samples-per-view", "--candidate-samples-per-view", "--elevation-step-deg",
+                               "--azimuth-step-deg"},
         ("report",): {"--held-out"},
         ("compare",): {"--lookups"},
         ("reconstruct",): {"--fit-samples", "--fit-start-samples", "--bandwidth-samples"}}

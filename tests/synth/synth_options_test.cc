@@ -2,11 +2,13 @@
 // that failed, and the constraints between parts (camera, light, ring, scanner outside the sample).
 #include "synth/synth_options.h"
 
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "tests/scratch_dir.h"
 
 namespace ibrdf {
 namespace {
@@ -113,6 +115,34 @@ TEST(SynthOptions, ShapeNamesRoundTrip) {
     EXPECT_EQ(SynthShapeFromName(SynthShapeName(shape)), shape);
   }
   EXPECT_THROW(SynthShapeFromName("cube"), Error);
+}
+
+// --camera-positions: a list of [x, y, z] or a capture-check.json's suggestions; anything else is an
+// Error naming the file and the entry.
+TEST(SynthOptions, CameraPositionsFromAListOrACaptureCheck) {
+  testing::ScratchDir dir;
+  std::ofstream(dir / "list.json") << "[[0.1, 0.2, 0.3], [1, 2, 3]]";
+  std::ofstream(dir / "check.json") << R"({"format": "ibrdf-capture-check", "suggestions": [{"position": [0.5, 0, 0.4]}]})";
+  std::ofstream(dir / "bad.json") << "[[0.1, 0.2]]";
+  const std::vector<Eigen::Vector3d> list = ReadCameraPositions(dir / "list.json");
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[1], Eigen::Vector3d(1, 2, 3));
+  const std::vector<Eigen::Vector3d> check = ReadCameraPositions(dir / "check.json");
+  ASSERT_EQ(check.size(), 1u);
+  EXPECT_EQ(check[0], Eigen::Vector3d(0.5, 0, 0.4));
+  try {
+    ReadCameraPositions(dir / "bad.json");
+    FAIL() << "a pair was read as a position";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/0: expected [x, y, z]"), std::string::npos) << e.what();
+  }
+  // Only the arc takes them.
+  SynthRigOptions rig;
+  rig.extra_camera_positions = list;
+  std::string why;
+  EXPECT_TRUE(rig.Check(&why)) << why;
+  rig.rig = SynthRig::kDome;
+  EXPECT_FALSE(rig.Check(&why));
 }
 
 }  // namespace
