@@ -5,6 +5,8 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <ostream>
+#include <utility>
 
 #include "core/error.h"
 #include "core/file_util.h"
@@ -93,7 +95,57 @@ std::vector<size_t> ParseShape(const std::string& path, const std::string& text)
   return shape;
 }
 
+// The 10-byte prefix of a version 1.0 file whose header dict is `header`.
+void WritePrefix(std::ostream& out, const std::string& header) {
+  const char prefix[10] = {'\x93',
+                           'N',
+                           'U',
+                           'M',
+                           'P',
+                           'Y',
+                           1,
+                           0,
+                           static_cast<char>(header.size() & 0xff),
+                           static_cast<char>(header.size() >> 8)};
+  out.write(prefix, 10);
+}
+
 }  // namespace
+
+NpyRowWriter::NpyRowWriter(std::string path, std::string descr, size_t item_size)
+    : path_(std::move(path)), descr_(std::move(descr)), item_size_(item_size) {
+  IBRDF_CHECK(item_size_ > 0);
+  const std::string header = Header(descr_, {0});
+  // The count is patched in place at Finish(), so the header may not grow with its digits.
+  IBRDF_CHECK(header.size() == Header(descr_, {size_t(9999999999999999999ull)}).size())
+      << path_ << ": the .npy header of " << descr_ << " changes length with the row count";
+  IBRDF_CHECK(header.size() <= 0xffff) << path_ << ": .npy header too long";
+  header_bytes_ = header.size();
+  out_.open(path_, std::ios::binary | std::ios::trunc);
+  if (!out_) ThrowError(path_, "cannot write file");
+  WritePrefix(out_, header);
+  out_.write(header.data(), static_cast<std::streamsize>(header.size()));
+  if (!out_) ThrowError(path_, "write failed (disk full?)");
+}
+
+void NpyRowWriter::Append(const void* data, uint64_t rows) {
+  IBRDF_CHECK(out_.is_open()) << path_ << ": append after Finish";
+  if (rows == 0) return;
+  out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(rows * item_size_));
+  if (!out_) ThrowError(path_, "write failed (disk full?)");
+  rows_ += rows;
+}
+
+void NpyRowWriter::Finish() {
+  IBRDF_CHECK(out_.is_open()) << path_ << ": Finish called twice";
+  IBRDF_CHECK(rows_ <= 9999999999999999999ull) << path_ << ": too many rows";
+  const std::string header = Header(descr_, {size_t(rows_)});
+  IBRDF_CHECK(header.size() == header_bytes_);
+  out_.seekp(10);
+  out_.write(header.data(), static_cast<std::streamsize>(header.size()));
+  out_.close();
+  if (!out_) ThrowError(path_, "write failed (disk full?)");
+}
 
 void WriteNpy(const std::string& path, const std::string& descr, const std::vector<size_t>& shape, size_t item_size,
               const void* data, size_t bytes) {
@@ -106,17 +158,7 @@ void WriteNpy(const std::string& path, const std::string& descr, const std::vect
   {
     std::ofstream out(file.temporary_path(), std::ios::binary);
     if (!out) ThrowError(path, "cannot write file");
-    const char prefix[10] = {'\x93',
-                             'N',
-                             'U',
-                             'M',
-                             'P',
-                             'Y',
-                             1,
-                             0,
-                             static_cast<char>(header.size() & 0xff),
-                             static_cast<char>(header.size() >> 8)};
-    out.write(prefix, 10);
+    WritePrefix(out, header);
     out.write(header.data(), static_cast<std::streamsize>(header.size()));
     out.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
     if (!out) ThrowError(path, "write failed (disk full?)");

@@ -22,6 +22,33 @@ namespace ibrdf {
 void WriteNpy(const std::string& path, const std::string& descr, const std::vector<size_t>& shape, size_t item_size,
               const void* data, size_t bytes);
 
+// A one-dimensional .npy of fixed-size rows written as they come, for arrays too large to hold in memory:
+// the header goes first with room for any row count, rows are appended, and Finish() writes the count
+// into the header in place. The file is byte for byte what WriteNpy writes for the same rows. It is
+// written at `path` directly: callers write to an AtomicFile's temporary path (core/file_util.h) and
+// commit it after Finish(), so the final file appears only when complete.
+class NpyRowWriter {
+ public:
+  // IBRDF_CHECKs that `descr`'s header has the same length for any row count below 10^19 (true of
+  // every dtype of the tool: the padding to 64 bytes absorbs the digits).
+  NpyRowWriter(std::string path, std::string descr, size_t item_size);
+  NpyRowWriter(const NpyRowWriter&) = delete;
+  NpyRowWriter& operator=(const NpyRowWriter&) = delete;
+
+  // Appends `rows` rows of item_size bytes each. Throws Error naming the file when the write fails.
+  void Append(const void* data, uint64_t rows);
+  uint64_t rows() const { return rows_; }
+  // Writes the row count into the header and closes the file; throws Error naming the file on failure.
+  void Finish();
+
+ private:
+  std::string path_, descr_;
+  size_t item_size_;
+  size_t header_bytes_;
+  uint64_t rows_ = 0;
+  std::ofstream out_;
+};
+
 namespace internal {
 // Opens `path`, checks its header against `descr` and `item_size` and the data's size against the
 // shape; leaves `in` at the data and returns the item count.

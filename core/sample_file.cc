@@ -118,7 +118,12 @@ std::string InvalidSampleReason(const BrdfSample& s) {
   return "";
 }
 
-std::vector<BrdfSample> ReadSamples(const std::string& path) {
+namespace {
+
+// ForEachSampleChunk, with `on_count` told the row count before the first chunk.
+uint64_t ReadSampleChunks(const std::string& path, size_t chunk_rows, const std::function<void(uint64_t)>& on_count,
+                          const std::function<void(const BrdfSample*, size_t, uint64_t)>& chunk) {
+  IBRDF_CHECK(chunk_rows > 0);
   // The header decides the format: the current dtype, else version 1 (no per-channel validity: every
   // channel valid, exposures not recorded). Any other dtype gets the message of the current format.
   std::vector<size_t> shape;
@@ -138,36 +143,56 @@ std::vector<BrdfSample> ReadSamples(const std::string& path) {
     }
   }
   if (shape.size() != 1) ThrowError(path, "sample files are one-dimensional arrays");
-  // The rows go through a small buffer that stays in the cache: read, checked there, and appended to
-  // memory reserved once (never zero-filled first; huge pages where the kernel gives them on request).
-  // A whole-file read into a value-initialized vector paid for zeroing and page-faulting the 85 MB
-  // of a demo run's samples, in each of check, compare, reconstruct and report.
-  std::vector<BrdfSample> samples;
-  samples.reserve(count);
-  AdviseHugePages(samples.data(), count * sizeof(BrdfSample));
-  constexpr uint64_t kChunkRows = 8192;
+  if (on_count) on_count(count);
+  // The rows go through a buffer of `chunk_rows` rows, read and checked there.
   const size_t row_bytes = version1 ? sizeof(BrdfSampleVersion1) : sizeof(BrdfSample);
-  std::vector<unsigned char> raw(kChunkRows * row_bytes);
-  std::vector<BrdfSample> converted(version1 ? kChunkRows : 0);
-  for (uint64_t first = 0; first < count; first += kChunkRows) {
-    const uint64_t rows = std::min(kChunkRows, count - first);
+  const uint64_t buffer_rows = std::min<uint64_t>(chunk_rows, count);
+  std::vector<unsigned char> raw(buffer_rows * row_bytes);
+  std::vector<BrdfSample> converted(version1 ? buffer_rows : 0);
+  for (uint64_t first = 0; first < count; first += chunk_rows) {
+    const uint64_t rows = std::min<uint64_t>(chunk_rows, count - first);
     internal::ReadNpyData(path, &in, raw.data(), rows * row_bytes);
-    const BrdfSample* chunk = reinterpret_cast<const BrdfSample*>(raw.data());
+    const BrdfSample* rows_read = reinterpret_cast<const BrdfSample*>(raw.data());
     if (version1) {
       for (uint64_t i = 0; i < rows; ++i) {
         std::memcpy(static_cast<void*>(&converted[i]), raw.data() + i * row_bytes, sizeof(BrdfSampleVersion1));
         converted[i].valid[0] = converted[i].valid[1] = converted[i].valid[2] = 1;
         converted[i].exposures = 0;
       }
-      chunk = converted.data();
+      rows_read = converted.data();
     }
     for (uint64_t i = 0; i < rows; ++i) {
-      if (PlausibleSample(chunk[i])) continue;
-      const std::string reason = InvalidSampleReason(chunk[i]);
+      if (PlausibleSample(rows_read[i])) continue;
+      const std::string reason = InvalidSampleReason(rows_read[i]);
       if (!reason.empty()) ThrowError(path, "sample " + std::to_string(first + i) + ": " + reason);
     }
-    samples.insert(samples.end(), chunk, chunk + rows);
+    chunk(rows_read, size_t(rows), first);
   }
+  return count;
+}
+
+}  // namespace
+
+SampleFileWriter::SampleFileWriter(const std::string& path) : writer_(path, BrdfSampleDtype(), sizeof(BrdfSample)) {}
+
+uint64_t ForEachSampleChunk(const std::string& path, size_t chunk_rows,
+                            const std::function<void(const BrdfSample* rows, size_t count, uint64_t first)>& chunk) {
+  return ReadSampleChunks(path, chunk_rows, nullptr, chunk);
+}
+
+std::vector<BrdfSample> ReadSamples(const std::string& path) {
+  // Chunks that stay in the cache, appended to memory reserved once (never zero-filled first; huge
+  // pages where the kernel gives them on request). A whole-file read into a value-initialized vector
+  // paid for zeroing and page-faulting the 85 MB of a demo run's samples, in each of check, compare,
+  // reconstruct and report.
+  std::vector<BrdfSample> samples;
+  ReadSampleChunks(
+      path, 8192,
+      [&](uint64_t count) {
+        samples.reserve(count);
+        AdviseHugePages(samples.data(), count * sizeof(BrdfSample));
+      },
+      [&](const BrdfSample* rows, size_t count, uint64_t) { samples.insert(samples.end(), rows, rows + count); });
   return samples;
 }
 

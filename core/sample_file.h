@@ -18,9 +18,13 @@
 // session the samples came from.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
+
+#include "core/npy.h"
 
 namespace ibrdf {
 
@@ -54,6 +58,19 @@ const char* BrdfSampleDtypeVersion1();
 // Writes samples as .npy atomically.
 void WriteSamples(const std::string& path, const std::vector<BrdfSample>& samples);
 
+// A sample file written row by row (NpyRowWriter): byte for byte what WriteSamples writes for the
+// same rows, at `path` directly (an AtomicFile's temporary path: the final file appears on commit).
+class SampleFileWriter {
+ public:
+  explicit SampleFileWriter(const std::string& path);
+  void Append(const BrdfSample* samples, size_t count) { writer_.Append(samples, count); }
+  uint64_t rows() const { return writer_.rows(); }
+  void Finish() { writer_.Finish(); }
+
+ private:
+  NpyRowWriter writer_;
+};
+
 // Why a sample is not a valid measurement ("" when it is): non-finite values, |wi| or |wo| not 1,
 // theta_i or theta_e outside [0, pi/2], delta_phi outside [-pi, pi], a negative BRDF or sigma, a
 // `valid` flag other than 0 or 1, or no valid channel.
@@ -63,6 +80,13 @@ std::string InvalidSampleReason(const BrdfSample& sample);
 // get every channel valid and exposures 0); throws Error naming the file if the header, dtype or size
 // do not match, or naming the first invalid sample (InvalidSampleReason).
 std::vector<BrdfSample> ReadSamples(const std::string& path);
+
+// Reads a sample file as ReadSamples does but `chunk_rows` rows at a time, in file order, so memory stays
+// bounded whatever the file's size: `chunk(rows, count, first)` gets each chunk's rows (valid until it
+// returns; `first` is the index of rows[0] in the file) after every one of them passed the checks.
+// Throws as ReadSamples does, naming the file and the first invalid row. Returns the file's row count.
+uint64_t ForEachSampleChunk(const std::string& path, size_t chunk_rows,
+                            const std::function<void(const BrdfSample* rows, size_t count, uint64_t first)>& chunk);
 
 // The sidecar path for a sample file: "<path>.json".
 std::string SidecarPath(const std::string& samples_path);

@@ -35,10 +35,7 @@ Eigen::Matrix3d SampleColourMatrix(const ColourChartSpec& chart, const Eigen::Ve
   return SpaceFromLinearSrgb(chart.space, corrected);
 }
 
-std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples,
-                                                   ColourCorrectionCounts* counts) {
-  ColourCorrectionCounts tally;
-  if (counts != nullptr) *counts = tally;
+std::vector<Eigen::Matrix3d> SampleColourMatrices(const Session& session) {
   if (!session.colour_chart) return {};
   const ColourChartSpec& chart = *session.colour_chart;
   if (!chart.matrix) {
@@ -56,6 +53,13 @@ std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::
     }
     matrices.push_back(SampleColourMatrix(chart, intensity));
   }
+  return matrices;
+}
+
+void ApplyColourMatrices(const Session& session, const std::vector<Eigen::Matrix3d>& matrices,
+                         std::vector<BrdfSample>* samples, ColourCorrectionCounts* counts) {
+  if (matrices.empty()) return;
+  ColourCorrectionCounts& tally = *counts;
   std::vector<Eigen::Matrix3f> single(matrices.size()), squared(matrices.size());
   for (size_t k = 0; k < matrices.size(); ++k) {
     single[k] = matrices[k].cast<float>();
@@ -93,7 +97,15 @@ std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::
   const size_t before = samples->size();
   const auto unmeasured = [](const BrdfSample& s) { return s.valid[0] == 0 && s.valid[1] == 0 && s.valid[2] == 0; };
   samples->erase(std::remove_if(samples->begin(), samples->end(), unmeasured), samples->end());
-  tally.dropped = before - samples->size();
+  tally.dropped += before - samples->size();
+}
+
+std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples,
+                                                   ColourCorrectionCounts* counts) {
+  ColourCorrectionCounts tally;
+  if (counts != nullptr) *counts = tally;
+  const std::vector<Eigen::Matrix3d> matrices = SampleColourMatrices(session);
+  ApplyColourMatrices(session, matrices, samples, &tally);
   if (counts != nullptr) *counts = tally;
   return matrices;
 }

@@ -45,6 +45,16 @@ struct ColourCorrectionCounts {
 std::vector<Eigen::Matrix3d> ApplyColourCorrection(const Session& session, std::vector<BrdfSample>* samples,
                                                    ColourCorrectionCounts* counts = nullptr);
 
+// The matrices ApplyColourCorrection applies, one per light (empty without a colour_chart); throws as it
+// does. Known before any photo is derendered, so the derenderer corrects each photo's samples as they come.
+std::vector<Eigen::Matrix3d> SampleColourMatrices(const Session& session);
+
+// ApplyColourCorrection with `matrices` (SampleColourMatrices of the session) on any run of samples, one
+// photo's say: `counts` gets this run's negative channels and removed samples added. Nothing for empty
+// `matrices`. Each sample is corrected on its own, so applying it run by run equals applying it once.
+void ApplyColourMatrices(const Session& session, const std::vector<Eigen::Matrix3d>& matrices,
+                         std::vector<BrdfSample>* samples, ColourCorrectionCounts* counts);
+
 // The sidecar's "colour" entry: space, reference source, the chart's matrix and per-patch fit, and the
 // matrices applied per light. Null without a colour_chart.
 nlohmann::json ColourSidecar(const Session& session, const std::vector<Eigen::Matrix3d>& applied);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -805,12 +806,11 @@ void DerenderStagePhoto(const Stage& stage, size_t group, const RadianceWindow& 
 
 // The stage's summary after the last photo: totals, exposure advice, the mesh's figures and the
 // check that some pixel saw the sample.
-void FinishSummary(const Stage& stage, DerenderResult* result) {
-  DerenderSummary& summary = result->summary;
+void FinishSummary(const Stage& stage, DerenderSummary* summary_ptr) {
+  DerenderSummary& summary = *summary_ptr;
   const size_t measured = stage.groups.size();
   summary.photos = measured;
   summary.pixels_examined = PixelsPerImage(stage.session.camera, stage.options.pixel_stride) * measured;
-  summary.accepted = result->samples.size();
   bool bracketed = false;
   for (const auto& group : stage.groups) bracketed = bracketed || group.size() > 1;
   summary.exposure_warnings = AdviseExposure(summary.exposure, stage.options.exposure_advice, bracketed);
@@ -835,13 +835,31 @@ void FinishSummary(const Stage& stage, DerenderResult* result) {
   summary.total_s = stage.timer.ElapsedSeconds();
 }
 
-// DerenderSetup::DerenderAll. A TBB pipeline keeps a few photos in flight, so one is decoded while
+// Where RunStage sends the samples: each photo's blocks (their concatenation is the photo's samples),
+// photo by photo in photo order. The blocks are the pipeline's buffers, valid until the sink returns.
+using PhotoSink = std::function<void(const std::vector<std::vector<BrdfSample>>& blocks)>;
+
+// Room for every pixel of every box: the most samples the stage can accept.
+uint64_t MostSamples(const Stage& stage) {
+  const int stride = stage.options.pixel_stride;
+  uint64_t box_pixels = 0;
+  for (const PixelBox& box : stage.boxes) {
+    if (!box.Empty())
+      box_pixels += uint64_t((box.x1 - box.x0 + stride - 1) / stride) * ((box.y1 - box.y0 + stride - 1) / stride);
+  }
+  return box_pixels;
+}
+
+// The stage's photos through a TBB pipeline that keeps a few photos in flight, so one is decoded while
 // another's pixels are worked on; each token's buffers (decoded files, radiance window, samples) are
-// reused from photo to photo, and the samples are appended in photo order, byte-identical to a
-// photo-by-photo loop.
-DerenderResult RunStage(const Stage& stage) {
-  DerenderResult result;
-  result.summary.sample = SampleKindName(stage.session.sample.kind);
+// reused from photo to photo, and the samples go to `sink` in photo order, byte-identical to a
+// photo-by-photo loop. The memory is that of the tokens, whatever the number of photos. `colour`
+// (SampleColourMatrices; empty: none) is applied to each photo's samples as they come, its counts
+// added to `colour_counts`; the summary's channel counts and `accepted` are those after it.
+DerenderSummary RunStage(const Stage& stage, const std::vector<Eigen::Matrix3d>& colour,
+                         ColourCorrectionCounts* colour_counts, const PhotoSink& sink) {
+  DerenderSummary summary;
+  summary.sample = SampleKindName(stage.session.sample.kind);
   const size_t photos = stage.groups.size();
   struct PhotoWork {
     size_t group = 0;
@@ -849,6 +867,7 @@ DerenderResult RunStage(const Stage& stage) {
     PhotoSamples samples;
     double decode_s = 0.0;
     std::array<uint64_t, 3> channels_not_measured{};
+    ColourCorrectionCounts colour;
   };
   // One photo in flight per thread and one more waiting its turn in the in-order merge: each token
   // holds full-frame buffers (tens of MB whose first touch costs page faults), so no more than that.
@@ -859,14 +878,6 @@ DerenderResult RunStage(const Stage& stage) {
     w = std::make_unique<PhotoWork>();
     idle.push(w.get());
   }
-  // Room for every pixel of every box: the samples never regrow, and only the pages written are touched.
-  const int stride = stage.options.pixel_stride;
-  uint64_t box_pixels = 0;
-  for (const PixelBox& box : stage.boxes) {
-    if (!box.Empty())
-      box_pixels += uint64_t((box.x1 - box.x0 + stride - 1) / stride) * ((box.y1 - box.y0 + stride - 1) / stride);
-  }
-  ReserveWithHugePages(&result.samples, box_pixels);
   ProgressBar progress("photos", photos);
   size_t next_group = 0;
   tbb::parallel_pipeline(
@@ -889,29 +900,86 @@ DerenderResult RunStage(const Stage& stage) {
         // uses every thread); the other analytic photos one per thread.
         const bool parallel = stage.mesh || w->group + 2 >= photos;
         DerenderStagePhoto(stage, w->group, w->image, parallel, &w->samples);
-        // Counted here, while the photo's samples are in cache, not over the whole result afterwards.
+        // Corrected and counted here, while the photo's samples are in cache (each sample is corrected
+        // on its own, so photo by photo equals all at once).
+        w->colour = ColourCorrectionCounts();
         w->channels_not_measured = {};
-        for (const std::vector<BrdfSample>& block : w->samples.blocks) {
+        for (std::vector<BrdfSample>& block : w->samples.blocks) {
+          ApplyColourMatrices(stage.session, colour, &block, &w->colour);
           for (const BrdfSample& s : block) {
             for (int c = 0; c < 3; ++c) w->channels_not_measured[c] += s.valid[c] == 0;
           }
         }
         return w;
       }) & tbb::make_filter<PhotoWork*, void>(tbb::filter_mode::serial_in_order, [&](PhotoWork* w) {
-        for (const std::vector<BrdfSample>& block : w->samples.blocks) {
-          result.samples.insert(result.samples.end(), block.begin(), block.end());
+        sink(w->samples.blocks);
+        for (const std::vector<BrdfSample>& block : w->samples.blocks) summary.accepted += block.size();
+        for (const auto& [reason, count] : w->samples.rejected) summary.rejected[reason] += count;
+        summary.decode_s += w->decode_s;
+        for (int c = 0; c < 3; ++c) {
+          summary.channels_not_measured[c] += w->channels_not_measured[c];
+          colour_counts->negative[c] += w->colour.negative[c];
         }
-        for (const auto& [reason, count] : w->samples.rejected) result.summary.rejected[reason] += count;
-        result.summary.decode_s += w->decode_s;
-        for (int c = 0; c < 3; ++c) result.summary.channels_not_measured[c] += w->channels_not_measured[c];
-        result.summary.shadow_rays += w->samples.shadow_rays;
-        result.summary.shadow_tests_skipped += w->samples.shadow_tests_skipped;
-        result.summary.exposure.Merge(w->samples.exposure);
+        colour_counts->dropped += w->colour.dropped;
+        summary.shadow_rays += w->samples.shadow_rays;
+        summary.shadow_tests_skipped += w->samples.shadow_tests_skipped;
+        summary.exposure.Merge(w->samples.exposure);
         idle.push(w);
         progress.Add(1);
       }));
   progress.Finish();
-  FinishSummary(stage, &result);
+  FinishSummary(stage, &summary);
+  return summary;
+}
+
+// RunStage into memory.
+DerenderResult RunStageInMemory(const Stage& stage, const std::vector<Eigen::Matrix3d>& colour,
+                                ColourCorrectionCounts* colour_counts) {
+  DerenderResult result;
+  // The samples never regrow, and only the pages written are touched.
+  ReserveWithHugePages(&result.samples, MostSamples(stage));
+  result.summary = RunStage(stage, colour, colour_counts, [&](const std::vector<std::vector<BrdfSample>>& blocks) {
+    for (const std::vector<BrdfSample>& block : blocks) {
+      result.samples.insert(result.samples.end(), block.begin(), block.end());
+    }
+  });
+  return result;
+}
+
+DerenderSummary& SummaryOf(DerenderResult& result) { return result.summary; }
+DerenderSummary& SummaryOf(DerenderSummary& summary) { return summary; }
+
+// Derender's checks and set-up, then the stage run by `run` (RunStage with the colour chart's matrices
+// applied photo by photo), and the colour correction's figures in the summary.
+template <class Run>
+auto DerenderWith(const Session& session, const DerenderOptions& options, const Run& run) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("derender options", why);
+  // The derenderer reads calibrated lights only: the white reference is a calibration of its own
+  // (calibrate/white_reference_intensity.h), which writes the lights' intensities into the session.
+  if (session.calibration && session.calibration->white_reference) {
+    ThrowError(session.manifest_path + ": /calibration/white_reference",
+               "the lights are not calibrated from the white reference yet: run `ibrdf lights white` on the "
+               "session and derender the session it writes (`ibrdf run` does both)");
+  }
+  const Stage stage(session, options);
+  // The colour chart's matrix, per sample by its photo's light (colour_correction.h), known before any
+  // photo is decoded: a chart without a matrix fails at once.
+  const std::vector<Eigen::Matrix3d> matrices = SampleColourMatrices(session);
+  ColourCorrectionCounts colour;
+  auto result = run(stage, matrices, &colour);
+  DerenderSummary& summary = SummaryOf(result);
+  summary.colour_matrices = matrices;
+  if (!matrices.empty()) {
+    Log(1, ColourCorrectionReport(session, matrices));
+    summary.rejected["colour_unmeasured"] += colour.dropped;
+    summary.colour_negative = colour.negative;
+  }
+  if (colour.dropped > 0) {
+    Log(1, "warning: colour: " + std::to_string(colour.dropped) +
+               " samples removed: after the colour matrix none of their channels is measured (each mixes an "
+               "unmeasured camera channel or came out negative)");
+  }
   return result;
 }
 
@@ -938,7 +1006,10 @@ void DerenderSetup::DerenderPhoto(size_t photo, const RadianceWindow& image, boo
   DerenderStagePhoto(*impl_, photo, image, parallel, out);
 }
 
-DerenderResult DerenderSetup::DerenderAll() const { return RunStage(*impl_); }
+DerenderResult DerenderSetup::DerenderAll() const {
+  ColourCorrectionCounts unused;
+  return RunStageInMemory(*impl_, {}, &unused);
+}
 
 bool DerenderOptions::Check(std::string* why) const {
   // Grazing limits in (0, 90] degrees.
@@ -1017,37 +1088,10 @@ DerenderResult DerenderAnalytic(const Session& session, const DerenderOptions& o
 }
 
 DerenderResult Derender(const Session& session, const DerenderOptions& options) {
-  std::string why;
-  if (!options.Check(&why)) ThrowError("derender options", why);
-  // The derenderer reads calibrated lights only: the white reference is a calibration of its own
-  // (calibrate/white_reference_intensity.h), which writes the lights' intensities into the session.
-  if (session.calibration && session.calibration->white_reference) {
-    ThrowError(session.manifest_path + ": /calibration/white_reference",
-               "the lights are not calibrated from the white reference yet: run `ibrdf lights white` on the "
-               "session and derender the session it writes (`ibrdf run` does both)");
-  }
-  DerenderResult result = DerenderSetup(session, options).DerenderAll();
-  // The colour chart's matrix, per sample by its photo's light (colour_correction.h). Its channels'
-  // validity is what the file holds, so the counts are taken again after it.
-  ColourCorrectionCounts colour;
-  DerenderSummary& summary = result.summary;
-  summary.colour_matrices = ApplyColourCorrection(session, &result.samples, &colour);
-  if (!summary.colour_matrices.empty()) {
-    Log(1, ColourCorrectionReport(session, summary.colour_matrices));
-    summary.rejected["colour_unmeasured"] += colour.dropped;
-    summary.accepted = result.samples.size();
-    summary.colour_negative = colour.negative;
-    summary.channels_not_measured = {};
-    for (const BrdfSample& s : result.samples) {
-      for (int c = 0; c < 3; ++c) summary.channels_not_measured[c] += s.valid[c] == 0;
-    }
-  }
-  if (colour.dropped > 0) {
-    Log(1, "warning: colour: " + std::to_string(colour.dropped) +
-               " samples removed: after the colour matrix none of their channels is measured (each mixes an "
-               "unmeasured camera channel or came out negative)");
-  }
-  return result;
+  return DerenderWith(session, options, [](const Stage& stage, const std::vector<Eigen::Matrix3d>& colour,
+                                           ColourCorrectionCounts* counts) {
+    return RunStageInMemory(stage, colour, counts);
+  });
 }
 
 nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options, const DerenderSummary& summary) {
@@ -1114,25 +1158,36 @@ nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& op
   return sidecar;
 }
 
-DerenderResult DerenderToFile(const Session& session, const DerenderOptions& options, const std::string& samples_path) {
+DerenderSummary DerenderToFile(const Session& session, const DerenderOptions& options,
+                               const std::string& samples_path) {
   Log(1, "session " + session.name + ": " + std::to_string(session.photos.size()) + " photos, " +
              SampleKindName(session.sample.kind) + " sample, response " + session.radiometry.response.Describe() +
              (session.radiometry.relative_intensities
                   ? "; lights' intensities relative (known up to one scale): the BRDF's scale is relative too"
                   : ""));
-  DerenderResult result = Derender(session, options);
-  if (result.samples.empty()) {
-    ThrowError(session.manifest_path,
-               "no BRDF samples: every pixel was rejected (" + result.summary.BriefReport() + "); nothing written");
-  }
   // The samples and their sidecar as one unit (core/file_util.h): never a new file beside an old sidecar.
+  // Each photo's samples are appended to the file as it is done, so memory does not grow with the photos;
+  // the file appears under its name only when the stage is complete.
   AtomicFile samples_file(samples_path), sidecar_file(SidecarPath(samples_path));
-  WriteSamples(samples_file.temporary_path(), result.samples);
-  WriteJsonFile(sidecar_file.temporary_path(), DerenderSidecar(session, options, result.summary));
+  SampleFileWriter writer(samples_file.temporary_path());
+  const DerenderSummary summary = DerenderWith(
+      session, options,
+      [&](const Stage& stage, const std::vector<Eigen::Matrix3d>& colour, ColourCorrectionCounts* counts) {
+        return RunStage(stage, colour, counts, [&](const std::vector<std::vector<BrdfSample>>& blocks) {
+          for (const std::vector<BrdfSample>& block : blocks) writer.Append(block.data(), block.size());
+        });
+      });
+  if (summary.accepted == 0) {
+    ThrowError(session.manifest_path,
+               "no BRDF samples: every pixel was rejected (" + summary.BriefReport() + "); nothing written");
+  }
+  IBRDF_CHECK(writer.rows() == summary.accepted) << writer.rows() << " rows written, " << summary.accepted << " accepted";
+  writer.Finish();
+  WriteJsonFile(sidecar_file.temporary_path(), DerenderSidecar(session, options, summary));
   CommitWithManifest(&samples_file, &sidecar_file);
-  Log(1, result.summary.BriefReport());
-  for (const ExposureWarning& warning : result.summary.exposure_warnings) Log(0, "warning: " + warning.message);
-  return result;
+  Log(1, summary.BriefReport());
+  for (const ExposureWarning& warning : summary.exposure_warnings) Log(0, "warning: " + warning.message);
+  return summary;
 }
 
 }  // namespace ibrdf

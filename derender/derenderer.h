@@ -169,8 +169,13 @@ std::vector<Eigen::Vector2f> PixelCornerRays(const Camera& camera);
 // The sample file's sidecar: units, colour space, counts, options and the session it came from.
 nlohmann::json DerenderSidecar(const Session& session, const DerenderOptions& options, const DerenderSummary& summary);
 
-// The derender stage as `ibrdf derender` runs it: logs the session, derenders it (Derender) and writes
-// the samples to `samples_path` (.npy) and the sidecar to SidecarPath(samples_path); logs the summary.
-DerenderResult DerenderToFile(const Session& session, const DerenderOptions& options, const std::string& samples_path);
+// The derender stage as `ibrdf derender` runs it: logs the session, derenders it as Derender does and
+// writes the samples to `samples_path` (.npy, byte for byte what WriteSamples writes for Derender's
+// samples) and the sidecar to SidecarPath(samples_path); logs the summary. The samples are streamed:
+// each photo's are appended to a temporary file as it is done (memory independent of the number of
+// photos), and the file is moved into place, with its sidecar, only when the stage is complete; a
+// stage that fails or is interrupted leaves no file. Returns the summary (ReadSamples reads the samples).
+DerenderSummary DerenderToFile(const Session& session, const DerenderOptions& options,
+                               const std::string& samples_path);
 
 }  // namespace ibrdf

@@ -104,7 +104,9 @@ py::object Derender(const py::object& session_arg, const py::object& out, bool o
     std::vector<std::string> inputs = SessionInputs(session);
     if (!session.sample.mesh_file.empty()) inputs.push_back(session.AbsolutePath(session.sample.mesh_file) + ".json");
     RequireWritableOutputs(path, {{SidecarPath(path), "ibrdf-samples"}}, overwrite, inputs);
-    RunLong([&] { result = DerenderToFile(session, options, path); }, progress);
+    // The stage streams its samples to the file; the array returned is the file's.
+    RunLong([&] { result.summary = DerenderToFile(session, options, path); }, progress);
+    result.samples = ReadSamples(path);
   } else {
     RunLong([&] { result = ibrdf::Derender(session, options); }, progress);
   }

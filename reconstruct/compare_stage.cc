@@ -22,7 +22,7 @@ CompareOutcome CompareFileWithTruth(const std::string& input, const std::string&
     outcome.json = ToJson(check);
     outcome.json["table"] = input;
   } else {
-    const TruthComparison comparison = CompareWithTruth(ReadSamples(input), *truth);
+    const TruthComparison comparison = CompareSampleFileWithTruth(input, *truth);
     outcome.text = ComparisonTable(comparison);
     outcome.brief = comparison.BriefReport();
     outcome.json = ToJson(comparison);

@@ -58,68 +58,98 @@ nlohmann::json StatsJson(const ErrorStats& stats) {
           {"mean_signed_rel_error", rgb(stats.bias)}};
 }
 
-}  // namespace
+// CompareWithTruth's work on samples that come in runs (a vector, or a file's chunks): the truth's values
+// in parallel, a block at a time into a reused buffer; the accumulation stays serial and in sample order,
+// so the figures are those of the one-thread loop, bit for bit, however the samples are split.
+class TruthComparer {
+ public:
+  TruthComparer(const BrdfModel& truth, const std::vector<double>& band_edges_deg)
+      : truth_(truth), edges_(band_edges_deg), bands_(band_edges_deg.size() - 1) {}
 
-TruthComparison CompareWithTruth(const std::vector<BrdfSample>& samples, const BrdfModel& truth,
-                                 const std::vector<double>& band_edges_deg) {
-  IBRDF_CHECK(band_edges_deg.size() >= 2);
-  TruthComparison comparison;
-  Accumulator overall;
-  std::vector<Accumulator> bands(band_edges_deg.size() - 1);
-  // The truth's values in parallel, a block at a time into a reused buffer; the accumulation stays
-  // serial and in sample order, so the figures are those of the one-thread loop, bit for bit.
-  constexpr size_t kBlock = 1 << 16;
+  void Add(const BrdfSample* samples, size_t count) {
+    for (size_t begin = 0; begin < count; begin += kBlock) {
+      const size_t end = std::min(count, begin + kBlock);
+      block_.resize(std::max(block_.size(), end - begin));
+      tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 1024), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t i = range.begin(); i < range.end(); ++i) Compare(samples[i], &block_[i - begin]);
+      });
+      for (size_t i = begin; i < end; ++i) {
+        const Compared& c = block_[i - begin];
+        if (c.zero_truth) {
+          ++comparison_.skipped_zero_truth;
+          continue;
+        }
+        overall_.Add(c.rel, samples[i].valid);
+        if (c.band >= 0) bands_[c.band].Add(c.rel, samples[i].valid);
+      }
+    }
+  }
+
+  TruthComparison Finish() {
+    // The percentiles of the bands and of the whole set, side by side.
+    std::vector<ErrorStats> band_stats(bands_.size());
+    tbb::parallel_invoke(
+        [&] { comparison_.overall = overall_.Finish(); },
+        [&] { tbb::parallel_for(size_t(0), bands_.size(), [&](size_t b) { band_stats[b] = bands_[b].Finish(); }); });
+    for (size_t b = 0; b < bands_.size(); ++b) {
+      comparison_.bands.push_back({edges_[b], edges_[b + 1], band_stats[b]});
+    }
+    comparison_.success = true;
+    return comparison_;
+  }
+
+ private:
+  static constexpr size_t kBlock = 1 << 16;
   struct Compared {
     Eigen::Vector3d rel;
     int band = -1;  // -1: in no band
     bool zero_truth = false;
   };
-  std::vector<Compared> block(std::min(kBlock, samples.size()));
-  for (size_t begin = 0; begin < samples.size(); begin += kBlock) {
-    const size_t end = std::min(samples.size(), begin + kBlock);
-    tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 1024), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i < range.end(); ++i) {
-        const BrdfSample& s = samples[i];
-        Compared& out = block[i - begin];
-        const Eigen::Vector3d wi = Eigen::Vector3d(s.wi[0], s.wi[1], s.wi[2]).normalized();
-        const Eigen::Vector3d wo = Eigen::Vector3d(s.wo[0], s.wo[1], s.wo[2]).normalized();
-        const Eigen::Vector3d f_true = truth.Eval(wi, wo);
-        out.zero_truth = !((f_true.array() > 0.0).all());
-        if (out.zero_truth) continue;
-        const Eigen::Vector3d f(s.brdf[0], s.brdf[1], s.brdf[2]);
-        out.rel = (f - f_true).cwiseQuotient(f_true);
-        const double theta_deg = std::max(s.theta_i, s.theta_e) * 180.0 / M_PI;
-        out.band = -1;
-        for (size_t b = 0; b + 1 < band_edges_deg.size(); ++b) {
-          const bool last = b + 2 == band_edges_deg.size();
-          if (theta_deg >= band_edges_deg[b] &&
-              (theta_deg < band_edges_deg[b + 1] || (last && theta_deg <= band_edges_deg[b + 1]))) {
-            out.band = int(b);
-            break;
-          }
-        }
+
+  void Compare(const BrdfSample& s, Compared* out) const {
+    const Eigen::Vector3d wi = Eigen::Vector3d(s.wi[0], s.wi[1], s.wi[2]).normalized();
+    const Eigen::Vector3d wo = Eigen::Vector3d(s.wo[0], s.wo[1], s.wo[2]).normalized();
+    const Eigen::Vector3d f_true = truth_.Eval(wi, wo);
+    out->zero_truth = !((f_true.array() > 0.0).all());
+    if (out->zero_truth) return;
+    const Eigen::Vector3d f(s.brdf[0], s.brdf[1], s.brdf[2]);
+    out->rel = (f - f_true).cwiseQuotient(f_true);
+    const double theta_deg = std::max(s.theta_i, s.theta_e) * 180.0 / M_PI;
+    out->band = -1;
+    for (size_t b = 0; b + 1 < edges_.size(); ++b) {
+      const bool last = b + 2 == edges_.size();
+      if (theta_deg >= edges_[b] && (theta_deg < edges_[b + 1] || (last && theta_deg <= edges_[b + 1]))) {
+        out->band = int(b);
+        break;
       }
-    });
-    for (size_t i = begin; i < end; ++i) {
-      const Compared& c = block[i - begin];
-      if (c.zero_truth) {
-        ++comparison.skipped_zero_truth;
-        continue;
-      }
-      overall.Add(c.rel, samples[i].valid);
-      if (c.band >= 0) bands[c.band].Add(c.rel, samples[i].valid);
     }
   }
-  // The percentiles of the bands and of the whole set, side by side.
-  std::vector<ErrorStats> band_stats(bands.size());
-  tbb::parallel_invoke(
-      [&] { comparison.overall = overall.Finish(); },
-      [&] { tbb::parallel_for(size_t(0), bands.size(), [&](size_t b) { band_stats[b] = bands[b].Finish(); }); });
-  for (size_t b = 0; b < bands.size(); ++b) {
-    comparison.bands.push_back({band_edges_deg[b], band_edges_deg[b + 1], band_stats[b]});
-  }
-  comparison.success = true;
-  return comparison;
+
+  const BrdfModel& truth_;
+  const std::vector<double> edges_;
+  TruthComparison comparison_;
+  Accumulator overall_;
+  std::vector<Accumulator> bands_;
+  std::vector<Compared> block_;
+};
+
+}  // namespace
+
+TruthComparison CompareWithTruth(const std::vector<BrdfSample>& samples, const BrdfModel& truth,
+                                 const std::vector<double>& band_edges_deg) {
+  IBRDF_CHECK(band_edges_deg.size() >= 2);
+  TruthComparer comparer(truth, band_edges_deg);
+  comparer.Add(samples.data(), samples.size());
+  return comparer.Finish();
+}
+
+TruthComparison CompareSampleFileWithTruth(const std::string& samples_path, const BrdfModel& truth,
+                                           const std::vector<double>& band_edges_deg) {
+  IBRDF_CHECK(band_edges_deg.size() >= 2);
+  TruthComparer comparer(truth, band_edges_deg);
+  ForEachSampleChunk(samples_path, size_t(1) << 16,
+                     [&](const BrdfSample* rows, size_t count, uint64_t) { comparer.Add(rows, count); });
+  return comparer.Finish();
 }
 
 std::string TruthComparison::BriefReport() const {

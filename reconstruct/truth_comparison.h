@@ -38,6 +38,12 @@ struct TruthComparison {
 TruthComparison CompareWithTruth(const std::vector<BrdfSample>& samples, const BrdfModel& truth,
                                  const std::vector<double>& band_edges_deg = {0, 20, 40, 60, 70, 80, 90});
 
+// CompareWithTruth of a sample file's samples, read a chunk at a time (ForEachSampleChunk) rather than
+// whole: the same figures, bit for bit; the memory is the relative errors kept for the percentiles
+// (3 doubles a sample, twice), not the 76-byte rows. Throws Error as ReadSamples does.
+TruthComparison CompareSampleFileWithTruth(const std::string& samples_path, const BrdfModel& truth,
+                                           const std::vector<double>& band_edges_deg = {0, 20, 40, 60, 70, 80, 90});
+
 nlohmann::json ToJson(const TruthComparison& comparison);
 
 // Reads the material of a synthetic session's truth.json ({"format": "ibrdf-truth", "version": 1, ...},

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -89,6 +90,52 @@ void ExpectCleanStop(int signal_number) {
 TEST(InterruptionCli, ReconstructStoppedBySigintLeavesNoTemporary) { ExpectCleanStop(SIGINT); }
 
 TEST(InterruptionCli, ReconstructStoppedBySigtermLeavesNoTemporary) { ExpectCleanStop(SIGTERM); }
+
+// `ibrdf derender` streams each photo's samples into its temporary file: stopped by SIGTERM once rows
+// are in it (the file has grown past its header), it ends by the signal and leaves neither the sample
+// file, nor its sidecar, nor the temporary.
+TEST(InterruptionCli, DerenderStoppedWhileStreamingLeavesNoFile) {
+  testing::ScratchDir dir;
+  const std::string session = dir / "session", out_dir = dir / "out", out = dir / "out/samples.npy";
+  const std::string synth = std::string(IBRDF_BINARY) + " --silent synth --out " + session + " --material " +
+                            IBRDF_SAMPLES_DIR + "/materials/bluepaint.json --photos 30 --width 480 --height 360";
+  ASSERT_EQ(std::system(synth.c_str()), 0) << synth;
+  fs::create_directories(out_dir);
+  std::vector<std::string> args = {IBRDF_BINARY, "--silent", "--threads", "1", "derender", session, "--out", out};
+  std::vector<char*> argv;
+  for (std::string& arg : args) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  ASSERT_EQ(::posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ), 0);
+  bool signalled = false;
+  uintmax_t seen_bytes = 0;
+  const auto start = std::chrono::steady_clock::now();
+  int status = 0;
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (!signalled) {
+      for (const std::string& name : Temporaries(out_dir)) {
+        std::error_code ignored;
+        const uintmax_t bytes = fs::file_size(fs::path(out_dir) / name, ignored);
+        if (name.find("samples") != std::string::npos && bytes != uintmax_t(-1) && bytes > 4096) {
+          seen_bytes = bytes;
+          ::kill(pid, SIGTERM);
+          signalled = true;
+        }
+      }
+    }
+    if (std::chrono::steady_clock::now() - start > std::chrono::seconds(120)) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      FAIL() << "derender did not end";
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  ASSERT_TRUE(signalled) << "derender ended before rows were seen in its temporary (status " << status << ")";
+  EXPECT_GT(seen_bytes, 4096u);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "status " << status;
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  EXPECT_TRUE(fs::is_empty(out_dir)) << "files left in " << out_dir;
+}
 
 }  // namespace
 }  // namespace ibrdf

@@ -383,5 +383,89 @@ TEST_F(SampleFileTest, InvalidSamplesAreErrors) {
   }
 }
 
+// 20001 distinct rows (more than one read buffer of ReadSamples' 8192 rows).
+std::vector<BrdfSample> ManySamples() {
+  const std::vector<BrdfSample> pattern = TestSamples();
+  std::vector<BrdfSample> samples;
+  for (size_t i = 0; i < 20001; ++i) {
+    BrdfSample s = pattern[i % pattern.size()];
+    s.pixel[0] = static_cast<uint32_t>(i);
+    samples.push_back(s);
+  }
+  return samples;
+}
+
+// The streamed writer's file is byte for byte WriteSamples' for the same rows, whatever the runs they
+// come in (empty runs included) and whatever the count's digits (the header's count is patched in place).
+TEST_F(SampleFileTest, StreamedFileIsByteIdenticalToWriteSamples) {
+  const std::vector<BrdfSample> all = ManySamples();
+  for (const size_t count : {size_t(0), size_t(1), size_t(9), size_t(10), size_t(12345), all.size()}) {
+    const std::vector<BrdfSample> samples(all.begin(), all.begin() + count);
+    WriteSamples(Path("whole.npy"), samples);
+    {
+      SampleFileWriter writer(Path("streamed.npy"));
+      size_t done = 0;
+      for (size_t run = 0; done < count; run = (run + 7) % 4000) {
+        const size_t n = std::min(run, count - done);
+        writer.Append(samples.data() + done, n);
+        done += n;
+      }
+      EXPECT_EQ(writer.rows(), count);
+      writer.Finish();
+    }
+    const std::string whole = ReadBytes(Path("whole.npy"));
+    ASSERT_EQ(ReadBytes(Path("streamed.npy")), whole) << count << " rows";
+    ExpectSameSamples(ReadSamples(Path("streamed.npy")), samples);
+  }
+}
+
+// The chunked reader hands over every row once, in file order, in chunks of the size asked for (the
+// last one shorter), each with its first row's index; version 1 rows converted as ReadSamples does.
+TEST_F(SampleFileTest, ChunkedReaderGivesEveryRowOnceInOrder) {
+  const std::vector<BrdfSample> samples = ManySamples();
+  WriteSamples(Path("many.npy"), samples);
+  std::vector<BrdfSample> read;
+  std::vector<uint64_t> firsts;
+  const uint64_t rows = ForEachSampleChunk(Path("many.npy"), 5000, [&](const BrdfSample* chunk, size_t n, uint64_t first) {
+    EXPECT_EQ(first, read.size());
+    EXPECT_LE(n, 5000u);
+    firsts.push_back(first);
+    read.insert(read.end(), chunk, chunk + n);
+  });
+  EXPECT_EQ(rows, samples.size());
+  EXPECT_EQ(firsts, (std::vector<uint64_t>{0, 5000, 10000, 15000, 20000}));
+  ExpectSameSamples(read, samples);
+  std::string v1;
+  for (const BrdfSample& s : samples) v1.append(reinterpret_cast<const char*>(&s), 72);
+  WriteNpy(Path("v1.npy"), BrdfSampleDtypeVersion1(), {samples.size()}, 72, v1.data(), v1.size());
+  read.clear();
+  ForEachSampleChunk(Path("v1.npy"), 3000,
+                     [&](const BrdfSample* chunk, size_t n, uint64_t) { read.insert(read.end(), chunk, chunk + n); });
+  ExpectSameSamples(read, ReadSamples(Path("v1.npy")));
+  WriteSamples(Path("empty.npy"), {});
+  size_t calls = 0;
+  EXPECT_EQ(ForEachSampleChunk(Path("empty.npy"), 10, [&](const BrdfSample*, size_t, uint64_t) { ++calls; }), 0u);
+  EXPECT_EQ(calls, 0u);
+}
+
+// A bad row stops the chunked reader with an Error naming the file and the row, before its chunk is
+// handed over; the chunks before it were whole and valid.
+TEST_F(SampleFileTest, ChunkedReaderNamesTheFileAndTheBadRow) {
+  std::vector<BrdfSample> samples = ManySamples();
+  samples[17003].delta_phi = 5.0f;
+  WriteSamples(Path("bad.npy"), samples);
+  uint64_t handed = 0;
+  const std::string message = testing::ErrorOf([&] {
+    ForEachSampleChunk(Path("bad.npy"), 1000, [&](const BrdfSample*, size_t n, uint64_t) { handed += n; });
+  });
+  EXPECT_NE(message.find(Path("bad.npy") + ": sample 17003: delta_phi"), std::string::npos) << message;
+  EXPECT_EQ(handed, 17000u);
+  // A file cut short: the header's count no longer matches its rows.
+  std::string bytes = ReadBytes(Path("bad.npy"));
+  WriteBytes(Path("cut.npy"), bytes.substr(0, bytes.size() - 10));
+  const std::string cut = testing::ErrorOf([&] { ForEachSampleChunk(Path("cut.npy"), 1000, [](const BrdfSample*, size_t, uint64_t) {}); });
+  EXPECT_NE(cut.find(Path("cut.npy")), std::string::npos) << cut;
+}
+
 }  // namespace
 }  // namespace ibrdf

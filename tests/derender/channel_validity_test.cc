@@ -86,8 +86,8 @@ TEST(ChannelValidity, ClippedSingleExposureWarnsAndNamesBrackets) {
   options.rig.exposure_target = 1.0;  // the 99th percentile at the saturation level: the top 1 % clips
   const Session single = Session::Load(MakeSession(dir / "single", options, *material));
   const std::string samples_path = dir / "single.npy";
-  const DerenderResult clipped = DerenderToFile(single, DerenderOptions(), samples_path);
-  ASSERT_GT(clipped.summary.channels_not_measured[0] + clipped.summary.rejected.at("saturated"), 0u);
+  const DerenderSummary clipped = DerenderToFile(single, DerenderOptions(), samples_path);
+  ASSERT_GT(clipped.channels_not_measured[0] + clipped.rejected.at("saturated"), 0u);
   const nlohmann::json sidecar = ReadJsonFile(SidecarPath(samples_path));
   const nlohmann::json& warnings = sidecar.at("exposure").at("warnings");
   bool named = false;

@@ -80,7 +80,8 @@ class ReportTest : public ::testing::Test {
     testing::MakeSession(s, synth, *material);
     fs::create_directories(run);
     const std::string samples_path = run + "/samples.npy";
-    const std::vector<BrdfSample> samples = DerenderToFile(Session::Load(s), DerenderOptions(), samples_path).samples;
+    DerenderToFile(Session::Load(s), DerenderOptions(), samples_path);
+    const std::vector<BrdfSample> samples = ReadSamples(samples_path);
     WriteJsonFile(run + "/consistency.json", CheckSamples(samples, ConsistencyOptions(), nullptr));
     const std::string truth_path = TruthPathFromSidecar(samples_path);
     nlohmann::json comparison = ToJson(CompareWithTruth(samples, *LoadTruthMaterial(truth_path)));
