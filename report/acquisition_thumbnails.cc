@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/logging.h"
 #include "core/math.h"
+#include "core/statistics.h"
 #include "radiometry/linear_image.h"
 #include "report/report_png.h"
 #include "report/tone_map.h"
@@ -29,8 +30,8 @@ using Polyline = std::vector<Eigen::Vector2d>;
 // The mesh in the world frame with its edges, each with the one or two faces beside it, built once for
 // every photo's silhouette.
 struct MeshEdges {
-  std::vector<Eigen::Vector3d> points;      // world frame
-  std::vector<Eigen::Vector3d> normals;     // per face, world frame, not normalized
+  std::vector<Eigen::Vector3d> points;    // world frame
+  std::vector<Eigen::Vector3d> normals;   // per face, world frame, not normalized
   std::vector<std::array<int, 4>> edges;  // vertex a, vertex b, face, other face (-1: boundary)
 };
 
@@ -56,8 +57,8 @@ MeshEdges BuildMeshEdges(const ScanMesh& mesh, const Sim3d& world_from_mesh) {
       ++j;
     }
     // A non-manifold edge (three or more faces) is drawn from its first two faces.
-    out.edges.push_back({std::get<0>(half[i]), std::get<1>(half[i]), std::get<2>(half[i]),
-                         j > i + 1 ? std::get<2>(half[i + 1]) : -1});
+    out.edges.push_back(
+        {std::get<0>(half[i]), std::get<1>(half[i]), std::get<2>(half[i]), j > i + 1 ? std::get<2>(half[i + 1]) : -1});
     i = j;
   }
   return out;
@@ -146,7 +147,8 @@ std::vector<Polyline> Outline(const Session& session, const Rigid3d& camera_from
           std::vector<Eigen::Vector3d> points;
           // Several points along the line: distortion bends its image.
           const int steps = std::max(2, n / 8);
-          for (int i = 0; i <= steps; ++i) points.push_back(sample.center + r * normal + (-half + 2.0 * half * i / steps) * a);
+          for (int i = 0; i <= steps; ++i)
+            points.push_back(sample.center + r * normal + (-half + 2.0 * half * i / steps) * a);
           project.Line(points);
         }
       }
@@ -155,10 +157,11 @@ std::vector<Polyline> Outline(const Session& session, const Rigid3d& camera_from
     case SampleSpec::Kind::kMesh: {
       if (!mesh) break;
       for (const std::array<int, 4>& e : mesh->edges) {
-        // Both faces are judged from the edge's own vertex (a plane through it faces the camera or not).
+        // Boundary edges are left out: on a scan mesh they are mostly the seams between merged scans,
+        // drawn across the object's face. Both faces are judged from the edge's own vertex.
+        if (e[3] < 0) continue;
         const Eigen::Vector3d to_eye = eye - mesh->points[e[0]];
-        const bool front0 = mesh->normals[e[2]].dot(to_eye) > 0.0;
-        const bool silhouette = e[3] < 0 ? front0 : front0 != (mesh->normals[e[3]].dot(to_eye) > 0.0);
+        const bool silhouette = (mesh->normals[e[2]].dot(to_eye) > 0.0) != (mesh->normals[e[3]].dot(to_eye) > 0.0);
         if (silhouette) project.Line({mesh->points[e[0]], mesh->points[e[1]]});
       }
       break;
@@ -248,6 +251,15 @@ nlohmann::json WriteAcquisitionThumbnails(const Session& session, const std::map
   }
   fs::create_directories(fs::path(tmp_dir) / "acquisition");
   nlohmann::json entries = nlohmann::json::array();
+  // The thumbnails, linear until every one is read (they share a tone scale).
+  struct Pending {
+    Image linear;
+    double scale = 0.0;
+    std::vector<Polyline> outline;  // thumbnail coordinates
+    std::string file;
+    size_t entry = 0;  // in `entries`
+  };
+  std::vector<Pending> pending;
   for (const size_t index : chosen) {
     const auto stats = photos.find(uint32_t(index));
     nlohmann::json entry = {{"index", index}, {"samples", stats == photos.end() ? 0 : stats->second.count}};
@@ -275,18 +287,23 @@ nlohmann::json WriteAcquisitionThumbnails(const Session& session, const std::map
       if (x1 > x0 && y1 > y0) {
         const int pad = std::max(4, int(std::max(x1 - x0, y1 - y0) / 8));
         box = {std::max(0, int(std::floor(x0)) - pad), std::max(0, int(std::floor(y0)) - pad),
-               std::min(photo.width - 1, int(std::ceil(x1)) + pad), std::min(photo.height - 1, int(std::ceil(y1)) + pad)};
+               std::min(photo.width - 1, int(std::ceil(x1)) + pad),
+               std::min(photo.height - 1, int(std::ceil(y1)) + pad)};
       }
+      Pending thumbnail;
       int step = 1;
-      Image thumbnail = ToneMap(ShrinkRegion(photo, box, options.size_px, &step), nullptr);
+      thumbnail.linear = ShrinkRegion(photo, box, options.size_px, &step);
+      ToneMap(thumbnail.linear, &thumbnail.scale);
       for (const Polyline& line : outline) {
         Polyline local;
         for (const Eigen::Vector2d& p : line) local.push_back((p - Eigen::Vector2d(box.x0, box.y0)) / step);
-        Draw(local, &thumbnail);
+        thumbnail.outline.push_back(local);
       }
       char name[40];
       std::snprintf(name, sizeof(name), "acquisition/%03zu.png", index);
-      WriteReportPng((fs::path(tmp_dir) / name).string(), thumbnail);
+      thumbnail.file = name;
+      thumbnail.entry = entries.size();
+      pending.push_back(std::move(thumbnail));
       entry["file"] = name;
       entry["outline"] = !outline.empty();
       entry["crop"] = {box.x0, box.y0, box.x1, box.y1};
@@ -295,6 +312,23 @@ nlohmann::json WriteAcquisitionThumbnails(const Session& session, const std::map
       entry["note"] = e.what();
     }
     entries.push_back(entry);
+  }
+  // One tone scale for all (the median of their own): a photo darker than the others reads darker
+  // (a view against the light is dark, not its noise stretched to white).
+  std::vector<double> scales;
+  for (const Pending& thumbnail : pending) {
+    if (std::isfinite(thumbnail.scale) && thumbnail.scale > 0.0) scales.push_back(thumbnail.scale);
+  }
+  const double scale = scales.empty() ? 1.0 : Median(scales);
+  for (const Pending& thumbnail : pending) {
+    Image image = ToneMapWithScale(thumbnail.linear, scale);
+    for (const Polyline& line : thumbnail.outline) Draw(line, &image);
+    try {
+      WriteReportPng((fs::path(tmp_dir) / thumbnail.file).string(), image);
+    } catch (const Error& e) {
+      entries[thumbnail.entry].erase("file");
+      entries[thumbnail.entry]["note"] = e.what();
+    }
   }
   result["shown"] = entries.size();
   result["photos"] = entries;

@@ -22,8 +22,8 @@ namespace ibrdf {
 struct ScanMesh;
 
 struct AcquisitionThumbnailOptions {
-  int max_photos = 24;  // at most this many measurement photos, chosen evenly over the session's order
-  int size_px = 200;    // longest side of a thumbnail, pixels
+  int max_photos = 24;       // at most this many measurement photos, chosen evenly over the session's order
+  int size_px = 200;         // longest side of a thumbnail, pixels
   int outline_points = 360;  // points per projected circle (sphere limb, cylinder rim) or line
 
   bool Check(std::string* why) const;
@@ -35,9 +35,9 @@ struct AcquisitionThumbnailOptions {
 //    radius R sqrt(1 - R^2/d^2), u the unit vector from c to the camera, d the distance), one closed line;
 //  cylinder: the two rim circles and the two limb lines (the generators whose normal is perpendicular
 //    to the view ray: at angle +-acos(R/d) from the camera's direction across the axis);
-//  mesh: each silhouette edge (one adjacent face towards the camera, the other away; boundary edges of
-//    a front face too) as a two-point line; `mesh` is the sample's mesh in its own frame (world_from_mesh
-//    maps it), null for other kinds.
+//  mesh: each silhouette edge (between a face towards the camera and one away; not boundary edges,
+//    which on a scan mesh are mostly seams between scans) as a two-point line; `mesh` is the sample's
+//    mesh in its own frame (world_from_mesh maps it), null for other kinds.
 // Points behind the camera end a polyline. Empty when the camera is inside the sphere or cylinder.
 std::vector<std::vector<Eigen::Vector2d>> SampleOutline(const Session& session, const Rigid3d& camera_from_world,
                                                         const ScanMesh* mesh, int outline_points = 360);
@@ -49,7 +49,8 @@ Image ShrinkRegion(const Image& photo, const PixelBox& box, int size, int* step 
 
 // Writes `tmp_dir`/acquisition/NNN.png (NNN the photo index) for up to options.max_photos measurement
 // photos of `session` (linearized, cropped to the outline's and the samples' box with a margin, shrunk,
-// tone-mapped, the outline in green (0, 255, 0)), and returns the report data's "acquisition_thumbnails":
+// tone-mapped on one scale for all, the median of ToneMap's own scales, the outline in green (0, 255, 0)), and returns
+// the report data's "acquisition_thumbnails":
 // {"measurement_photos", "shown", "size_px", "photos": [{"index", "file", "samples" (from `photos`),
 // "outline" (false where the photo has no pose or the sample projects nowhere), "crop" [x0, y0, x1, y1],
 // "step"} or {"index", "note"} where the photo could not be read]}, plus "note" when the mesh cannot

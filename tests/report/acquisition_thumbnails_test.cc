@@ -170,7 +170,8 @@ TEST(AcquisitionThumbnails, ThumbnailOutlineLiesOnThePhotosSphereEdge) {
     int green = 0;
     for (int y = 0; y < thumbnail.height; ++y) {
       for (int x = 0; x < thumbnail.width; ++x) {
-        if (!(thumbnail.at(x, y, 0) == 0.0f && thumbnail.at(x, y, 1) == 1.0f && thumbnail.at(x, y, 2) == 0.0f)) continue;
+        if (!(thumbnail.at(x, y, 0) == 0.0f && thumbnail.at(x, y, 1) == 1.0f && thumbnail.at(x, y, 2) == 0.0f))
+          continue;
         ++green;
         const Eigen::Vector2d q = (Eigen::Vector2d(x + 0.5, y + 0.5) - (centre - crop) / step);
         EXPECT_NEAR(q.norm(), radius / step, 1.0) << "photo " << index << " pixel " << x << ", " << y;
