@@ -49,12 +49,11 @@ Image ShrinkRegion(const Image& photo, const PixelBox& box, int size, int* step 
 
 // Writes `tmp_dir`/acquisition/NNN.png (NNN the photo index) for up to options.max_photos measurement
 // photos of `session` (linearized, cropped to the outline's and the samples' box with a margin, shrunk,
-// tone-mapped on one scale for all, the median of ToneMap's own scales, the outline in green (0, 255, 0)), and returns
-// the report data's "acquisition_thumbnails":
-// {"measurement_photos", "shown", "size_px", "photos": [{"index", "file", "samples" (from `photos`),
-// "outline" (false where the photo has no pose or the sample projects nowhere), "crop" [x0, y0, x1, y1],
-// "step"} or {"index", "note"} where the photo could not be read]}, plus "note" when the mesh cannot
-// be read (the photos are then shown without an outline).
+// tone-mapped on one scale for all, the median of ToneMap's own scales, the outline in green (0, 255,
+// 0)), and returns the report data's "acquisition_thumbnails": {"measurement_photos", "shown", "size_px", "photos":
+// [{"index", "file", "samples" (from `photos`), "outline" (false where the photo has no pose or the sample projects
+// nowhere), "crop" [x0, y0, x1, y1], "step"} or {"index", "note"} where the photo could not be read]}, plus "note" when
+// the mesh cannot be read (the photos are then shown without an outline).
 nlohmann::json WriteAcquisitionThumbnails(const Session& session, const std::map<uint32_t, PhotoStats>& photos,
                                           const std::string& tmp_dir,
                                           const AcquisitionThumbnailOptions& options = AcquisitionThumbnailOptions());
