@@ -12,6 +12,7 @@
 #include "core/image_io.h"
 #include "core/math.h"
 #include "radiometry/linear_image.h"
+#include "scan/ply_io.h"
 #include "scan/scan_mesh.h"
 #include "tests/test_util.h"
 
@@ -40,6 +41,33 @@ Session MakeSynthetic(const ScratchDir& dir, SampleSpec::Kind kind, bool distort
 Eigen::Vector3d Ray(const Session& session, const Rigid3d& camera_from_world, const Eigen::Vector2d& pixel) {
   const Eigen::Vector2d plane = session.camera.CamPlaneFromImage(pixel);
   return (camera_from_world.rotation.inverse() * Eigen::Vector3d(plane.x(), plane.y(), 1.0)).normalized();
+}
+
+// A closed UV sphere of `radius` about the origin (3-degree rings and segments), faces counter-clockwise
+// seen from outside.
+ScanMesh UvSphere(double radius) {
+  ScanMesh mesh;
+  const int rings = 60, segments = 120;
+  mesh.points.push_back(Eigen::Vector3d(0, 0, radius));
+  for (int i = 1; i < rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      const double t = kPi * i / rings, p = 2.0 * kPi * j / segments;
+      mesh.points.push_back(radius *
+                            Eigen::Vector3d(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)));
+    }
+  }
+  mesh.points.push_back(Eigen::Vector3d(0, 0, -radius));
+  const int south = int(mesh.points.size()) - 1;
+  auto at = [&](int i, int j) { return 1 + (i - 1) * segments + (j % segments); };
+  for (int j = 0; j < segments; ++j) {
+    mesh.faces.push_back(Eigen::Vector3i(0, at(1, j), at(1, j + 1)));
+    mesh.faces.push_back(Eigen::Vector3i(south, at(rings - 1, j + 1), at(rings - 1, j)));
+    for (int i = 1; i + 1 < rings; ++i) {
+      mesh.faces.push_back(Eigen::Vector3i(at(i, j), at(i + 1, j), at(i + 1, j + 1)));
+      mesh.faces.push_back(Eigen::Vector3i(at(i, j), at(i + 1, j + 1), at(i, j + 1)));
+    }
+  }
+  return mesh;
 }
 
 TEST(AcquisitionThumbnails, DefaultOptionsAreValid) {
@@ -105,26 +133,7 @@ TEST(AcquisitionThumbnails, MeshSilhouetteEdgesFollowTheLimb) {
   const Eigen::Vector3d eye = pose.Inverse().translation, centre = session.sample.center;
   const double r = session.sample.radius;
   // A UV sphere of radius r in a mesh frame scaled by 2 and shifted (world_from_mesh maps it back).
-  ScanMesh mesh;
-  const int rings = 60, segments = 120;
-  mesh.points.push_back(Eigen::Vector3d(0, 0, r / 2));
-  for (int i = 1; i < rings; ++i) {
-    for (int j = 0; j < segments; ++j) {
-      const double t = kPi * i / rings, p = 2.0 * kPi * j / segments;
-      mesh.points.push_back(r / 2 * Eigen::Vector3d(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)));
-    }
-  }
-  mesh.points.push_back(Eigen::Vector3d(0, 0, -r / 2));
-  const int south = int(mesh.points.size()) - 1;
-  auto at = [&](int i, int j) { return 1 + (i - 1) * segments + (j % segments); };
-  for (int j = 0; j < segments; ++j) {
-    mesh.faces.push_back(Eigen::Vector3i(0, at(1, j), at(1, j + 1)));
-    mesh.faces.push_back(Eigen::Vector3i(south, at(rings - 1, j + 1), at(rings - 1, j)));
-    for (int i = 1; i + 1 < rings; ++i) {
-      mesh.faces.push_back(Eigen::Vector3i(at(i, j), at(i + 1, j), at(i + 1, j + 1)));
-      mesh.faces.push_back(Eigen::Vector3i(at(i, j), at(i + 1, j + 1), at(i, j + 1)));
-    }
-  }
+  const ScanMesh mesh = UvSphere(r / 2);
   session.sample.kind = SampleSpec::Kind::kMesh;
   session.sample.world_from_mesh = Sim3d(Eigen::Quaterniond::Identity(), centre, 2.0);
   const auto outline = SampleOutline(session, pose, &mesh);
@@ -215,6 +224,44 @@ TEST(AcquisitionThumbnails, ManyPhotosGiveAnEvenSubset) {
   EXPECT_EQ(data.at("photos")[2].at("index"), 6);
   const Image small = ReadImage((fs::path(dir / "out") / data.at("photos")[1].at("file").get<std::string>()).string());
   EXPECT_LE(std::max(small.width, small.height), 64);
+}
+
+// A mesh session: the mesh file (PLY, in the session's folder) is read and its silhouette drawn on
+// the sphere's edge; a photo without a pose gets no outline; a missing mesh file is a note, the photos
+// still shown.
+TEST(AcquisitionThumbnails, MeshSessionReadsItsPlyAndPhotosWithoutPoseHaveNoOutline) {
+  ScratchDir dir;
+  Session session = MakeSynthetic(dir, SampleSpec::Kind::kSphere, /*distortion=*/true, 2);
+  WritePly(dir / "s/mesh.ply", UvSphere(session.sample.radius));
+  session.sample.kind = SampleSpec::Kind::kMesh;
+  session.sample.mesh_file = "mesh.ply";
+  session.sample.world_from_mesh = Sim3d(Eigen::Quaterniond::Identity(), session.sample.center, 1.0);
+  session.photos[1].camera_from_world.reset();
+  const nlohmann::json data = WriteAcquisitionThumbnails(session, {}, dir / "out");
+  ASSERT_FALSE(data.contains("note")) << data.dump();
+  ASSERT_EQ(data.at("photos").size(), 2u);
+  EXPECT_TRUE(data.at("photos")[0].at("outline").get<bool>());
+  EXPECT_FALSE(data.at("photos")[1].at("outline").get<bool>());
+  const Image drawn = ReadImage((fs::path(dir / "out") / data.at("photos")[0].at("file").get<std::string>()).string());
+  const Image plain = ReadImage((fs::path(dir / "out") / data.at("photos")[1].at("file").get<std::string>()).string());
+  auto green = [](const Image& image) {
+    int n = 0;
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        n += image.at(x, y, 0) == 0.0f && image.at(x, y, 1) == 1.0f && image.at(x, y, 2) == 0.0f;
+      }
+    }
+    return n;
+  };
+  EXPECT_GT(green(drawn), 100);
+  EXPECT_EQ(green(plain), 0);
+
+  session.sample.mesh_file = "missing.ply";
+  const nlohmann::json missing = WriteAcquisitionThumbnails(session, {}, dir / "out2");
+  ASSERT_TRUE(missing.contains("note"));
+  EXPECT_NE(missing.at("note").get<std::string>().find("missing.ply"), std::string::npos) << missing.dump();
+  EXPECT_EQ(missing.at("shown"), 2);
+  EXPECT_FALSE(missing.at("photos")[0].at("outline").get<bool>());
 }
 
 }  // namespace
