@@ -18,6 +18,7 @@
 #include "core/session.h"
 #include "core/statistics.h"
 #include "radiometry/linear_image.h"
+#include "report/acquisition_thumbnails.h"
 #include "report/report_png.h"
 #include "report/tone_map.h"
 
@@ -34,23 +35,7 @@ Image Thumbnail(const Session& session, uint32_t index, const PhotoStats& stats,
   const int pad = std::max(4, (stats.x1 - stats.x0) / 8);
   const int x0 = std::max(0, stats.x0 - pad), y0 = std::max(0, stats.y0 - pad);
   const int x1 = std::min(photo.width - 1, stats.x1 + pad), y1 = std::min(photo.height - 1, stats.y1 + pad);
-  const int w = x1 - x0 + 1, h = y1 - y0 + 1;
-  const int step = std::max(1, static_cast<int>(std::ceil(double(std::max(w, h)) / size)));
-  Image small(std::max(1, w / step), std::max(1, h / step), 3);
-  for (int y = 0; y < small.height; ++y) {
-    for (int x = 0; x < small.width; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        double sum = 0.0;
-        for (int dy = 0; dy < step; ++dy) {
-          for (int dx = 0; dx < step; ++dx) {
-            sum += photo.at(x0 + x * step + dx, y0 + y * step + dy, std::min(c, photo.channels - 1));
-          }
-        }
-        small.at(x, y, c) = static_cast<float>(sum / (step * step));
-      }
-    }
-  }
-  return ToneMap(small, nullptr);
+  return ToneMap(ShrinkRegion(photo, PixelBox{x0, y0, x1, y1}, size), nullptr);
 }
 
 }  // namespace

@@ -32,6 +32,7 @@
 #include "reconstruct/merl_table.h"
 #include "reconstruct/prediction_check.h"
 #include "reconstruct/truth_comparison.h"
+#include "report/acquisition_thumbnails.h"
 #include "report/light_photos.h"
 #include "report/photo_comparison.h"
 #include "report/photo_statistics.h"
@@ -647,6 +648,8 @@ ReportResult WriteReport(const std::string& run_dir_name, const ReportOptions& o
   // Multi-light sessions (a dome, a turntable): the lights and a photo under each.
   const nlohmann::json lights = WriteLightPhotos(samples_path, photos, tmp.string());
   if (!lights.is_null()) data["lights"] = lights;
+  // Each measurement photo (an even subset) with the sample's outline: the poses and the sample at a glance.
+  if (session) data["acquisition_thumbnails"] = WriteAcquisitionThumbnails(*session, photos, tmp.string());
   WriteSpheres(models, options.render_size_px, chosen.phase, tmp, &data);
   data["incidence_plane"] = IncidencePlanes(samples, models, options.angles_deg, tmp, &result);
   if (options.explorer) data["explorer"] = ExplorerGrids(samples, models, tmp);

@@ -916,10 +916,48 @@ def _fmt(value, scale=1.0, digits=3):
     return "n/a" if not isinstance(value, (int, float)) else f"{value * scale:.{digits}g}"
 
 
-def acquisition_html(run_dir, side):
+def acquisition_thumbnails_html(out, data, align):
+    """Each measurement photo (an even subset) with the sample's outline as the poses put it, in a grid captioned
+    with the photo's index and whether it was used (align's verdict where it posed the photos, else whether it
+    gave samples). `data["acquisition_thumbnails"]` is written by report/acquisition_thumbnails.cc."""
+    thumbs = (data or {}).get("acquisition_thumbnails")
+    if not thumbs or not thumbs.get("photos"):
+        return ""
+    posed = {image.get("photo"): image for image in (align or {}).get("images", [])}
+    cells = []
+    for photo in thumbs["photos"]:
+        index = photo["index"]
+        image = posed.get(index)
+        if image is not None and not image.get("used"):
+            state = "dropped: " + str(image.get("dropped", ""))
+        elif photo.get("samples", 0) > 0:
+            state = f"used, {photo['samples']} samples"
+        else:
+            state = "used" if image is not None else "no samples"
+        if not photo.get("outline", True):
+            state += "; no outline (no pose, or the sample is not in view)"
+        if photo.get("file"):
+            cells.append(f'<figure><img src="{embed(out, photo["file"])}" alt="{html.escape(photo["file"])}">'
+                         f'<figcaption>photo {index}: {html.escape(state)}</figcaption></figure>')
+        else:
+            cells.append(f'<figure><figcaption>photo {index}: {html.escape(photo.get("note", "not read"))}'
+                         f'</figcaption></figure>')
+    shown, total = thumbs.get("shown", len(cells)), thumbs.get("measurement_photos", len(cells))
+    subset = (f"{shown} of the {total} measurement photos (chosen evenly)" if shown < total
+              else f"All {total} measurement photos")
+    note = f" {html.escape(thumbs['note'])}." if thumbs.get("note") else ""
+    return (f"<h3>The sample in each photo</h3><p>{subset}, each linearized, cropped to the sample and tone-mapped on one "
+            f"scale for all (a dark photo reads dark), with the sample's outline (the sphere's limb, the cylinder's rims and limb lines, or the mesh's "
+            f"silhouette edges) projected through the camera model, distortion included, from the photo's pose in "
+            f"green: an outline beside the object is a pose or sample geometry that is off.{note}</p>"
+            f'<div class="thumbs">' + "".join(cells) + "</div>\n")
+
+
+def acquisition_html(run_dir, side, data=None, out=None):
     """What the calibration stages found (response/response.json, align/alignment.json,
     lights/white-reference.json, colour/colour.json): the verdicts as a pass/fail table, each photo's markers and residual, the
-    sample's fit, the light, the white reference, the colour fit per patch, and the clipped pixels."""
+    sample's fit, the light, the white reference, the colour fit per patch, and the clipped pixels; and each photo with
+    the sample's outline drawn over it (report data from `out`)."""
     align = load_json(os.path.join(run_dir, "align", "alignment.json"))
     white = load_json(os.path.join(run_dir, "lights", "white-reference.json"))
     colour = load_json(os.path.join(run_dir, "colour", "colour.json"))
@@ -945,6 +983,10 @@ def acquisition_html(run_dir, side):
                      f"the used photos.</p>" + _table(
                          ["photo", "pose", "markers", "light markers", "outlier corners", "RMS px", "position sigma mm",
                           "rotation sigma deg"], rows))
+    thumbnails = acquisition_thumbnails_html(out, data, align) if out else ""
+    if thumbnails:
+        parts.append(thumbnails)
+    if align:
         sphere = align.get("sphere")
         if sphere:
             sigma = sphere.get("center_sigma_m", [None, None, None])
@@ -991,9 +1033,12 @@ def acquisition_html(run_dir, side):
     clipped = {k: v for k, v in rejected.items() if "saturat" in k or "clip" in k}
     if clipped:
         parts.append("<h3>Clipping</h3>" + _table(["rejected as", "pixels"], [[k, v] for k, v in clipped.items()]))
+    given = "<p>No calibration stage ran: the session's poses, sample and lights are used as given.</p>"
     if not parts:
-        return "<h2>Acquisition</h2><p>No calibration stage ran: the session's poses, sample and lights are used as given.</p>"
-    return "<h2>Acquisition</h2>\n" + "\n".join(parts)
+        return '<h2 id="acquisition">Acquisition</h2>' + given
+    if parts == [thumbnails]:
+        return '<h2 id="acquisition">Acquisition</h2>' + "\n" + given + thumbnails
+    return '<h2 id="acquisition">Acquisition</h2>' + "\n" + "\n".join(parts)
 
 
 def notices_html(run_dir, side):
@@ -1082,6 +1127,7 @@ body {{ font-family: sans-serif; margin: 2em; max-width: 1500px; }}
 table {{ border-collapse: collapse; }} th, td {{ border: 1px solid #ccc; padding: 3px 8px; text-align: left; }}
 th {{ font-weight: normal; color: #444; }} figure {{ display: inline-block; margin: 0.5em; vertical-align: top; }}
 figure img {{ max-width: 100%; }} figcaption {{ font-size: 0.85em; color: #555; max-width: 24em; }}
+.thumbs figure {{ margin: 0.3em; }} .thumbs figcaption {{ max-width: 200px; }}
 </style></head><body>
 <h1>ibrdf consistency report: {html.escape(title)}</h1>
 <p>Run folder: <code>{html.escape(os.path.abspath(run_dir))}</code>. Figures after Marschner et al. 1999, Image-Based
@@ -1097,7 +1143,7 @@ pixel that gave a sample, f_model(wi, wo) times the irradiance term E cos(theta_
 {appearance_html(data, out, figures)}
 {held_out_html(data, out, figures)}
 {lights_section(out, data)}
-{acquisition_html(run_dir, side)}
+{acquisition_html(run_dir, side, data, out)}
 <h2>Sample coverage</h2>
 {figure_html(out, figures['coverage'], 'exitant directions sampled at each incidence angle')}
 <h2>Incidence plane, three colour channels</h2>

@@ -183,14 +183,17 @@ TEST(CaptureCli, ACollapsedSphereFitStopsTheRunUnlessAccepted) {
   EXPECT_TRUE(said) << summary.dump(1);
   EXPECT_NE(accepted.output.find("verdict: align sphere.radius: fail (accepted by the user)"), std::string::npos)
       << accepted.output;
-  // The report opens with the verdicts and shows the acquisition: checks, photos posed, the sample's fit.
+  // The report opens with the verdicts and shows the acquisition: checks, photos posed, each photo with
+  // the sample's outline, the sample's fit.
   std::ifstream page_file(dir / "run/report/index.html");
   const std::string page((std::istreambuf_iterator<char>(page_file)), std::istreambuf_iterator<char>());
   EXPECT_NE(page.find("<h2>Verdicts and warnings</h2>"), std::string::npos);
   EXPECT_NE(page.find("align sphere.radius: fail (accepted by the user)"), std::string::npos);
-  EXPECT_NE(page.find("<h2>Acquisition</h2>"), std::string::npos);
+  EXPECT_NE(page.find("<h2 id=\"acquisition\">Acquisition</h2>"), std::string::npos);
   EXPECT_NE(page.find("<td>FAIL (accepted)</td>"), std::string::npos);
   EXPECT_NE(page.find("<h3>Photos posed</h3>"), std::string::npos);
+  EXPECT_NE(page.find("<h3>The sample in each photo</h3>"), std::string::npos);
+  EXPECT_NE(page.find("alt=\"acquisition/000.png\""), std::string::npos);
 }
 
 }  // namespace

@@ -21,6 +21,8 @@
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
+#include "core/math.h"
+#include "core/merl_brdf.h"
 #include "core/sample_file.h"
 #include "core/session.h"
 #include "derender/derenderer.h"
@@ -29,8 +31,6 @@
 #include "reconstruct/prediction_check.h"
 #include "reconstruct/reconstruction_stage.h"
 #include "reconstruct/truth_comparison.h"
-#include "core/math.h"
-#include "core/merl_brdf.h"
 #include "tests/run_ibrdf.h"
 #include "tests/scratch_dir.h"
 #include "tests/test_util.h"
@@ -167,6 +167,25 @@ TEST_F(ReportTest, WritesEveryFigureAndTheHtmlShowsThemInHeadlessChromium) {
     }
   }
   const std::string html = Slurp(folder + "/index.html");
+  // Every measurement photo (6, under the limit of 24) as a thumbnail with the sample's outline, written
+  // and shown in the Acquisition section with its caption.
+  const nlohmann::json& thumbnails = data.at("acquisition_thumbnails");
+  EXPECT_EQ(thumbnails.at("measurement_photos"), 6);
+  ASSERT_EQ(thumbnails.at("photos").size(), 6u);
+  for (const nlohmann::json& thumbnail : thumbnails.at("photos")) {
+    const std::string file = thumbnail.at("file");
+    EXPECT_TRUE(thumbnail.at("outline").get<bool>()) << file;
+    EXPECT_TRUE(fs::is_regular_file(folder + "/" + file)) << file;
+    EXPECT_NE(html.find("alt=\"" + file + "\""), std::string::npos) << file;
+    // Not aligned here: a photo is used where it gave samples (the last looks against the light).
+    const int index = thumbnail.at("index");
+    const size_t photo_samples = thumbnail.at("samples");
+    const std::string caption =
+        "photo " + std::to_string(index) + ": " +
+        (photo_samples > 0 ? "used, " + std::to_string(photo_samples) + " samples" : "no samples");
+    EXPECT_NE(html.find(caption), std::string::npos) << caption;
+  }
+  EXPECT_NE(html.find("All 6 measurement photos"), std::string::npos);
   // Self-contained: every image is embedded, none is fetched from a path.
   const int images = Count(html, "<img ");
   const int embedded = Count(html, "<img src=\"data:image/png;base64,");
