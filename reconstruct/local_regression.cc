@@ -332,6 +332,56 @@ ErrorParts StandardErrors(const NormalEquations& eq, const LocalRegressionOption
   parts.shrunk = shrunk;
   return parts;
 }
+
+// The next lower degree's estimate (fitting space) from the accumulated equations: the bias's stand-in
+// where the shrunk kernel cannot carry `degree` (zeros for degree 0; the local mean where the lower
+// system is singular).
+void LowerDegreeValue(const NormalEquations& eq, int degree, double lower[3]) {
+  if (degree < 1) return;
+  const int m = kCoefficients[degree - 1];
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a(m, m);
+  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxCoefficients, 3> b(m, 3);
+  for (int i = 0; i < m; ++i) {
+    for (int j = i; j < m; ++j) a(i, j) = a(j, i) = eq.a[i][j];
+    for (int c = 0; c < 3; ++c) b(i, c) = eq.b[i][c];
+  }
+  const Eigen::LDLT<decltype(a)> ldlt(a);
+  const auto coefficients = ldlt.solve(b).eval();
+  for (int c = 0; c < 3; ++c) lower[c] = std::isfinite(coefficients(0, c)) ? coefficients(0, c) : eq.b[0][c] / eq.sum_w;
+}
+
+// The squared disagreement (per channel, fitting space) between the estimate (constant term
+// `chosen[0]`) and the highest degree above `degree` that the accumulated (wider) kernel carries under
+// the same acceptance rules as the fit; false when none does.
+bool WideFitBias(const NormalEquations& eq, const LocalRegressionOptions& options, int degree,
+                 const double chosen[kMaxCoefficients][3], Eigen::Vector3d* wide2) {
+  const double wide_samples = eq.sum_w2 > 0.0 ? eq.sum_w * eq.sum_w / eq.sum_w2 : 0.0;
+  for (int d = options.degree; d > degree; --d) {
+    const int m = kCoefficients[d];
+    if (wide_samples < options.min_samples_per_coefficient * m) continue;
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a(m, m);
+    Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxCoefficients, 3> b(m, 3);
+    for (int i = 0; i < m; ++i) {
+      for (int j = i; j < m; ++j) a(i, j) = a(j, i) = eq.a[i][j];
+      for (int c = 0; c < 3; ++c) b(i, c) = eq.b[i][c];
+    }
+    const Eigen::LDLT<decltype(a)> ldlt(a);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.rcond() > options.min_rcond)) continue;
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCoefficients, 1> e1 =
+        Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCoefficients, 1>::Zero(m);
+    e1[0] = 1.0;
+    const auto g = ldlt.solve(e1).eval();
+    const double variance = eq.Variance(g.data(), m);
+    if (!(variance > 0.0) || 1.0 / variance < options.min_fit_samples) continue;
+    const auto coefficients = ldlt.solve(b).eval();
+    for (int c = 0; c < 3; ++c) {
+      const double difference = chosen[0][c] - coefficients(0, c);
+      (*wide2)[c] = difference * difference;
+    }
+    if (wide2->allFinite()) return true;
+  }
+  return false;
+}
 }  // namespace
 
 struct LocalRegression::Impl {
@@ -902,57 +952,20 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
   }
   if (estimate.degree < 0) return Estimate();  // cannot happen: degree 0 is always finite here
   if (options_.standard_errors && exclude < 0 && self < 0) {
-    // The next lower degree's estimate in the full kernel (the bias's stand-in where the shrunk kernel
-    // cannot carry the degree).
     double lower[3] = {0, 0, 0};
-    if (estimate.degree >= 1) {
-      const int m = kCoefficients[estimate.degree - 1];
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a(m, m);
-      Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxCoefficients, 3> b(m, 3);
-      for (int i = 0; i < m; ++i) {
-        for (int j = i; j < m; ++j) a(i, j) = a(j, i) = eq.a[i][j];
-        for (int c = 0; c < 3; ++c) b(i, c) = eq.b[i][c];
-      }
-      const Eigen::LDLT<decltype(a)> ldlt(a);
-      const auto coefficients = ldlt.solve(b).eval();
-      for (int c = 0; c < 3; ++c) lower[c] = std::isfinite(coefficients(0, c)) ? coefficients(0, c) : eq.b[0][c] / eq.sum_w;
-    }
+    LowerDegreeValue(eq, estimate.degree, lower);
     ErrorParts parts = StandardErrors(eq, options_, estimate.degree, chosen_coefficients, chosen_g, lower, growth);
     if (estimate.degree < options_.degree && growth <= 1.0f) {
       // A reduced degree leaves a direction unresolved (one sheet of samples across w: the local constant
       // or plane cannot see theta_d's trend, and neither can a shrunk kernel). The requested degree
-      // fitted in a kernel bias_wide_growth times as large, where more sheets take part, gives the trend: its
-      // disagreement with the estimate stands for the estimate's bias (plus the larger fit's own bias:
-      // conservative). Where even that kernel cannot carry a higher degree, the stand-in stays.
+      // fitted in a kernel bias_wide_growth times as large, where more sheets take part, gives the
+      // trend: its disagreement with the estimate stands for the estimate's bias (plus the larger fit's
+      // own bias: conservative). Where even that kernel cannot carry a higher degree, the stand-in stays.
       search(float(options_.bias_wide_growth), false);
       eq.Accumulate();
-      const double wide_samples = eq.sum_w2 > 0.0 ? eq.sum_w * eq.sum_w / eq.sum_w2 : 0.0;
-      for (int degree = options_.degree; degree > estimate.degree; --degree) {
-        const int m = kCoefficients[degree];
-        if (wide_samples < options_.min_samples_per_coefficient * m) continue;
-        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a(m, m);
-        Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxCoefficients, 3> b(m, 3);
-        for (int i = 0; i < m; ++i) {
-          for (int j = i; j < m; ++j) a(i, j) = a(j, i) = eq.a[i][j];
-          for (int c = 0; c < 3; ++c) b(i, c) = eq.b[i][c];
-        }
-        const Eigen::LDLT<decltype(a)> ldlt(a);
-        if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.rcond() > options_.min_rcond)) continue;
-        Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCoefficients, 1> e1 =
-            Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCoefficients, 1>::Zero(m);
-        e1[0] = 1.0;
-        const auto g = ldlt.solve(e1).eval();
-        const double variance = eq.Variance(g.data(), m);
-        if (!(variance > 0.0) || 1.0 / variance < options_.min_fit_samples) continue;
-        const auto coefficients = ldlt.solve(b).eval();
-        Eigen::Vector3d wide2;
-        for (int c = 0; c < 3; ++c) {
-          const double d = chosen_coefficients[0][c] - coefficients(0, c);
-          wide2[c] = d * d;
-        }
-        if (!wide2.allFinite()) continue;
+      Eigen::Vector3d wide2;
+      if (WideFitBias(eq, options_, estimate.degree, chosen_coefficients, &wide2)) {
         parts.bias2 = parts.shrunk ? parts.bias2.cwiseMax(wide2) : wide2;
-        break;
       }
     }
     Eigen::Vector3d error = (parts.variance + parts.bias2).cwiseSqrt();

@@ -143,7 +143,7 @@ TEST(Uncertainty, GrowsAtASharpPeak) {
 }
 
 // A 10-photo bluepaint session at 400 x 300 with the default camera: the measured cells' true errors
-// fall within 2 standard errors for 90-98 % of the cell channels (measured 91.6 %, scripts/
+// fall within 2 standard errors for 90-98 % of the cell channels (measured 91.5 %, scripts/
 // bench-uncertainty); halving the stated errors loses the band (the test can fail).
 TEST(Uncertainty, TwoSigmaBandCoversMeasuredCellsOfATenPhotoSession) {
   const auto truth = LoadMaterial(MaterialPath("bluepaint"));
