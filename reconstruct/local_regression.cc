@@ -196,6 +196,192 @@ struct NormalEquations {
   }
 };
 
+
+// The standard error per channel of a fit of `degree` with coefficients `coefficients` (fitting space;
+// m x 3 for m = kCoefficients[degree]) and weights g = A^-1 e1 (the estimate is sum_p n_p w_p (b_p . g)
+// m_p over the kernel's points p of n_p samples with mean m_p), from the rows the search kept:
+//  - noise: sigma^2 sum_p n_p w_p^2 (b_p . g)^2, with the per-sample residual variance
+//    sigma^2 = sum_p w_p n_p r_p^2 / sum_p w_p (a bin mean's residual has variance sigma^2 / n_p)
+//    times P / (P - m), P = (sum w)^2 / sum w^2 the kernel's effective point count (degrees of freedom);
+//  - bias: the same degree refitted in the kernel shrunk by `shrink` (the same rows, tricube weights of
+//    r / shrink) differs from the estimate by about bias (1 - shrink^(degree + 1)) for a bias of order
+//    h^(degree + 1) (local polynomial regression's leading term, Fan and Gijbels 1996, section 3.2);
+//    the squared difference less its own noise, sigma^2 sum_p n_p (w_p b_p . g - w'_p b_p . g')^2,
+//    floored at 0, divided by (1 - shrink^(degree + 1))^2. Where the shrunk kernel cannot carry the
+//    degree (too few samples, ill-conditioned), the disagreement with the next lower degree in the
+//    full kernel stands for the bias (larger than the fit's own: conservative), and for degree 0 half
+//    the neighbours' value range.
+// Per channel, in the fitting space.
+struct ErrorParts {
+  Eigen::Vector3d variance = Eigen::Vector3d::Zero();  // of the noise
+  Eigen::Vector3d bias2 = Eigen::Vector3d::Zero();     // squared bias
+  bool shrunk = false;  // the bias is the shrunk kernel's (false: a stand-in, see above)
+};
+ErrorParts StandardErrors(const NormalEquations& eq, const LocalRegressionOptions& options, int degree,
+                               const double coefficients[kMaxCoefficients][3], const double* g,
+                               const double lower_value[3], double growth) {
+  using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients>;
+  using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCoefficients, 1>;
+  const int m = kCoefficients[degree];
+  const int kRow = NormalEquations::kRowSize;
+  const double* rows = eq.rows->data();
+  const size_t count = eq.rows_used / kRow;
+  double residual[3] = {0, 0, 0}, sum_w = 0.0, sum_w2 = 0.0;
+  const double shrink = options.bias_shrink;
+  Matrix a = Matrix::Zero(m, m);
+  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxCoefficients, 3> b =
+      Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxCoefficients, 3>::Zero(m, 3);
+  double small_w = 0.0, small_w2 = 0.0;
+  for (size_t p = 0; p < count; ++p) {
+    const double* row = rows + p * kRow;
+    const double nw2 = row[NormalEquations::kSquaredWeight], nw = row[NormalEquations::kWeight];
+    if (!(nw > 0.0)) continue;
+    const double w = nw2 / nw, n = nw * nw / nw2;
+    const double* basis = row + NormalEquations::kBasis;
+    for (int c = 0; c < 3; ++c) {
+      double fitted = 0.0;
+      for (int i = 0; i < m; ++i) fitted += basis[i] * coefficients[i][c];
+      const double r = row[NormalEquations::kMean + c] - fitted;
+      residual[c] += nw * r * r;
+    }
+    sum_w += w;
+    sum_w2 += w * w;
+    // The shrunk kernel's weight from the offsets in support radii (basis 1..3).
+    const double r2 = (basis[1] * basis[1] + basis[2] * basis[2] + basis[3] * basis[3]) / (shrink * shrink);
+    if (r2 >= 1.0) continue;
+    const double t = 1.0 - r2 * std::sqrt(r2);
+    const double ws = n * t * t * t;
+    small_w += ws;
+    small_w2 += ws * t * t * t;
+    for (int i = 0; i < m; ++i) {
+      for (int j = i; j < m; ++j) a(i, j) += ws * basis[i] * basis[j];
+      for (int c = 0; c < 3; ++c) b(i, c) += ws * basis[i] * row[NormalEquations::kMean + c];
+    }
+  }
+  Eigen::Vector3d sigma2;
+  const double points = sum_w2 > 0.0 ? sum_w * sum_w / sum_w2 : 0.0;
+  const double dof = points > m + 1.0 ? points / (points - m) : std::max(points, 1.0);
+  for (int c = 0; c < 3; ++c) sigma2[c] = sum_w > 0.0 ? residual[c] / sum_w * dof : 0.0;
+  const double relative_variance = eq.Variance(g, m);
+  Eigen::Vector3d variance = sigma2 * relative_variance;
+
+  // The shrunk kernel's fit of the same degree.
+  Eigen::Vector3d bias2 = Eigen::Vector3d::Zero();
+  bool shrunk = false;
+  if (small_w > 0.0 && small_w * small_w / small_w2 >= options.min_samples_per_coefficient * m) {
+    for (int i = 0; i < m; ++i) {
+      for (int j = 0; j < i; ++j) a(i, j) = a(j, i);
+    }
+    const Eigen::LDLT<Matrix> ldlt(a);
+    if (ldlt.info() == Eigen::Success && ldlt.isPositive() && ldlt.rcond() > options.min_rcond) {
+      Vector e1 = Vector::Zero(m);
+      e1[0] = 1.0;
+      const Vector gs = ldlt.solve(e1).eval();
+      const auto cs = ldlt.solve(b).eval();
+      double difference_variance = 0.0, small_variance = 0.0;
+      for (size_t p = 0; p < count; ++p) {
+        const double* row = rows + p * kRow;
+        const double nw2 = row[NormalEquations::kSquaredWeight], nw = row[NormalEquations::kWeight];
+        if (!(nw > 0.0)) continue;
+        const double w = nw2 / nw, n = nw * nw / nw2;
+        const double* basis = row + NormalEquations::kBasis;
+        const double r2 = (basis[1] * basis[1] + basis[2] * basis[2] + basis[3] * basis[3]) / (shrink * shrink);
+        double ws = 0.0;
+        if (r2 < 1.0) {
+          const double t = 1.0 - r2 * std::sqrt(r2);
+          ws = t * t * t;
+        }
+        double lg = 0.0, ls = 0.0;
+        for (int i = 0; i < m; ++i) {
+          lg += basis[i] * g[i];
+          ls += basis[i] * gs[i];
+        }
+        difference_variance += n * (w * lg - ws * ls) * (w * lg - ws * ls);
+        small_variance += n * ws * ws * ls * ls;
+      }
+      if (small_variance > 0.0 && 1.0 / small_variance >= options.min_fit_samples) {
+        shrunk = true;
+        const double order = 1.0 - std::pow(shrink, degree + 1);
+        for (int c = 0; c < 3; ++c) {
+          const double d = coefficients[0][c] - cs(0, c);
+          bias2[c] = std::max(0.0, d * d - sigma2[c] * difference_variance) / (order * order);
+        }
+      }
+    }
+  }
+  if (!shrunk) {
+    for (int c = 0; c < 3; ++c) {
+      const double d = degree > 0 ? coefficients[0][c] - lower_value[c] : 0.5 * (double(eq.high[c]) - eq.low[c]);
+      bias2[c] = d * d;
+    }
+  }
+  // Binning: a bin enters at its samples' centroid with their mean value, which exceeds the value at the
+  // centroid by sum_k c_kk Var_k for a quadratic of diagonal coefficients c_kk (within-bin variances
+  // Var_k, edge^2 / 12 for samples spread evenly over the bin). Both fits above see the same bins, so
+  // this part of the bias is added on its own: at a peak a few bin edges wide it dominates.
+  if (degree == 2) {
+    const double h = options.bin_fraction_h / growth, d = options.bin_fraction_d / growth;
+    for (int c = 0; c < 3; ++c) {
+      const double binning = (coefficients[4][c] + coefficients[5][c]) * h * h / 12.0 + coefficients[6][c] * d * d / 12.0;
+      bias2[c] += binning * binning;
+    }
+  }
+  ErrorParts parts;
+  parts.variance = variance;
+  parts.bias2 = bias2;
+  parts.shrunk = shrunk;
+  return parts;
+}
+
+// The next lower degree's estimate (fitting space) from the accumulated equations: the bias's stand-in
+// where the shrunk kernel cannot carry `degree` (zeros for degree 0; the local mean where the lower
+// system is singular).
+void LowerDegreeValue(const NormalEquations& eq, int degree, double lower[3]) {
+  if (degree < 1) return;
+  const int m = kCoefficients[degree - 1];
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a(m, m);
+  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxCoefficients, 3> b(m, 3);
+  for (int i = 0; i < m; ++i) {
+    for (int j = i; j < m; ++j) a(i, j) = a(j, i) = eq.a[i][j];
+    for (int c = 0; c < 3; ++c) b(i, c) = eq.b[i][c];
+  }
+  const Eigen::LDLT<decltype(a)> ldlt(a);
+  const auto coefficients = ldlt.solve(b).eval();
+  for (int c = 0; c < 3; ++c) lower[c] = std::isfinite(coefficients(0, c)) ? coefficients(0, c) : eq.b[0][c] / eq.sum_w;
+}
+
+// The squared disagreement (per channel, fitting space) between the estimate (constant term
+// `chosen[0]`) and the highest degree above `degree` that the accumulated (wider) kernel carries under
+// the same acceptance rules as the fit; false when none does.
+bool WideFitBias(const NormalEquations& eq, const LocalRegressionOptions& options, int degree,
+                 const double chosen[kMaxCoefficients][3], Eigen::Vector3d* wide2) {
+  const double wide_samples = eq.sum_w2 > 0.0 ? eq.sum_w * eq.sum_w / eq.sum_w2 : 0.0;
+  for (int d = options.degree; d > degree; --d) {
+    const int m = kCoefficients[d];
+    if (wide_samples < options.min_samples_per_coefficient * m) continue;
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a(m, m);
+    Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxCoefficients, 3> b(m, 3);
+    for (int i = 0; i < m; ++i) {
+      for (int j = i; j < m; ++j) a(i, j) = a(j, i) = eq.a[i][j];
+      for (int c = 0; c < 3; ++c) b(i, c) = eq.b[i][c];
+    }
+    const Eigen::LDLT<decltype(a)> ldlt(a);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.rcond() > options.min_rcond)) continue;
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCoefficients, 1> e1 =
+        Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCoefficients, 1>::Zero(m);
+    e1[0] = 1.0;
+    const auto g = ldlt.solve(e1).eval();
+    const double variance = eq.Variance(g.data(), m);
+    if (!(variance > 0.0) || 1.0 / variance < options.min_fit_samples) continue;
+    const auto coefficients = ldlt.solve(b).eval();
+    for (int c = 0; c < 3; ++c) {
+      const double difference = chosen[0][c] - coefficients(0, c);
+      (*wide2)[c] = difference * difference;
+    }
+    if (wide2->allFinite()) return true;
+  }
+  return false;
+}
 }  // namespace
 
 struct LocalRegression::Impl {
@@ -253,6 +439,9 @@ bool LocalRegressionOptions::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_RANGE(bin_fraction_d, 0.0, 1.0);
   if (log_space) IBRDF_CHECK_OPTION_GT(log_floor, 0.0);
   IBRDF_CHECK_OPTION_GE(max_log_noise_correction, 0.0);
+  IBRDF_CHECK_OPTION_GT(bias_shrink, 0.0);
+  IBRDF_CHECK_OPTION_LT(bias_shrink, 1.0);
+  IBRDF_CHECK_OPTION_GT(bias_wide_growth, 1.0);
   return true;
 }
 
@@ -612,6 +801,7 @@ Estimate LocalRegression::EvaluateAt(const Eigen::Vector3d& uvw, int64_t exclude
     if (!channel_regressions_[c]) continue;
     const Estimate e = channel_regressions_[c]->EvaluateAt(uvw);
     estimate.value[c] = e.value[c];
+    estimate.standard_error[c] = e.standard_error[c];
     // The least favourable reliability over the channels.
     estimate.effective_samples = std::min(estimate.effective_samples, e.effective_samples);
     estimate.rcond = std::min(estimate.rcond, e.rcond);
@@ -699,6 +889,9 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
       growth * std::sqrt(eq.a[0][1] * eq.a[0][1] + eq.a[0][2] * eq.a[0][2] + eq.a[0][3] * eq.a[0][3]) / eq.sum_w);
   estimate.effective_samples = static_cast<float>(eq.sum_w * eq.sum_w / eq.sum_w2);
   estimate.nearest = std::sqrt(eq.nearest_squared);  // the tree is in given-radius units
+  // The accepted degree's coefficients (fitting space) and weights g = A^-1 e1, for its standard error.
+  double chosen_coefficients[kMaxCoefficients][3] = {};
+  double chosen_g[kMaxCoefficients] = {};
   for (int degree = options_.degree; degree >= 0; --degree) {
     const int m = kCoefficients[degree];
     Eigen::Vector3d value;
@@ -708,6 +901,8 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
     if (degree == 0) {
       value = Eigen::Vector3d(eq.b[0][0], eq.b[0][1], eq.b[0][2]) / eq.sum_w;
       self_weight = eq.self_basis[0] / eq.sum_w;
+      for (int c = 0; c < 3; ++c) chosen_coefficients[0][c] = value[c];
+      chosen_g[0] = 1.0 / eq.sum_w;
     } else {
       if (estimate.effective_samples < options_.min_samples_per_coefficient * m) continue;
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoefficients, kMaxCoefficients> a(m, m);
@@ -741,6 +936,10 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
         in_range = in_range && value[c] >= eq.low[c] - margin && value[c] <= eq.high[c] + margin;
       }
       if (!in_range) continue;
+      for (int i = 0; i < m; ++i) {
+        chosen_g[i] = g[i];
+        for (int c = 0; c < 3; ++c) chosen_coefficients[i][c] = coefficients(i, c);
+      }
     }
     if (options_.log_space) value = value.array().exp();
     if (!value.allFinite()) continue;
@@ -752,6 +951,35 @@ Estimate LocalRegression::Fit(const Eigen::Vector3d& uvw_in, int64_t exclude, in
     break;
   }
   if (estimate.degree < 0) return Estimate();  // cannot happen: degree 0 is always finite here
+  if (options_.standard_errors && exclude < 0 && self < 0) {
+    double lower[3] = {0, 0, 0};
+    LowerDegreeValue(eq, estimate.degree, lower);
+    ErrorParts parts = StandardErrors(eq, options_, estimate.degree, chosen_coefficients, chosen_g, lower, growth);
+    if (estimate.degree < options_.degree && growth <= 1.0f) {
+      // A reduced degree leaves a direction unresolved (one sheet of samples across w: the local constant
+      // or plane cannot see theta_d's trend, and neither can a shrunk kernel). The requested degree
+      // fitted in a kernel bias_wide_growth times as large, where more sheets take part, gives the
+      // trend: its disagreement with the estimate stands for the estimate's bias (plus the larger fit's
+      // own bias: conservative). Where even that kernel cannot carry a higher degree, the stand-in stays.
+      search(float(options_.bias_wide_growth), false);
+      eq.Accumulate();
+      Eigen::Vector3d wide2;
+      if (WideFitBias(eq, options_, estimate.degree, chosen_coefficients, &wide2)) {
+        parts.bias2 = parts.shrunk ? parts.bias2.cwiseMax(wide2) : wide2;
+      }
+    }
+    Eigen::Vector3d error = (parts.variance + parts.bias2).cwiseSqrt();
+    if (!options_.log_space) {
+      // Relative: the standard error of f over f (infinite at 0).
+      for (int c = 0; c < 3; ++c) {
+        error[c] = estimate.value[c] > 0.0 ? error[c] / estimate.value[c] : std::numeric_limits<double>::infinity();
+      }
+    }
+    for (int c = 0; c < 3; ++c) {
+      estimate.standard_error[c] =
+          std::isfinite(error[c]) ? static_cast<float>(error[c]) : std::numeric_limits<float>::infinity();
+    }
+  }
   if (options_.clamp_negative && (estimate.value.array() < 0.0).any()) {
     estimate.value = estimate.value.cwiseMax(0.0);
     estimate.clamped = true;

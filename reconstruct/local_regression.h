@@ -84,6 +84,17 @@ struct LocalRegressionOptions {
   // its own point). Measured in docs/benchmarks.md, "Reconstruct".
   double bin_fraction_h = 0.2;
   double bin_fraction_d = 0.1;
+  // Standard errors (Estimate::standard_error): the noise of the estimate from the residual variance
+  // about the fit and its weights, and its bias from the disagreement with the same degree's fit in a
+  // kernel `bias_shrink` times as large (computed from the same neighbours), extrapolated to the full
+  // kernel as a bias of order h^(degree + 1), with that difference's own noise subtracted
+  // (docs/reconstruct.md, "Per-cell uncertainty"). Off: standard_error stays infinite
+  // (cross-validation never computes it).
+  // Where the degree had to be reduced, the bias is also measured against the requested degree fitted
+  // in a kernel this many times larger (more sheets of samples: the trend the reduced fit cannot see).
+  bool standard_errors = true;
+  double bias_shrink = 0.6;
+  double bias_wide_growth = 3.0;
 
   bool Check(std::string* why) const;
 };
@@ -110,6 +121,10 @@ struct Estimate {
   // Distance from the query to the nearest point of the regression (a bin's centroid, or a sample
   // without binning) inside the final support, in kernel radii as given; infinity when there is none.
   float nearest = std::numeric_limits<float>::infinity();
+  // One-sigma standard error per channel of log f (the relative error of f; in linear space the
+  // standard error of f divided by f): sqrt(noise variance + bias^2) (LocalRegressionOptions::
+  // standard_errors). Infinite when not computed or unsupported.
+  Eigen::Vector3f standard_error = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
   uint32_t neighbors = 0;  // samples with non-zero weight (mirrored images included)
   int8_t degree = -1;      // degree used; -1 when unsupported
   EstimateStatus status = EstimateStatus::kUnsupported;

@@ -40,7 +40,7 @@ std::string TabulateSummary::BriefReport() const {
 
 MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions& options, TabulateSummary* summary,
                        std::vector<float>* effective_samples, std::vector<uint8_t>* domain,
-                       const BrdfModel* fill_model) {
+                       const BrdfModel* fill_model, std::vector<float>* uncertainty) {
   std::string why;
   if (!options.Check(&why)) ThrowError("tabulate options", why);
   if (options.fill == FillMode::kModel && !fill_model) ThrowError("tabulate options", "fill 'model' without a model");
@@ -81,6 +81,7 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
   }
   if (effective_samples) effective_samples->assign(kMerlCells, 0.0f);
   if (domain) domain->assign(kMerlCells, 0);
+  if (uncertainty) uncertainty->assign(3 * kMerlCells, -1.0f);
   const double margin = options.domain.theta_d_margin_deg * M_PI / 180.0;
   const double theta_d_low = regression.theta_d_min() - margin, theta_d_high = regression.theta_d_max() + margin;
   std::mutex mutex;
@@ -111,8 +112,9 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
           if (e.effective_samples < options.min_effective_samples) c = DomainClass::kUnmeasured;
           Eigen::Vector3d value = e.value;
           bool has_value = c != DomainClass::kUnmeasured;
+          bool regression_value = has_value;  // the value is the regression's (its standard error applies)
           if (!has_value && options.fill == FillMode::kExtrapolate && e.status != EstimateStatus::kUnsupported) {
-            has_value = true;
+            has_value = regression_value = true;
           } else if (!has_value && options.fill == FillMode::kModel) {
             Eigen::Vector3d wi, wo;
             FromHalfDiff(angles, &wi, &wo);
@@ -132,6 +134,9 @@ MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions&
             }
             if (domain) (*domain)[target] = static_cast<uint8_t>(c);
             if (effective_samples && c != DomainClass::kUnmeasured) (*effective_samples)[target] = e.effective_samples;
+            if (uncertainty && regression_value) {
+              for (int ch = 0; ch < 3; ++ch) (*uncertainty)[3 * target + ch] = e.standard_error[ch];
+            }
           }
         }
         progress.Add(range.size());

@@ -43,10 +43,12 @@ struct TabulateSummary {
 // unmeasured ones -1, or with options.fill the regression's estimate (kExtrapolate, where it has one)
 // or `fill_model` (kModel; required then). `effective_samples` (optional) gets each cell's effective
 // sample count (kMerlCells floats, 0 where unmeasured); `domain` (optional) each cell's DomainClass
-// (kMerlCells bytes, 0 beyond the theta limit). Throws Error on bad options.
+// (kMerlCells bytes, 0 beyond the theta limit); `uncertainty` (optional) each cell's standard error per
+// channel (3 kMerlCells floats, Estimate::standard_error, relative) where the cell holds the
+// regression's estimate, -1 where it holds no value or a model's. Throws Error on bad options.
 MerlTable TabulateMerl(const LocalRegression& regression, const TabulateOptions& options, TabulateSummary* summary,
                        std::vector<float>* effective_samples = nullptr, std::vector<uint8_t>* domain = nullptr,
-                       const BrdfModel* fill_model = nullptr);
+                       const BrdfModel* fill_model = nullptr, std::vector<float>* uncertainty = nullptr);
 
 // The table as a float64 array of shape (90, 90, 180, 3) in 1/sr (-1 where unmeasured), for .npy.
 std::vector<double> MerlToArray(const MerlTable& table);

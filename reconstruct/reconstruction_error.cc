@@ -228,6 +228,85 @@ nlohmann::json ToJson(const ReconstructionError& error) {
            }()}};
 }
 
+UncertaintyCoverage CompareUncertaintyWithTruth(const MerlTable& table, const std::vector<float>& uncertainty,
+                                                const std::vector<uint8_t>& domain, uint8_t domain_class,
+                                                const BrdfModel& truth, double max_theta_deg) {
+  IBRDF_CHECK(uncertainty.size() == 3 * kMerlCells && domain.size() == kMerlCells)
+      << "uncertainty " << uncertainty.size() << " and domain " << domain.size() << " values for " << kMerlCells
+      << " cells";
+  std::vector<Cell> cells = Cells(max_theta_deg, 1);
+  cells.erase(std::remove_if(cells.begin(), cells.end(),
+                             [&](const Cell& cell) {
+                               return domain[cell.flat] != domain_class || !table.Measured(cell.flat) ||
+                                      uncertainty[3 * cell.flat] < 0.0f;
+                             }),
+              cells.end());
+  // Per cell channel: |log(f / f_true)| and the stated error (negative: not scored, -2: unbounded).
+  std::vector<std::array<float, 6>> scored(cells.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t k = range.begin(); k != range.end(); ++k) {
+      const Cell& cell = cells[k];
+      const Eigen::Vector3d f = table.Cell(cell.flat), t = truth.Eval(cell.wi, cell.wo);
+      for (int c = 0; c < 3; ++c) {
+        const float se = uncertainty[3 * cell.flat + c];
+        scored[k][c] = f[c] > 0.0 && t[c] > 0.0 ? static_cast<float>(std::log(f[c] / t[c])) : NAN;
+        scored[k][3 + c] = se;
+      }
+    }
+  });
+  UncertaintyCoverage out;
+  std::vector<float> errors, stated;
+  size_t one = 0, two = 0;
+  double sum2 = 0.0;
+  for (const auto& s : scored) {
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(s[c])) continue;
+      if (!std::isfinite(s[3 + c])) {
+        ++out.unbounded;
+        continue;
+      }
+      const float e = std::abs(s[c]);
+      ++out.values;
+      one += e <= s[3 + c];
+      two += e <= 2.0f * s[3 + c];
+      sum2 += double(e) * e;
+      errors.push_back(e);
+      stated.push_back(s[3 + c]);
+    }
+  }
+  if (out.values == 0) return out;
+  out.within_1sigma = double(one) / double(out.values);
+  out.within_2sigma = double(two) / double(out.values);
+  out.rms_error = std::sqrt(sum2 / double(out.values));
+  auto median = [](std::vector<float>* v) {
+    std::nth_element(v->begin(), v->begin() + v->size() / 2, v->end());
+    return double((*v)[v->size() / 2]);
+  };
+  out.median_error = median(&errors);
+  out.median_stated = median(&stated);
+  return out;
+}
+
+std::string UncertaintyCoverage::Brief() const {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "%zu cell channels: %.1f %% within 2 standard errors, %.1f %% within 1 (error median %.2f %%, RMS "
+                "%.2f %%; stated median %.2f %%)",
+                values, 100.0 * within_2sigma, 100.0 * within_1sigma, 100.0 * median_error, 100.0 * rms_error,
+                100.0 * median_stated);
+  return buffer;
+}
+
+nlohmann::json ToJson(const UncertaintyCoverage& coverage) {
+  return {{"cell_channels", coverage.values},
+          {"unbounded", coverage.unbounded},
+          {"within_1sigma", coverage.within_1sigma},
+          {"within_2sigma", coverage.within_2sigma},
+          {"median_abs_log_error", coverage.median_error},
+          {"rms_log_error", coverage.rms_error},
+          {"median_standard_error", coverage.median_stated}};
+}
+
 std::string MerlLookupCheck::Brief() const {
   char buffer[256];
   std::snprintf(buffer, sizeof(buffer),

@@ -54,6 +54,26 @@ std::vector<ReconstructionError> CompareTableWithTruth(const MerlTable& table, c
 
 nlohmann::json ToJson(const ReconstructionError& error);
 
+// How well a table's stated standard errors (uncertainty.npy: of log f, per cell and channel) cover its
+// true errors: over the cells of one class holding the regression's value with theta_i, theta_e within
+// the limit, each channel where the truth and the value are positive and the error is finite, the
+// fraction with |log(f / f_true)| within 1 and 2 standard errors (the 2-sigma band's coverage; 95 % for a
+// Gaussian error stated exactly).
+struct UncertaintyCoverage {
+  size_t values = 0;            // cell channels scored
+  size_t unbounded = 0;         // cell channels left out: infinite standard error
+  double within_1sigma = 0.0;   // fraction
+  double within_2sigma = 0.0;   // fraction
+  double median_error = 0.0;    // of |log(f / f_true)|
+  double median_stated = 0.0;   // of the standard error
+  double rms_error = 0.0;       // of log(f / f_true)
+  std::string Brief() const;
+};
+UncertaintyCoverage CompareUncertaintyWithTruth(const MerlTable& table, const std::vector<float>& uncertainty,
+                                                const std::vector<uint8_t>& domain, uint8_t domain_class,
+                                                const BrdfModel& truth, double max_theta_deg = 80.0);
+nlohmann::json ToJson(const UncertaintyCoverage& coverage);
+
 // What a renderer or a colleague doing MERL lookups (BRDFRead.cpp's lookup_brdf_val) at random
 // directions gets from a table: wi and wo drawn uniformly (by solid angle) and independently over the
 // hemisphere up to max_theta_deg (fixed seed); a lookup hits a valid cell when the cell holds data

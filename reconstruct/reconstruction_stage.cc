@@ -1,5 +1,6 @@
 #include "reconstruct/reconstruction_stage.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -98,6 +99,7 @@ void EvaluatePoints(const LocalRegression& regression, const StageInputs& inputs
   ReliabilityCounts counts;
   const std::vector<Estimate> estimates = regression.EvaluateMany(uvw, &counts);
   std::vector<double> values(3 * n, -1.0), true_values;
+  std::vector<float> uncertainty(3 * n, -1.0f);  // the regression's standard error where it gave the value
   std::vector<uint8_t> classes(n);
   DomainCounts domain;
   const FillMode fill = options.tabulate.fill;
@@ -116,12 +118,17 @@ void EvaluatePoints(const LocalRegression& regression, const StageInputs& inputs
       has_value = value.allFinite();
     }
     if (!has_value) continue;
+    const bool regression_value = c != DomainClass::kUnmeasured || fill == FillMode::kExtrapolate;
     if (c == DomainClass::kUnmeasured) ++domain.filled;
-    for (int ch = 0; ch < 3; ++ch) values[3 * i + ch] = value[ch];
+    for (int ch = 0; ch < 3; ++ch) {
+      values[3 * i + ch] = value[ch];
+      if (regression_value) uncertainty[3 * i + ch] = e.standard_error[ch];
+    }
   }
   (*timings)["eval_s"] = timer.ElapsedSeconds();
   WriteNpyArray(tmp + "/eval.npy", values, {n, 3});
   WriteBytes(tmp + "/eval_domain.npy", classes, {n});
+  WriteNpyArray(tmp + "/eval_uncertainty.npy", uncertainty, {n, 3});
   if (inputs.truth) {
     true_values.resize(3 * n);
     for (size_t i = 0; i < n; ++i) {
@@ -138,9 +145,54 @@ void EvaluatePoints(const LocalRegression& regression, const StageInputs& inputs
   Log(1, "evaluated " + std::to_string(n) + " points: " + domain.Brief() + "; " + counts.Brief());
 }
 
+// Median and 95th percentile of `values` (sorted in place); zeros when empty.
+std::pair<double, double> MedianP95(std::vector<float>* values) {
+  if (values->empty()) return {0.0, 0.0};
+  std::sort(values->begin(), values->end());
+  auto at = [values](double q) { return double((*values)[size_t(q * double(values->size() - 1))]); };
+  return {at(0.5), at(0.95)};
+}
+
+// The standard errors' figures by class (the largest channel's per cell), for summary.json and brdf.json.
+nlohmann::json UncertaintyFigures(const std::vector<uint8_t>& domain, const std::vector<float>& uncertainty,
+                                  const ReconstructOptions& options) {
+  std::vector<float> by_class[3];
+  for (size_t flat = 0; flat < domain.size(); ++flat) {
+    if (uncertainty[3 * flat] < 0.0f) continue;
+    const float e = std::max({uncertainty[3 * flat], uncertainty[3 * flat + 1], uncertainty[3 * flat + 2]});
+    by_class[std::min<int>(domain[flat], 2)].push_back(e);
+  }
+  nlohmann::json json = {
+      {"file", "uncertainty.npy"},
+      {"meaning",
+       "float32 (90, 90, 180, 3): one-sigma standard error of log f per channel (relative error of f), noise and "
+       "bias of the local fit; -1 where the cell holds no value or a model's, inf where no error could be stated"},
+      {"max_measured_standard_error", options.tabulate.domain.max_measured_standard_error},
+      {"bias_shrink", options.regression.bias_shrink}};
+  for (int c = 0; c < 3; ++c) {
+    const auto [median, p95] = MedianP95(&by_class[c]);
+    json[DomainClassName(static_cast<DomainClass>(c))] = {
+        {"cells", by_class[c].size()}, {"median", median}, {"p95", p95}};
+  }
+  return json;
+}
+
+std::string UncertaintyBrief(const nlohmann::json& figures) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "measured cells median %.2f %%, p95 %.2f %%; interpolated median %.2f %%, p95 %.2f %% (largest channel; "
+                "measured requires <= %.1f %%)",
+                100.0 * figures["measured"]["median"].get<double>(), 100.0 * figures["measured"]["p95"].get<double>(),
+                100.0 * figures["interpolated"]["median"].get<double>(),
+                100.0 * figures["interpolated"]["p95"].get<double>(),
+                100.0 * figures["max_measured_standard_error"].get<double>());
+  return buffer;
+}
+
 // What WriteTable writes besides the table and its domain.
 struct TableFiles {
   std::vector<float> effective_samples;  // per cell
+  std::vector<float> uncertainty;        // per cell and channel: the standard error (uncertainty.npy)
   nlohmann::json sidecar;                // brdf.json
 };
 
@@ -153,7 +205,7 @@ void Tabulate(const LocalRegression& regression, const ReconstructOptions& optio
   TabulateSummary tabulated;
   std::vector<float>& ess = files->effective_samples;
   std::vector<uint8_t>& domain = *domain_out;
-  *table_out = TabulateMerl(regression, options.tabulate, &tabulated, &ess, &domain, fill_model);
+  *table_out = TabulateMerl(regression, options.tabulate, &tabulated, &ess, &domain, fill_model, &files->uncertainty);
   (*timings)["tabulate_s"] = tabulated.seconds;
   Log(1, "regression: " + std::to_string(regression.size()) + " samples in " + std::to_string(regression.points()) +
              " points, " + tabulated.reliability.Brief());
@@ -176,12 +228,15 @@ void Tabulate(const LocalRegression& regression, const ReconstructOptions& optio
                                {"domain_rules",
                                 {{"measured_nearest_kernel_radii", options.tabulate.domain.measured_nearest},
                                  {"max_centroid_offset_kernel_radii", options.tabulate.domain.max_centroid_offset},
-                                 {"theta_d_margin_deg", options.tabulate.domain.theta_d_margin_deg}}}};
+                                 {"theta_d_margin_deg", options.tabulate.domain.theta_d_margin_deg},
+                                 {"max_measured_standard_error", options.tabulate.domain.max_measured_standard_error}}}};
+  table_json["uncertainty"] = UncertaintyFigures(domain, files->uncertainty, options);
+  Log(1, "standard errors (uncertainty.npy): " + UncertaintyBrief(table_json["uncertainty"]));
   if (!tabulated.fill_model.empty()) table_json["fill_model"] = tabulated.fill_model;
   files->sidecar = {
       {"format", "ibrdf-merl-table"},
       {"version", 1},
-      {"files", {"brdf.binary", "brdf.npy", "domain.npy", "effective_samples.npy"}},
+      {"files", {"brdf.binary", "brdf.npy", "domain.npy", "effective_samples.npy", "uncertainty.npy"}},
       {"domain_classes", {{"0", "unmeasured"}, {"1", "interpolated"}, {"2", "measured"}}},
       {"unmeasured_value", options.tabulate.fill == FillMode::kNone
                                ? "-1 (MERL's no data)"
@@ -206,6 +261,7 @@ double WriteTable(const MerlTable& table, const std::vector<uint8_t>& domain, co
   WriteMerl(tmp + "/brdf.binary", table);
   WriteNpyArray(tmp + "/brdf.npy", MerlToArray(table), {90, 90, 180, 3});
   WriteNpyArray(tmp + "/effective_samples.npy", files.effective_samples, {90, 90, 180});
+  WriteNpyArray(tmp + "/uncertainty.npy", files.uncertainty, {90, 90, 180, 3});
   WriteBytes(tmp + "/domain.npy", domain, {90, 90, 180});
   WriteJsonFile(tmp + "/brdf.json", files.sidecar);
   return timer.ElapsedSeconds();
@@ -214,15 +270,26 @@ double WriteTable(const MerlTable& table, const std::vector<uint8_t>& domain, co
 // The table scored against the truth over the valid cells (measured or interpolated), the measured ones
 // alone and every cell holding a value (filled ones included), and random MERL lookups; into `summary`
 // (its own object: this runs beside the .bsdf export) and `result`'s score.
-void Score(const MerlTable& table, const std::vector<uint8_t>& domain, const BrdfModel& truth,
-           const ReconstructOptions& options, nlohmann::json* summary, ReconstructResult* result) {
-  std::vector<uint8_t> measured_only(domain.size());
-  for (size_t i = 0; i < domain.size(); ++i) measured_only[i] = domain[i] == uint8_t(DomainClass::kMeasured);
+void Score(const MerlTable& table, const std::vector<uint8_t>& domain, const std::vector<float>& uncertainty,
+           const BrdfModel& truth, const ReconstructOptions& options, nlohmann::json* summary,
+           ReconstructResult* result) {
+  std::vector<uint8_t> measured_only(domain.size()), interpolated_only(domain.size());
+  for (size_t i = 0; i < domain.size(); ++i) {
+    measured_only[i] = domain[i] == uint8_t(DomainClass::kMeasured);
+    interpolated_only[i] = domain[i] == uint8_t(DomainClass::kInterpolated);
+  }
+  UncertaintyCoverage coverage_measured, coverage_interpolated;
   MerlLookupCheck lookups;
   std::vector<ReconstructionError> errors;
   tbb::task_group group;
   group.run([&] { lookups = CheckMerlLookups(table, truth); });
-  errors = CompareTableWithTruth(table, truth, 80.0, {&domain, &measured_only, nullptr});
+  group.run([&] {
+    coverage_measured =
+        CompareUncertaintyWithTruth(table, uncertainty, domain, uint8_t(DomainClass::kMeasured), truth, 80.0);
+    coverage_interpolated =
+        CompareUncertaintyWithTruth(table, uncertainty, domain, uint8_t(DomainClass::kInterpolated), truth, 80.0);
+  });
+  errors = CompareTableWithTruth(table, truth, 80.0, {&domain, &measured_only, nullptr, &interpolated_only});
   group.wait();
   const ReconstructionError& error = errors[0];
   (*summary)["error_against_truth"] = ToJson(error);
@@ -232,6 +299,15 @@ void Score(const MerlTable& table, const std::vector<uint8_t>& domain, const Brd
   Log(1, "against the truth (theta <= 80, measured and interpolated cells): " + error.Brief());
   (*summary)["error_against_truth_measured"] = ToJson(errors[1]);
   (*summary)["error_against_truth_all_tabulated"] = ToJson(errors[2]);
+  (*summary)["error_against_truth_interpolated"] = ToJson(errors[3]);
+  Log(1, "against the truth by class (theta <= 80): measured " + errors[1].Brief() + "; interpolated " +
+             errors[3].Brief());
+  (*summary)["uncertainty_coverage"] = {{"measured", ToJson(coverage_measured)},
+                                        {"interpolated", ToJson(coverage_interpolated)},
+                                        {"domain", "theta_i, theta_e <= 80 deg; |log(f / f_true)| against the "
+                                                   "cell's standard error (uncertainty.npy), every channel"}};
+  Log(1, "standard errors against the truth, measured cells: " + coverage_measured.Brief());
+  Log(1, "standard errors against the truth, interpolated cells: " + coverage_interpolated.Brief());
   Log(1, "against the truth (theta <= 80, every cell holding a value): " + errors[2].Brief());
   (*summary)["merl_lookups_against_truth"] = ToJson(lookups);
   Log(1, lookups.Brief());
@@ -327,7 +403,8 @@ std::unique_ptr<BrdfModel> FitModels(const std::vector<BrdfSample>& samples, con
 // The .bsdf file's description: what it was made from, and how many nodes were measured,
 // interpolated, or unmeasured and filled how.
 std::string BsdfDescription(const std::string& name, const std::string& samples_file, const DomainCounts& classes,
-                            const BrdfModel* chosen, uint64_t filled_extrapolated, uint64_t zero) {
+                            const BrdfModel* chosen, uint64_t filled_extrapolated, uint64_t zero,
+                            std::vector<float> measured_errors) {
   const uint64_t nodes = classes.measured + classes.interpolated + classes.unmeasured;
   auto percent = [nodes](uint64_t n) {
     char buffer[32];
@@ -349,6 +426,15 @@ std::string BsdfDescription(const std::string& name, const std::string& samples_
     text << filled_extrapolated << " filled with the regression's extrapolation (invented values), " << zero
          << " set to 0 (no estimate, no fit)";
   }
+  // The format has no uncertainty field: the standard errors are stated here and tabulated beside the
+  // MERL table.
+  const auto [median, p95] = MedianP95(&measured_errors);
+  char errors[320];
+  std::snprintf(errors, sizeof(errors),
+                ". Stated standard error of the measured nodes (largest channel, noise and bias of the local fit): "
+                "median %.2f %%, 95th percentile %.2f %%; per cell in uncertainty.npy beside the MERL table",
+                100.0 * median, 100.0 * p95);
+  text << errors;
   text << ". Spectra: a box-like upsampling of the RGB (not colour-exact); the rgb field is exact.";
   return text.str();
 }
@@ -454,6 +540,7 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
   Timer timer;
   DomainCounts classes;
   uint64_t filled_model = 0, filled_extrapolated = 0, zero = 0;
+  std::vector<float> measured_errors;  // the measured nodes' standard errors, largest channel
   const BrdfBatch source = [&](const std::vector<Eigen::Vector3d>& wi, const std::vector<Eigen::Vector3d>& wo,
                                std::vector<Eigen::Vector3d>* f) {
     const size_t n = wi.size();
@@ -487,6 +574,7 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
       DomainClass c = ClassifyEstimate(e, theta_d[i], regression, options.tabulate.domain);
       if (e.effective_samples < options.tabulate.min_effective_samples) c = DomainClass::kUnmeasured;
       classes.Add(c);
+      if (c == DomainClass::kMeasured) measured_errors.push_back(e.standard_error.maxCoeff());
       if (c != DomainClass::kUnmeasured) {
         (*f)[i] = e.value;
       } else if (chosen) {
@@ -504,7 +592,7 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
   // are built first with a placeholder and the text replaced.
   TensorFile file = BuildRglBsdf(source, "", options.bsdf_export);
   const uint64_t nodes = classes.measured + classes.interpolated + classes.unmeasured;
-  file["description"] = TextField(BsdfDescription(name, samples_file, classes, chosen, filled_extrapolated, zero));
+  file["description"] = TextField(BsdfDescription(name, samples_file, classes, chosen, filled_extrapolated, zero, measured_errors));
   const std::string file_name = name + ".bsdf";
   WriteTensorFile(tmp + "/" + file_name, file);
   const double build_s = timer.ElapsedSeconds();
@@ -573,6 +661,9 @@ void ExportBsdf(const LocalRegression& regression, const ReconstructOptions& opt
         {"max", back.reciprocity.empty() ? 0.0 : back.reciprocity.back()},
         {"values", back.reciprocity.size()},
         {"by_theta_max_deg", reciprocity_bands}}},
+      {"uncertainty",
+       "the format has no uncertainty field: the measured nodes' standard errors are stated in the file's "
+       "description; per cell in uncertainty.npy"},
       {"build_s", build_s}};
   Log(1, "wrote " + file_name + " (RGL .bsdf; " + std::to_string(classes.unmeasured) + " of " + std::to_string(nodes) +
              " nodes unmeasured" +
@@ -702,7 +793,7 @@ ReconstructResult Run(const std::vector<BrdfSample>& samples, const ReconstructO
     if (inputs.truth) {
       scoring.run([&] {
         const Timer score_timer;
-        Score(table, domain, *inputs.truth, options, &score, &result);
+        Score(table, domain, table_files.uncertainty, *inputs.truth, options, &score, &result);
         score["score_s"] = score_timer.ElapsedSeconds();
       });
     }

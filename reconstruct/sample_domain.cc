@@ -26,6 +26,7 @@ bool DomainRules::Check(std::string* why) const {
   IBRDF_CHECK_OPTION_GT(measured_nearest, 0.0);
   IBRDF_CHECK_OPTION_GT(max_centroid_offset, 0.0);
   IBRDF_CHECK_OPTION_GE(theta_d_margin_deg, 0.0);
+  IBRDF_CHECK_OPTION_GT(max_measured_standard_error, 0.0);
   return true;
 }
 
@@ -37,7 +38,10 @@ DomainClass ClassifyEstimate(const Estimate& e, double theta_d, const LocalRegre
     return DomainClass::kUnmeasured;
   }
   if (!(e.centroid_offset <= rules.max_centroid_offset)) return DomainClass::kUnmeasured;
-  if (e.status != EstimateStatus::kGrown && e.nearest <= rules.measured_nearest) return DomainClass::kMeasured;
+  if (e.status != EstimateStatus::kGrown && e.nearest <= rules.measured_nearest &&
+      e.standard_error.maxCoeff() <= rules.max_measured_standard_error) {
+    return DomainClass::kMeasured;
+  }
   return DomainClass::kInterpolated;
 }
 

@@ -3,8 +3,9 @@
 // effective sample count (a kernel grown into empty territory can still gather many samples):
 //   measured      the point lies within the samples' theta_d range, a regression point (a bin of
 //                 samples) lies within `measured_nearest` kernel radii of it, its support did not have
-//                 to grow, and the weighted centroid of the samples in its kernel lies within
-//                 `max_centroid_offset` kernel radii (samples around it, not beside it);
+//                 to grow, the weighted centroid of the samples in its kernel lies within
+//                 `max_centroid_offset` kernel radii (samples around it, not beside it), and the
+//                 estimate's stated standard error is at most `max_measured_standard_error`;
 //   interpolated  within the samples' theta_d range, supported, and the centroid of the samples in its
 //                 (possibly grown) kernel still within `max_centroid_offset` kernel radii: samples on
 //                 several sides of a gap, so the estimate is an interpolation;
@@ -35,6 +36,10 @@ struct DomainRules {
   // The samples' theta_d range is widened by this (degrees) on each side before cells are tested
   // against it (0: a cell centre beyond the largest sampled theta_d is unmeasured).
   double theta_d_margin_deg = 0.0;
+  // A cell placed as measured by the rules above is measured only if its stated standard error
+  // (Estimate::standard_error, of log f: relative) is at most this in every channel; otherwise it is
+  // interpolated (docs/reconstruct.md, "Per-cell uncertainty"). Infinity: no such test.
+  double max_measured_standard_error = 0.02;
   bool Check(std::string* why) const;
 };
 

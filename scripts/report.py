@@ -550,6 +550,24 @@ def headline_rows(s, side, c, t, r, data, times):
         e = r["error_against_truth"]
         rows.append(("reconstruction vs truth: relative RMS (R / G / B)",
                      f"{pct(e['rel_rms_error'])} over {e['cells_scored']} MERL cells (coverage {pct(e['coverage'])})"))
+    if r and "uncertainty" in r.get("table", {}):
+        u = r["table"]["uncertainty"]
+        for cls in ("measured", "interpolated"):
+            if u.get(cls, {}).get("cells"):
+                rows.append((f"reconstruction: stated standard error, {cls} cells (largest channel; uncertainty.npy)",
+                             f"median {pct(u[cls]['median'])}, p95 {pct(u[cls]['p95'])} over {u[cls]['cells']} cells"
+                             + (f" (measured requires <= {pct(u['max_measured_standard_error'])})"
+                                if cls == "measured" else "")))
+        rows.append(("reconstruction .bsdf: uncertainty", "not in the format; stated in its description"))
+    for cls in ("measured", "interpolated"):
+        e = (r or {}).get(f"error_against_truth_{cls}")
+        if e and e.get("cells_scored"):
+            rows.append((f"reconstruction vs truth, {cls} cells: relative RMS (R / G / B)",
+                         f"{pct(e['rel_rms_error'])} over {e['cells_scored']} cells"))
+        cov = (r or {}).get("uncertainty_coverage", {}).get(cls)
+        if cov and cov.get("cell_channels"):
+            rows.append((f"reconstruction vs truth, {cls} cells: true error within 2 standard errors",
+                         f"{pct(cov['within_2sigma'])} of {cov['cell_channels']} cell channels"))
     if r and "fits" in r:
         for model, fit in r["fits"].items():
             # Besides one block per model the summary holds "chosen", "snippet_kind", "renderer_snippets".
