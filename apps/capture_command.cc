@@ -1,11 +1,8 @@
 // ibrdf capture check: what a session's photos will measure, before leaving the lab (the predicted
 // coverage of coverage/coverage.h and the next shots of coverage/shot_planning.h) behind flags.
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <memory>
-
-#include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
 #include "core/error.h"
@@ -116,31 +113,7 @@ IBRDF_COMMAND(12, Capture) {
     if (!plan.suggestions.empty()) PrintBands("with the suggestions", plan.after);
     Log(1, plan.BriefReport());
     if (args->out.empty()) return;
-    AtomicDirectory out(args->out, args->overwrite);
-    nlohmann::json photos = nlohmann::json::array();
-    for (size_t i = 0; i < session.photos.size(); ++i) {
-      const PhotoSpec& photo = session.photos[i];
-      if (photo.role != PhotoRole::kMeasurement) continue;
-      const Light& light = session.PhotoLight(i);
-      photos.push_back({{"file", photo.file},
-                        {"pose", photo.camera_from_world.has_value()},
-                        {"light", light.id},
-                        {"light_placed", light.placement_known}});
-    }
-    nlohmann::json report = ToJson(plan);
-    report["format"] = "ibrdf-capture-check";
-    report["session"] = session.manifest_path;
-    report["sample"] = SampleKindName(session.sample.kind);
-    report["photos"] = photos;
-    report["missing"] = missing;
-    report["occlusion"] = "not modelled: a convex sample never shadows itself; other objects are not in the session";
-    {
-      std::ofstream file(out.temporary_path() + "/capture-check.json");
-      file << report.dump(2) << "\n";
-      if (!file) ThrowError(args->out + "/capture-check.json", "cannot write");
-    }
-    WriteCoveragePicture(plan, out.temporary_path() + "/coverage.png");
-    out.Commit();
+    WriteCaptureCheck(session, plan, missing, args->out, args->overwrite);
     std::cout << "wrote " << args->out << "/capture-check.json and " << args->out << "/coverage.png\n";
   });
 }

@@ -13,6 +13,8 @@
 #include "core/logging.h"
 #include "core/math.h"
 #include "core/merl_format.h"
+#include "core/file_util.h"
+#include "core/json_reader.h"
 #include "core/png_writer.h"
 
 namespace ibrdf {
@@ -343,6 +345,31 @@ void WriteCoveragePicture(const ShotPlan& plan, const std::string& path) {
     }
   }
   WritePlainPng(path, image, PixelFormat::kUint8, PngEncoding::kAsOpenImageIo);
+}
+
+void WriteCaptureCheck(const Session& session, const ShotPlan& plan, const std::vector<std::string>& missing,
+                       const std::string& out_dir, bool overwrite) {
+  AtomicDirectory out(out_dir, overwrite);
+  nlohmann::json photos = nlohmann::json::array();
+  for (size_t i = 0; i < session.photos.size(); ++i) {
+    const PhotoSpec& photo = session.photos[i];
+    if (photo.role != PhotoRole::kMeasurement) continue;
+    const Light& light = session.PhotoLight(i);
+    photos.push_back({{"file", photo.file},
+                      {"pose", photo.camera_from_world.has_value()},
+                      {"light", light.id},
+                      {"light_placed", light.placement_known}});
+  }
+  nlohmann::json report = ToJson(plan);
+  report["format"] = "ibrdf-capture-check";
+  report["session"] = session.manifest_path;
+  report["sample"] = SampleKindName(session.sample.kind);
+  report["photos"] = photos;
+  report["missing"] = missing;
+  report["occlusion"] = "not modelled: a convex sample never shadows itself; other objects are not in the session";
+  WriteJsonFile(out.temporary_path() + "/capture-check.json", report);
+  WriteCoveragePicture(plan, out.temporary_path() + "/coverage.png");
+  out.Commit();
 }
 
 }  // namespace ibrdf

@@ -74,4 +74,11 @@ ShotPlan PlanShots(const Camera& camera, const SampleSpec& sample, const std::ve
 // a PNG at `path`.
 void WriteCoveragePicture(const ShotPlan& plan, const std::string& path);
 
+// `ibrdf capture check`'s outputs for `session`, planned as `plan` from its posed views (`missing`: the
+// measurement photos left out and why, SessionViews): DIR/capture-check.json (every measurement
+// photo's pose and light, the plan, what is not modelled) and DIR/coverage.png (WriteCoveragePicture),
+// as one folder that appears complete (replacing `out_dir` only with `overwrite`).
+void WriteCaptureCheck(const Session& session, const ShotPlan& plan, const std::vector<std::string>& missing,
+                       const std::string& out_dir, bool overwrite);
+
 }  // namespace ibrdf
