@@ -288,7 +288,10 @@ void WriteHeldOutPhotos(const std::optional<Session>& session, const std::vector
                         std::map<uint32_t, PhotoStats>& photos, int count, const RunModels& models, const fs::path& tmp,
                         nlohmann::json* data, ReportResult* result) {
   if (count <= 0 || !session) return;
-  const LocalRegressionOptions regression_options = ReconstructionRegression(models.table_path);
+  LocalRegressionOptions regression_options = ReconstructionRegression(models.table_path);
+  // The held-out renders show the fit's values only: its per-cell standard errors (two more fits per
+  // point) would double the report's time for nothing shown.
+  regression_options.standard_errors = false;
   nlohmann::json held = nlohmann::json::array();
   // A figure written as JSON: NaN (no pixel had one) is null there.
   auto number = [](const nlohmann::json& value) { return value.is_number() ? value.get<double>() : double(NAN); };
