@@ -46,7 +46,7 @@ IBRDF_COMMAND(80, Run) {
                   align = &MeasurementOptions::align_args, lights = &MeasurementOptions::lights_args,
                   colour = &MeasurementOptions::colour_args, derender = &MeasurementOptions::derender_args,
                   check = &MeasurementOptions::check_args, reconstruct = &MeasurementOptions::reconstruct_args,
-                  report = &MeasurementOptions::report_args;
+                  uniformity = &MeasurementOptions::uniformity_args, report = &MeasurementOptions::report_args;
   const struct {
     const char* flag;
     StageArgs target;
@@ -59,6 +59,7 @@ IBRDF_COMMAND(80, Run) {
               {"--derender-args", derender, "derender", "--shadow-edge-deg 2"},
               {"--check-args", check, "check", "--theta-bin-deg 5 --phi-bin-deg 10"},
               {"--reconstruct-args", reconstruct, "reconstruct", "--degree 1 --no-fold"},
+              {"--uniformity-args", uniformity, "uniformity", "--cell-mm 4 --accept uniformity.cells"},
               {"--report-args", report, "report", "--angles-deg 20,40,60"}},
     named[] = {{"--calibrate", align, "align", "Calibrate the camera first from the ChArUco photos in this folder"},
                {"--colmap", align, "align", "A COLMAP sparse model whose poses replace the targets'"},

@@ -19,7 +19,7 @@ import re
 import sys
 
 BEGIN, END = "<!-- readme-figures -->", "<!-- /readme-figures -->"
-STAGES = ["synth", "scan", "align", "derender", "check", "compare", "reconstruct", "report"]
+STAGES = ["synth", "scan", "align", "derender", "check", "compare", "reconstruct", "uniformity", "report"]
 
 # The format of every line of the block, in order (a regular expression per line; NUM a number).
 NUM = r"[0-9]+(?:\.[0-9]+)?"

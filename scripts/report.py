@@ -381,7 +381,7 @@ def stamps(run_dir):
     return result
 
 
-STAGE_ORDER = ("synth", "scan", "align", "derender", "check", "compare", "reconstruct", "report")
+STAGE_ORDER = ("synth", "scan", "align", "derender", "check", "compare", "reconstruct", "uniformity", "report")
 
 
 def timings_figure(times, counts, out):
@@ -1059,8 +1059,33 @@ def acquisition_html(run_dir, side, data=None, out=None):
     return '<h2 id="acquisition">Acquisition</h2>' + "\n" + "\n".join(parts)
 
 
+def uniformity_html(run_dir):
+    """The uniformity check (uniformity/uniformity.json, docs/spatial.md): whether the sample is one material, its
+    figures and the map of its surface cells drawn over a photo."""
+    u = load_json(os.path.join(run_dir, "uniformity", "uniformity.json"))
+    if not u:
+        return ""
+    verdict = next((v for v in u.get("verdicts", []) if v.get("check") == "uniformity.cells"), {})
+    cells = u.get("cells", {})
+    spread = ", ".join("n/a" if x is None else f"{x:.2f}x" for x in u.get("spread_p90_p10", []))
+    text = (f"<p>Is the sample one material? Its surface in cells of {1e3 * u.get('cell_m', 0):.1f} mm, each cell's "
+            f"samples against the reconstructed BRDF (the median ratio per channel): {cells.get('deviating')} of "
+            f"{cells.get('scored')} cells deviate ({100 * u.get('deviating_fraction', 0):.1f} %); the cells' ratios "
+            f"spread {spread} (90th over 10th percentile, R, G, B). Verdict: <b>{html.escape(str(verdict.get('verdict')))}"
+            f"{' (accepted by the user)' if verdict.get('accepted') else ''}</b>: {html.escape(str(verdict.get('measured')))}"
+            f"; bound: {html.escape(str(verdict.get('bound')))}.</p>")
+    image = os.path.join(run_dir, "uniformity", u.get("map", "map.png"))
+    if os.path.exists(image):
+        with open(image, "rb") as f:
+            text += (f'<figure><img src="data:image/png;base64,{base64.b64encode(f.read()).decode("ascii")}" '
+                     f'alt="map.png" style="max-width:640px"><figcaption>where: each sample pixel of photo '
+                     f'{u.get("map_photo")} coloured by its cell\'s ratio to the object\'s BRDF (red above, blue below, '
+                     f'full colour at 2x; pale: within the bound) (uniformity/map.png)</figcaption></figure>')
+    return "<h2>One material?</h2>\n" + text
+
+
 def notices_html(run_dir, side):
-    """Every calibration verdict that is not ok (response, align, lights white, colour), the stages' warnings and the
+    """Every calibration verdict that is not ok (response, align, lights white, colour, uniformity), the stages' warnings and the
     samples' scale, at the top of the report: what the run could not trust, or had to be told."""
     items = []
     if side.get("intensity_scale") == "relative":
@@ -1070,7 +1095,8 @@ def notices_html(run_dir, side):
     align = load_json(os.path.join(run_dir, "align", "alignment.json")) or {}
     stage_jsons = [("response", load_json(os.path.join(run_dir, "response", "response.json")) or {}), ("align", align),
                    ("lights", load_json(os.path.join(run_dir, "lights", "white-reference.json")) or {}),
-                   ("colour", load_json(os.path.join(run_dir, "colour", "colour.json")) or {})]
+                   ("colour", load_json(os.path.join(run_dir, "colour", "colour.json")) or {}),
+                   ("uniformity", load_json(os.path.join(run_dir, "uniformity", "uniformity.json")) or {})]
     for stage, stage_json in stage_jsons:
         for v in stage_json.get("verdicts", []):
             if v.get("verdict") == "ok":
@@ -1162,6 +1188,7 @@ pixel that gave a sample, f_model(wi, wo) times the irradiance term E cos(theta_
 {held_out_html(data, out, figures)}
 {lights_section(out, data)}
 {acquisition_html(run_dir, side, data, out)}
+{uniformity_html(run_dir)}
 <h2>Sample coverage</h2>
 {figure_html(out, figures['coverage'], 'exitant directions sampled at each incidence angle')}
 <h2>Incidence plane, three colour channels</h2>

@@ -78,6 +78,7 @@ const StageArgsKey kStageArgs[] = {{"scan_args", "--scan-args", &MeasurementOpti
                                    {"derender_args", "--derender-args", &MeasurementOptions::derender_args},
                                    {"check_args", "--check-args", &MeasurementOptions::check_args},
                                    {"reconstruct_args", "--reconstruct-args", &MeasurementOptions::reconstruct_args},
+                                   {"uniformity_args", "--uniformity-args", &MeasurementOptions::uniformity_args},
                                    {"report_args", "--report-args", &MeasurementOptions::report_args}};
 
 // Reads an "options" block on top of `options`.

@@ -281,6 +281,16 @@ void Planner::SampleStages() {
     Execute(reconstruct);
   }
 
+  // Whether the object is one material: its surface cells' samples against the reconstruction.
+  Stage uniformity = MakeStage("uniformity",
+                               {"uniformity", At("samples.npy"), "--brdf", At("reconstruction/brdf.binary"), "--session",
+                                current, "--out", At("uniformity"), "--overwrite"},
+                               {At("samples.npy"), At("samples.npy.json"), At("reconstruction/brdf.binary"), current},
+                               {At("uniformity/uniformity.json"), At("uniformity/map.png")});
+  uniformity.arguments.insert(uniformity.arguments.end(), options_.uniformity_args.begin(),
+                              options_.uniformity_args.end());
+  Execute(uniformity);
+
   Stage report = MakeStage("report", {"report", run_->run_dir(), "--out", At("report"), "--overwrite"}, {},
                            {At("report/index.html")});
   report.arguments.insert(report.arguments.end(), options_.report_args.begin(), options_.report_args.end());
@@ -288,7 +298,8 @@ void Planner::SampleStages() {
     report.not_applicable = "--no-report";
   } else {
     report.inputs = {At("samples.npy"), At("samples.npy.json"), At("consistency.json"),
-                     At("reconstruction/summary.json"), At("reconstruction/brdf.binary")};
+                     At("reconstruction/summary.json"), At("reconstruction/brdf.binary"),
+                     At("uniformity/uniformity.json")};
     if (!truth_path.empty()) report.inputs.push_back(At("truth-comparison.json"));
     for (const Stage& stage : run_->stages()) {
       if (run_->outcome(stage.name).status != StageStatus::kNotApplicable) {
@@ -303,7 +314,8 @@ void Planner::SampleStages() {
 
 const std::vector<std::string>& MeasurementStageNames() {
   static const std::vector<std::string> kStages = {"synth",    "scan",  "response", "align",       "lights", "colour",
-                                                   "derender", "check", "compare",  "reconstruct", "report"};
+                                                   "derender", "check", "compare",  "reconstruct", "uniformity",
+                                                   "report"};
   return kStages;
 }
 
@@ -323,7 +335,7 @@ bool MeasurementOptions::Check(std::string* why) const {
   const std::vector<std::string>& stages = MeasurementStageNames();
   if (!stop_after.empty() && std::find(stages.begin(), stages.end(), stop_after) == stages.end()) {
     *why = "--stop-after: unknown stage \"" + stop_after +
-           "\" (synth, scan, response, align, lights, colour, derender, check, compare, reconstruct, report)";
+           "\" (synth, scan, response, align, lights, colour, derender, check, compare, reconstruct, uniformity, report)";
     return false;
   }
   return true;

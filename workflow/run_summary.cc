@@ -98,8 +98,8 @@ void AddTruth(const fs::path& dir, const std::string& truth_path, nlohmann::json
   (*summary)["truth"] = truth;
 }
 
-// The calibration stages' verdicts (response/response.json, align/alignment.json,
-// lights/white-reference.json and colour/colour.json "verdicts", core/verdict.h), each with its stage, and every
+// The calibration stages' and the uniformity check's verdicts (response/response.json, align/alignment.json,
+// lights/white-reference.json, colour/colour.json and uniformity/uniformity.json "verdicts", core/verdict.h), each with its stage, and every
 // stage's warnings in one list: the verdicts that are not ok (an accepted failure included, marked so), align's own
 // warnings and derender's exposure advice.
 void AddVerdicts(const fs::path& dir, nlohmann::json* summary) {
@@ -107,7 +107,8 @@ void AddVerdicts(const fs::path& dir, nlohmann::json* summary) {
   for (const auto& [stage, file] : {std::pair<std::string, std::string>{"response", "response/response.json"},
                                     std::pair<std::string, std::string>{"align", "align/alignment.json"},
                                     std::pair<std::string, std::string>{"lights", "lights/white-reference.json"},
-                                    std::pair<std::string, std::string>{"colour", "colour/colour.json"}}) {
+                                    std::pair<std::string, std::string>{"colour", "colour/colour.json"},
+                                    std::pair<std::string, std::string>{"uniformity", "uniformity/uniformity.json"}}) {
     const std::optional<StageJson> stage_json = StageJson::ReadIfExists((dir / file).string());
     if (!stage_json) continue;
     const nlohmann::json list = stage_json->ValueOr("/verdicts", nlohmann::json::array());
