@@ -35,8 +35,11 @@ IBRDF_COMMAND(10, Synth) {
   SynthRequest& r = args->request;
   SynthOptions& o = r.options;
   AddOutputFlags(c, args->out, args->overwrite, "Session folder to write", "Replace an existing output folder");
-  c.add_option("--material", args->material, "Material JSON (samples/materials/*.json) or a MERL table (.binary)")
-      ->required()
+  c.add_option("--material", args->material,
+               "Material JSON (samples/materials/*.json) or a MERL table (.binary); required unless --material-map")
+      ->check(CLI::ExistingFile);
+  c.add_option("--material-map", r.material_map,
+               "A spatially varying sample: stripes of basis materials (JSON, docs/synth.md), instead of --material")
       ->check(CLI::ExistingFile);
   AddOption(c, "--no-data", r.no_data, "A MERL table's cells without data: skip (masked out), zero (warned) or error")
       ->check(CLI::IsMember({"skip", "zero", "error"}));

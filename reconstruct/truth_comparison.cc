@@ -16,6 +16,7 @@
 #include "core/rgl_bsdf.h"
 #include "core/sample_file.h"
 #include "core/statistics.h"
+#include "core/truth_file.h"
 
 namespace ibrdf {
 namespace {
@@ -188,6 +189,7 @@ std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path) {
     ThrowError(root.Where("version"), "unknown version " + std::to_string(version) + " (this build reads version " +
                                           std::to_string(kTruthVersion) + ")");
   }
+  if (root.Has("material_map")) ThrowError(root.Where("material_map"), kSpatiallyVaryingTruth);
   root.String("material_name", "");
   root.Raw("generator");
   std::unique_ptr<BrdfModel> material = MaterialFromJson(root.Raw("material"), truth_path, "/material");

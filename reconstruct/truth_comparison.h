@@ -48,7 +48,8 @@ nlohmann::json ToJson(const TruthComparison& comparison);
 
 // Reads the material of a synthetic session's truth.json ({"format": "ibrdf-truth", "version": 1, ...},
 // written by synth/synthetic.cc). Throws Error naming the file and field for another format or an
-// unknown version.
+// unknown version, and (core/truth_file.h's kSpatiallyVaryingTruth, naming "material_map") for a
+// truth.json with a material map in place of a material: its per-point truth is synth/material_map.h's.
 std::unique_ptr<BrdfModel> LoadTruthMaterial(const std::string& truth_path);
 // Any truth: truth.json (as LoadTruthMaterial), a plain material file, or a MERL table (".binary").
 std::unique_ptr<BrdfModel> LoadTruthFile(const std::string& path);

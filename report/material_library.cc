@@ -324,6 +324,7 @@ std::string Card(const nlohmann::json& r) {
   row("table coverage", Percent(f.value("table_coverage", nlohmann::json())));
   row("reciprocity error", Percent(f.value("reciprocity", nlohmann::json())));
   row("bilateral-symmetry error", Percent(f.value("bilateral_symmetry", nlohmann::json())));
+  if (f.value("truth_spatially_varying", false)) row("truth", "spatially varying: no single-material comparison");
   row("samples vs truth (median)", Percent(f.value("samples_median_rel_error", nlohmann::json())));
   row("table vs truth (rel. RMS)", Percent(f.value("brdf_rel_rmse", nlohmann::json())));
   const nlohmann::json fits = f.contains("fits") ? f["fits"] : nlohmann::json::object();
@@ -456,6 +457,9 @@ nlohmann::json LibraryRecord(const LibraryEntry& entry) {
   nlohmann::json symmetry = At(summary, {"consistency", "bilateral_symmetry"});
   figures["bilateral_symmetry"] = symmetry.is_null() ? At(summary, {"consistency", "isotropy"}) : symmetry;
   figures["truth_coverage"] = At(summary, {"truth", "brdf_coverage"});
+  // A material map's truth (summary.json truth.spatially_varying): no figures against one material.
+  figures["truth_spatially_varying"] = At(summary, {"truth", "spatially_varying"}).is_boolean() &&
+                                       At(summary, {"truth", "spatially_varying"}).get<bool>();
   figures["samples_median_rel_error"] = Overall(At(summary, {"truth", "samples_median_rel_error"}));
   figures["brdf_rel_rmse"] = At(summary, {"truth", "brdf_rel_rmse_all"});
   nlohmann::json fits = nlohmann::json::object();

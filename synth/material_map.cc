@@ -56,7 +56,12 @@ MaterialMap ParseMap(const nlohmann::json& value, const std::string& source, con
     if (entry.is_string()) {
       if (directory.empty()) ThrowError(source, "materials must be embedded here, not given by path");
       const fs::path path = fs::path(directory) / entry.get<std::string>();
-      materials.push_back(LoadMaterial(path.string()));
+      // The material's own error (its file, its field) under the map's field that named it.
+      try {
+        materials.push_back(LoadMaterial(path.string()));
+      } catch (const Error& e) {
+        ThrowError(source + ": /materials/" + std::to_string(k), e.what());
+      }
       names.push_back(path.stem().string());
     } else if (entry.is_object() && entry.contains("material")) {
       materials.push_back(

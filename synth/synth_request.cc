@@ -5,10 +5,12 @@
 
 #include "core/colour.h"
 #include "core/error.h"
+#include "core/json_reader.h"
 #include "core/logging.h"
 #include "core/merl_brdf.h"
 #include "core/output_guard.h"
 #include "core/session.h"
+#include "synth/material_map.h"
 #include "synth/synthetic.h"
 
 namespace ibrdf {
@@ -102,18 +104,47 @@ CharucoPhotosSummary WriteSessionCharucoPhotos(const std::string& session_dir, i
   return summary;
 }
 
+namespace {
+// A material map file and the material files it names (for the output guard), once it loaded.
+std::vector<std::string> MapInputFiles(const std::string& map_path) {
+  std::vector<std::string> files = {map_path};
+  const nlohmann::json json = ReadJsonFile(map_path);
+  for (const nlohmann::json& entry : json.at("materials")) {
+    if (entry.is_string()) files.push_back((fs::path(map_path).parent_path() / entry.get<std::string>()).string());
+  }
+  return files;
+}
+}  // namespace
+
 void WriteSynthStage(const SynthRequest& request, const SynthOptions& options, const std::string& material_path,
                      const std::string& out, bool overwrite) {
-  RequireWritableOutput(out, overwrite, {material_path});
-  const std::unique_ptr<BrdfModel> material = LoadRequestedMaterial(request, material_path);
-  const SynthSummary summary = WriteSyntheticSession(options, *material, material_path, out, overwrite);
-  Log(1, summary.BriefReport());
-  if (!summary.NoDataReport().empty()) {
-    const bool invented = summary.no_data == SynthNoData::kZero;  // zero-valued samples: a warning
-    Log(invented ? 0 : 1, std::string(invented ? "warning: " : "") + material_path + ": " + summary.NoDataReport() +
-                              " (truth.json generator.material_no_data)");
+  const std::string& map_path = request.material_map;
+  if (material_path.empty() == map_path.empty()) {
+    ThrowError("--material, --material-map",
+               material_path.empty() ? "give one: a material, or a material map (a spatially varying sample)"
+                                     : "give one, not both: a material map replaces the material");
   }
-  Log(1, "session written to " + out + "/session.json (truth in " + out + "/truth.json)");
+  if (!map_path.empty()) {
+    if (request.merl_lookup_given) {
+      ThrowError("--merl-lookup", "applies to --material's MERL table, not to a material map's materials");
+    }
+    const MaterialMap map = MaterialMap::Load(map_path);
+    RequireWritableOutput(out, overwrite, MapInputFiles(map_path));
+    const SynthSummary summary = WriteSyntheticSession(options, map, map_path, out, overwrite);
+    Log(1, summary.BriefReport() + ", " + std::to_string(map.NumMaterials()) + " materials in a material map");
+    Log(1, "session written to " + out + "/session.json (truth, the material map, in " + out + "/truth.json)");
+  } else {
+    RequireWritableOutput(out, overwrite, {material_path});
+    const std::unique_ptr<BrdfModel> material = LoadRequestedMaterial(request, material_path);
+    const SynthSummary summary = WriteSyntheticSession(options, *material, material_path, out, overwrite);
+    Log(1, summary.BriefReport());
+    if (!summary.NoDataReport().empty()) {
+      const bool invented = summary.no_data == SynthNoData::kZero;  // zero-valued samples: a warning
+      Log(invented ? 0 : 1, std::string(invented ? "warning: " : "") + material_path + ": " + summary.NoDataReport() +
+                                " (truth.json generator.material_no_data)");
+    }
+    Log(1, "session written to " + out + "/session.json (truth in " + out + "/truth.json)");
+  }
   if (request.charuco_photos > 0) {
     const CharucoPhotosSummary photos = WriteSessionCharucoPhotos(out, request.charuco_photos, options.seed);
     Log(1, photos.BriefReport() + ", written to " + out + "/calibration");

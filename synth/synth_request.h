@@ -40,6 +40,9 @@ struct SynthRequest {
   // A MERL table's lookups (MerlLookupFromName), applied only when given: other materials have none.
   std::string merl_lookup = "nearest";
   bool merl_lookup_given = false;
+  // A material map file (MaterialMap::Load): the sample is spatially varying; it replaces the material,
+  // so exactly one of the two is given.
+  std::string material_map;
 };
 
 // The options a request describes. Throws Error naming the flag for contradictory choices (--no-clip
@@ -57,9 +60,11 @@ std::unique_ptr<BrdfModel> LoadRequestedMaterial(const SynthRequest& request, co
 CharucoPhotosSummary WriteSessionCharucoPhotos(const std::string& session_dir, int num_photos, uint64_t session_seed);
 
 // `ibrdf synth` as a stage, once `options` (SynthOptionsFromRequest) passed their Check(): the output
-// guard (`out` is not the material and holds it not), the material, the session written to `out`
-// (synthetic.h) and its ChArUco photos when the request asks for them; logs what was written and warns
-// when a MERL table's cells without data were rendered as zero.
+// guard (`out` is not the material and holds it not), the material (`material_path`) or the request's
+// material map, the session written to `out` (synthetic.h) and its ChArUco photos when the request asks
+// for them; logs what was written and warns when a MERL table's cells without data were rendered as
+// zero. Throws Error naming both flags when both or neither of --material and --material-map are
+// given, and naming the map's file and field for a bad map.
 void WriteSynthStage(const SynthRequest& request, const SynthOptions& options, const std::string& material_path,
                      const std::string& out, bool overwrite);
 

@@ -505,8 +505,15 @@ nlohmann::json RigidJson(const Rigid3d& transform) {
   return {{"rotation", {q.w(), q.x(), q.y(), q.z()}}, {"translation", ToJson(transform.translation)}};
 }
 
+// What a session's surface is made of: one material, or (map non-null) a material map, whose
+// Eval takes the hit's world point; `material` is then null.
+struct SurfaceMaterial {
+  const BrdfModel* material = nullptr;
+  const MaterialMap* map = nullptr;
+};
+
 Image RenderRadianceImpl(const Session& session, size_t photo_index, const PixelRays& rays, const AnalyticSample& truth,
-                         bool shadow_rays, const BrdfModel& material, std::vector<uint8_t>* hit_mask,
+                         bool shadow_rays, const SurfaceMaterial& surface, std::vector<uint8_t>* hit_mask,
                          uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance,
                          std::vector<uint8_t>* no_data_mask);
 
@@ -534,21 +541,27 @@ Rigid3d ScanFromWorld(const SynthScanOptions& scan) {
 Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel& material, int supersample,
                      std::vector<uint8_t>* hit_mask) {
   const std::unique_ptr<AnalyticSample> sample = AnalyticSample::Create(session.sample);
-  return RenderRadianceImpl(session, photo_index, PixelRays(session.camera, supersample), *sample, false, material,
-                            hit_mask, nullptr, Eigen::Vector3d::Zero(), nullptr);
+  return RenderRadianceImpl(session, photo_index, PixelRays(session.camera, supersample), *sample, false,
+                            SurfaceMaterial{&material, nullptr}, hit_mask, nullptr, Eigen::Vector3d::Zero(), nullptr);
 }
 
 Image RenderRadiance(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
                      const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask) {
-  return RenderRadianceImpl(session, photo_index, PixelRays(session.camera, supersample), truth, shadow_rays, material,
-                            hit_mask, nullptr, Eigen::Vector3d::Zero(), nullptr);
+  return RenderRadianceImpl(session, photo_index, PixelRays(session.camera, supersample), truth, shadow_rays,
+                            SurfaceMaterial{&material, nullptr}, hit_mask, nullptr, Eigen::Vector3d::Zero(), nullptr);
+}
+
+Image RenderRadiance(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
+                     const MaterialMap& map, int supersample, std::vector<uint8_t>* hit_mask) {
+  return RenderRadianceImpl(session, photo_index, PixelRays(session.camera, supersample), truth, shadow_rays,
+                            SurfaceMaterial{nullptr, &map}, hit_mask, nullptr, Eigen::Vector3d::Zero(), nullptr);
 }
 
 namespace {
 // `no_data_mask` (optional) gets 1 where a ray of the pixel looked up a cell without data of a tabulated
 // material (a MERL table's negative cell; such a lookup evaluates to 0); all 0 for other materials.
 Image RenderRadianceImpl(const Session& session, size_t photo_index, const PixelRays& rays, const AnalyticSample& truth,
-                         bool shadow_rays, const BrdfModel& material, std::vector<uint8_t>* hit_mask,
+                         bool shadow_rays, const SurfaceMaterial& surface, std::vector<uint8_t>* hit_mask,
                          uint64_t* shadowed_pixels, const Eigen::Vector3d& fill_irradiance,
                          std::vector<uint8_t>* no_data_mask) {
   const Camera& camera = session.camera;
@@ -558,14 +571,21 @@ Image RenderRadianceImpl(const Session& session, size_t photo_index, const Pixel
   if (hit_mask) hit_mask->assign(size_t(camera.width) * camera.height, 0);
   if (no_data_mask) no_data_mask->assign(size_t(camera.width) * camera.height, 0);
   const bool fill = fill_irradiance.any();
-  const auto* table = no_data_mask ? dynamic_cast<const MerlBrdf*>(&material) : nullptr;
-  // The material at (wi, wo), marking the pixel where the lookup found no data (MerlBrdf::Eval's test).
-  auto eval = [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& wo, const PixelRay& ray) {
+  const BrdfModel* material = surface.material;
+  const MaterialMap* map = surface.map;
+  IBRDF_CHECK((material == nullptr) != (map == nullptr));
+  const auto* table = no_data_mask && material ? dynamic_cast<const MerlBrdf*>(material) : nullptr;
+  // The surface's BRDF at the world point `point` for (wi, wo), marking the pixel where a table's lookup
+  // found no data (MerlBrdf::Eval's test). One pointer test per call keeps the single material's path as
+  // it was.
+  auto eval = [&](const Eigen::Vector3d& point, const Eigen::Vector3d& wi, const Eigen::Vector3d& wo,
+                  const PixelRay& ray) -> Eigen::Vector3d {
+    if (map) return map->Eval(point, wi, wo);
     if (table && wi.z() > 0.0 && wo.z() > 0.0 &&
         (table->Lookup(wi.normalized(), wo.normalized()).array() < 0.0).any()) {
       (*no_data_mask)[ray.pixel] = 1;
     }
-    return material.Eval(wi, wo);
+    return material->Eval(wi, wo);
   };
   Image image = RenderRays(rays, *session.photos[photo_index].camera_from_world,
                            [&](const Eigen::Vector3d& eye, const PixelRay& ray) -> Eigen::Vector3d {
@@ -577,7 +597,8 @@ Image RenderRadianceImpl(const Session& session, size_t photo_index, const Pixel
                              Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
                              // The fill light (SynthOptions::fill_light) reaches every point, shadowed or not.
                              if (fill) {
-                               radiance += eval(Eigen::Vector3d::UnitZ(), wo, ray).cwiseProduct(fill_irradiance);
+                               radiance +=
+                                   eval(hit.point, Eigen::Vector3d::UnitZ(), wo, ray).cwiseProduct(fill_irradiance);
                              }
                              const Incidence incidence = IncidenceAt(light, hit.point, hit.normal);
                              if (!incidence.lit) return radiance;
@@ -591,7 +612,7 @@ Image RenderRadianceImpl(const Session& session, size_t photo_index, const Pixel
                                  return radiance;
                                }
                              }
-                             const Eigen::Vector3d f = eval(frame.ToLocal(incidence.wi), wo, ray);
+                             const Eigen::Vector3d f = eval(hit.point, frame.ToLocal(incidence.wi), wo, ray);
                              return Eigen::Vector3d(radiance + f.cwiseProduct(incidence.irradiance));
                            });
   if (shadowed_pixels) *shadowed_pixels += shadowed;
@@ -781,8 +802,10 @@ std::string SynthSummary::NoDataReport() const {
   return head + "refused (--no-data error)";
 }
 
-SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel& material,
-                                   const std::string& material_name, const std::string& out_dir, bool overwrite) {
+namespace {
+// WriteSyntheticSession for one material or a map (`surface`); `material_name` names either.
+SynthSummary WriteSession(const SynthOptions& options, const SurfaceMaterial& surface, const std::string& material_name,
+                          const std::string& out_dir, bool overwrite) {
   Timer timer;
   std::string why;
   if (!options.Check(&why)) ThrowError("synth options", why);
@@ -825,7 +848,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
       }
     }
   } wait_on_exit{writing};
-  if (const auto* table = dynamic_cast<const MerlBrdf*>(&material)) {
+  if (const auto* table = surface.material ? dynamic_cast<const MerlBrdf*>(surface.material) : nullptr) {
     summary.tabulated = true;
     summary.table_cells_without_data = table->cells_without_data();
   }
@@ -834,7 +857,7 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
     std::vector<uint8_t> mask, no_data;
     const bool measurement = session.photos[i].role == PhotoRole::kMeasurement;
     Image image =
-        RenderRadianceImpl(session, i, rays, *truth, shadow_rays, material, &mask, measurement ? &shadowed : nullptr,
+        RenderRadianceImpl(session, i, rays, *truth, shadow_rays, surface, &mask, measurement ? &shadowed : nullptr,
                            fill_irradiance(i), measurement && summary.tabulated ? &no_data : nullptr);
     if (!no_data.empty()) {
       ApplyNoDataPolicy(options, material_name, session.camera, no_data, directory.temporary_path(), &session.photos[i],
@@ -888,13 +911,16 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
                                          : nlohmann::json();
   if (!shape_truth.is_null()) summary.shadowed_pixels = shadowed;
   session.Save((fs::path(directory.temporary_path()) / "session.json").string());
-  nlohmann::json truth_json = {
-      {"format", "ibrdf-truth"},
-      {"version", 1},
-      {"material_name", material_name},
-      {"material", material.ToJson()},
-      {"generator", GeneratorJson(options)},
-  };
+  nlohmann::json truth_json = {{"format", "ibrdf-truth"}, {"version", 1}};
+  if (surface.map) {
+    // No single material is the truth: the map (materials embedded) gives it point by point.
+    truth_json["material_map_name"] = material_name;
+    truth_json["material_map"] = surface.map->ToJson();
+  } else {
+    truth_json["material_name"] = material_name;
+    truth_json["material"] = surface.material->ToJson();
+  }
+  truth_json["generator"] = GeneratorJson(options);
   if (!shape_truth.is_null()) truth_json["generator"]["geometry"] = shape_truth;
   if (!colour_truth.is_null()) truth_json["generator"]["colour"] = colour_truth;
   if (summary.tabulated) {
@@ -910,6 +936,25 @@ SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel&
   summary.total_s = timer.ElapsedSeconds();
   summary.success = true;
   return summary;
+}
+}  // namespace
+
+SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel& material,
+                                   const std::string& material_name, const std::string& out_dir, bool overwrite) {
+  return WriteSession(options, SurfaceMaterial{&material, nullptr}, material_name, out_dir, overwrite);
+}
+
+SynthSummary WriteSyntheticSession(const SynthOptions& options, const MaterialMap& map, const std::string& map_name,
+                                   const std::string& out_dir, bool overwrite) {
+  for (size_t k = 0; k < map.NumMaterials(); ++k) {
+    const auto* table = dynamic_cast<const MerlBrdf*>(&map.Material(k));
+    if (table && table->cells_without_data() > 0) {
+      ThrowError(map_name + ": /materials/" + std::to_string(k),
+                 "\"" + map.Name(k) + "\" is a MERL table with " + std::to_string(table->cells_without_data()) +
+                     " cells without data; a material map has no mask for them (use a complete table)");
+    }
+  }
+  return WriteSession(options, SurfaceMaterial{nullptr, &map}, map_name, out_dir, overwrite);
 }
 
 }  // namespace ibrdf

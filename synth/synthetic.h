@@ -17,6 +17,7 @@
 #include "core/brdf_model.h"
 #include "core/image_io.h"
 #include "core/session.h"
+#include "synth/material_map.h"
 #include "synth/synth_options.h"
 #include "synth/synthetic_shapes.h"
 
@@ -36,6 +37,9 @@ Image RenderRadiance(const Session& session, size_t photo_index, const BrdfModel
 // is free of the shape (non-convex truths cast shadows on themselves).
 Image RenderRadiance(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
                      const BrdfModel& material, int supersample, std::vector<uint8_t>* hit_mask);
+// The same with a spatially varying material: each hit's BRDF is map.Eval at its world point.
+Image RenderRadiance(const Session& session, size_t photo_index, const AnalyticSample& truth, bool shadow_rays,
+                     const MaterialMap& map, int supersample, std::vector<uint8_t>* hit_mask);
 
 // What WriteSyntheticSession wrote; reads as failure until it ran.
 struct SynthSummary {
@@ -65,5 +69,12 @@ struct SynthSummary {
 // With kSkip such pixels are left out through a mask per photo (masks/, session.json's photo "mask").
 SynthSummary WriteSyntheticSession(const SynthOptions& options, const BrdfModel& material,
                                    const std::string& material_name, const std::string& out_dir, bool overwrite);
+// The same with a spatially varying material (`map_name`: the map's file): every hit's BRDF is
+// map.Eval at its world point, and truth.json holds "material_map" (MaterialMap::ToJson, the
+// materials embedded) in place of "material", since no single material is the truth. Throws Error
+// naming `map_name` for a basis material that is a MERL table with cells without data (a map has no
+// per-material mask of them).
+SynthSummary WriteSyntheticSession(const SynthOptions& options, const MaterialMap& map, const std::string& map_name,
+                                   const std::string& out_dir, bool overwrite);
 
 }  // namespace ibrdf

@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/session.h"
+#include "core/truth_file.h"
 #include "workflow/stamp.h"
 
 namespace fs = std::filesystem;
@@ -79,6 +80,8 @@ class Planner {
   std::string manifest_path;  // the input session (synth's for a recipe)
   std::string current;        // the manifest the next stage reads
   std::string truth_path;     // truth.json beside the input session, if any
+  // The truth is a material map (synth --material-map): no single material to compare the samples with.
+  bool truth_spatially_varying = false;
   std::string material_name;  // the fitted materials' name: the recipe's, else the input session's folder
 
  private:
@@ -88,8 +91,12 @@ class Planner {
 };
 
 void Planner::Synth(const Recipe& recipe) {
-  Stage synth = MakeStage("synth", {"synth", "--material", recipe.material}, {recipe.path, recipe.material},
-                          {At("synth/session.json"), At("synth/truth.json")});
+  Stage synth = recipe.material_map.empty()
+                    ? MakeStage("synth", {"synth", "--material", recipe.material}, {recipe.path, recipe.material},
+                                {At("synth/session.json"), At("synth/truth.json")})
+                    : MakeStage("synth", {"synth", "--material-map", recipe.material_map},
+                                {recipe.path, recipe.material_map}, {At("synth/session.json"), At("synth/truth.json")});
+  synth.inputs.insert(synth.inputs.end(), recipe.map_materials.begin(), recipe.map_materials.end());
   synth.arguments.insert(synth.arguments.end(), recipe.synth_args.begin(), recipe.synth_args.end());
   synth.arguments.insert(synth.arguments.end(), {"--out", At("synth"), "--overwrite"});
   Execute(synth);
@@ -241,6 +248,8 @@ void Planner::SampleStages() {
   Stage compare = MakeStage("compare", {}, samples_in, {At("truth-comparison.json")});
   if (truth_path.empty()) {
     compare.not_applicable = "no truth.json beside the session (not synthetic)";
+  } else if (truth_spatially_varying) {
+    compare.not_applicable = kSpatiallyVaryingTruth;
   } else {
     compare.arguments = {"compare", At("samples.npy"),           "--truth",    truth_path,
                          "--out",   At("truth-comparison.json"), "--overwrite"};
@@ -250,7 +259,7 @@ void Planner::SampleStages() {
   Stage reconstruct =
       MakeStage("reconstruct", {"reconstruct", At("samples.npy"), "--out", At("reconstruction"), "--overwrite"},
                 samples_in, {At("reconstruction/summary.json"), At("reconstruction/brdf.binary")});
-  if (!truth_path.empty()) {
+  if (!truth_path.empty() && !truth_spatially_varying) {
     reconstruct.arguments.insert(reconstruct.arguments.end(), {"--truth", truth_path});
     reconstruct.inputs.push_back(truth_path);
   }
@@ -300,7 +309,7 @@ void Planner::SampleStages() {
     report.inputs = {At("samples.npy"), At("samples.npy.json"), At("consistency.json"),
                      At("reconstruction/summary.json"), At("reconstruction/brdf.binary"),
                      At("uniformity/uniformity.json")};
-    if (!truth_path.empty()) report.inputs.push_back(At("truth-comparison.json"));
+    if (!truth_path.empty() && !truth_spatially_varying) report.inputs.push_back(At("truth-comparison.json"));
     for (const Stage& stage : run_->stages()) {
       if (run_->outcome(stage.name).status != StageStatus::kNotApplicable) {
         report.inputs.push_back(StampPath(run_->run_dir(), stage.name));
@@ -372,6 +381,9 @@ std::string RunMeasurement(const MeasurementInput& input, const MeasurementOptio
   const fs::path session_dir = fs::path(plan.manifest_path).parent_path();
   plan.material_name = input.recipe ? input.recipe->name : session_dir.filename().string();
   if (fs::exists(session_dir / "truth.json")) plan.truth_path = (session_dir / "truth.json").string();
+  // A recipe's map says so before synth ran (a dry run); a session's truth.json says so itself.
+  plan.truth_spatially_varying = (input.recipe && !input.recipe->material_map.empty()) ||
+                                 (!plan.truth_path.empty() && IsSpatiallyVaryingTruth(plan.truth_path));
   plan.current = plan.manifest_path;
   plan.Scan();
   plan.Response();

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/truth_file.h"
 #include "workflow/stage_json.h"
 
 namespace fs = std::filesystem;
@@ -82,6 +83,13 @@ void AddReconstruction(const fs::path& dir, nlohmann::json* summary) {
 void AddTruth(const fs::path& dir, const std::string& truth_path, nlohmann::json* summary) {
   if (truth_path.empty()) return;
   nlohmann::json truth = {{"file", truth_path}};
+  if (fs::exists(truth_path) && IsSpatiallyVaryingTruth(truth_path)) {
+    // No figures against one material: compare did not run and reconstruct was given no truth.
+    truth["spatially_varying"] = true;
+    truth["comparison"] = kSpatiallyVaryingTruth;
+    (*summary)["truth"] = truth;
+    return;
+  }
   if (const std::optional<StageJson> t = StageJson::ReadIfExists((dir / "truth-comparison.json").string())) {
     truth["samples_median_rel_error"] = t->Figure("/overall/median_rel_error");
     truth["samples_p95_rel_error"] = t->Figure("/overall/p95_rel_error");
@@ -220,7 +228,10 @@ std::vector<std::string> RunHeadline(const nlohmann::json& summary_json) {
                     ", bilateral symmetry " + Percent(summary.ValueOr("/consistency/bilateral_symmetry", nullptr)) +
                     " (medians over bins)");
   }
-  if (summary.Has("/truth")) {
+  if (summary.ValueOr("/truth/spatially_varying", false) == true) {
+    lines.push_back(std::string("against the truth: ") + kSpatiallyVaryingTruth +
+                    " (truth.json's material_map gives it point by point)");
+  } else if (summary.Has("/truth")) {
     lines.push_back("against the truth: samples' median relative error (R, G, B) " +
                     PercentPerChannel(summary.ValueOr("/truth/samples_median_rel_error", nullptr)) +
                     "; reconstruction relative RMS " +

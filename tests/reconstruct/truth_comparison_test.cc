@@ -8,6 +8,7 @@
 
 #include "core/brdf_coords.h"
 #include "core/error.h"
+#include "core/truth_file.h"
 #include "tests/scratch_dir.h"
 
 namespace ibrdf {
@@ -90,6 +91,33 @@ TEST(TruthComparison, LoadTruthMaterialRejectsUnknownVersions) {
   }
   EXPECT_THROW(LoadTruthMaterial(write("v0.json", "ibrdf-truth", 0)), Error);
   EXPECT_THROW(LoadTruthMaterial(write("other.json", "ibrdf-alignment", 1)), Error);
+}
+
+// A spatially varying truth (synth --material-map) has no one material: every single-material reader
+// says so, naming the file and the field, rather than picking a basis material.
+TEST(TruthComparison, SpatiallyVaryingTruthIsRefusedNamingTheField) {
+  testing::ScratchDir dir;
+  const std::string path = dir / "truth.json";
+  std::ofstream(path) << R"({"format": "ibrdf-truth", "version": 1, "material_map_name": "map.json",
+    "generator": {}, "material_map": {"kind": "stripes", "centre": [0, 0, 0], "axis": [0, 0, 1],
+    "materials": [{"name": "a", "material": {"model": "lambertian", "albedo": [0.2, 0.2, 0.2]}},
+                  {"name": "b", "material": {"model": "lambertian", "albedo": [0.7, 0.7, 0.7]}}],
+    "stripes": [0, 1], "blend_mm": [0, 10]}})";
+  EXPECT_TRUE(IsSpatiallyVaryingTruth(path));
+  for (const auto& load : {LoadTruthMaterial, LoadTruthFile}) {
+    try {
+      load(path);
+      ADD_FAILURE() << "a spatially varying truth was read as one material";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(path + ": /material_map"), std::string::npos) << message;
+      EXPECT_NE(message.find(kSpatiallyVaryingTruth), std::string::npos) << message;
+    }
+  }
+  std::ofstream(dir / "one.json") << R"({"format": "ibrdf-truth", "version": 1, "generator": {},
+    "material": {"model": "lambertian", "albedo": [0.5, 0.5, 0.5]}})";
+  EXPECT_FALSE(IsSpatiallyVaryingTruth(dir / "one.json"));
+  EXPECT_FALSE(IsSpatiallyVaryingTruth(dir / "table.binary"));  // by extension, not read
 }
 
 }  // namespace

@@ -1,0 +1,164 @@
+// `ibrdf synth --material-map FILE` on the command line: the map replaces --material, truth.json keeps
+// the map (materials embedded), a bad map is refused naming its file and field, and the tools that
+// compare with one true material say that this truth has none.
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/json_reader.h"
+#include "core/math.h"
+#include "synth/material_map.h"
+#include "tests/run_ibrdf.h"
+#include "tests/scratch_dir.h"
+#include "tests/test_util.h"
+
+namespace fs = std::filesystem;
+
+namespace ibrdf {
+namespace {
+
+using testing::RunIbrdf;
+using testing::ScratchDir;
+
+const char kSmall[] = " --width 160 --height 120 --photos 3 --effects none";
+
+// A map in `dir`/maps/map.json naming two materials copied into `dir`/materials (paths relative to the
+// map), with `change` applied to its JSON.
+std::string WriteMap(const ScratchDir& dir, const std::function<void(nlohmann::json*)>& change = {}) {
+  fs::create_directories(dir / "maps");
+  fs::create_directories(dir / "materials");
+  fs::copy_file(testing::MaterialPath("bluepaint"), dir / "materials/bluepaint.json",
+                fs::copy_options::overwrite_existing);
+  fs::copy_file(testing::MaterialPath("felt"), dir / "materials/felt.json", fs::copy_options::overwrite_existing);
+  nlohmann::json map = {{"kind", "stripes"},
+                        {"centre", {0.0, 0.0, 0.0}},
+                        {"axis", {0.0, 0.0, 1.0}},
+                        {"materials", {"../materials/bluepaint.json", "../materials/felt.json"}},
+                        {"stripes", {0, 1, 0, 1, 0, 1}},
+                        {"blend_mm", {0, 15, 0, 15, 0, 0}}};
+  if (change) change(&map);
+  std::ofstream(dir / "maps/map.json") << map.dump(2);
+  return dir / "maps/map.json";
+}
+
+TEST(SynthMaterialMapCli, TruthHoldsTheMapAndRoundTrips) {
+  ScratchDir dir;
+  const std::string map_path = WriteMap(dir);
+  const auto run = RunIbrdf("synth --material-map " + map_path + " --out " + (dir / "s") + kSmall, /*quiet=*/true);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("material map"), std::string::npos) << run.output;
+  const nlohmann::json truth = ReadJsonFile(dir / "s/truth.json");
+  EXPECT_FALSE(truth.contains("material"));
+  EXPECT_EQ(truth.at("material_map_name"), map_path);
+  // The embedded map is the file's map: the same names, weights and values everywhere.
+  const MaterialMap back = MaterialMap::FromJson(truth.at("material_map"), dir / "s/truth.json");
+  const MaterialMap file = MaterialMap::Load(map_path);
+  ASSERT_EQ(back.NumMaterials(), 2u);
+  EXPECT_EQ(back.Name(0), "bluepaint");
+  EXPECT_EQ(back.Name(1), "felt");
+  const Eigen::Vector3d wi(0.3, 0.1, 0.95), wo(-0.2, 0.4, 0.89);
+  for (double deg = 0.5; deg < 360.0; deg += 2.9) {
+    const Eigen::Vector3d p(0.04 * std::cos(deg * kDegree), 0.04 * std::sin(deg * kDegree), -0.01);
+    EXPECT_NEAR((back.Weights(p) - file.Weights(p)).norm(), 0.0, 1e-12) << deg;
+    EXPECT_NEAR((back.Eval(p, wi, wo) - file.Eval(p, wi, wo)).norm(), 0.0, 1e-9 * file.Eval(p, wi, wo).norm()) << deg;
+    EXPECT_EQ(back.Label(p), file.Label(p));
+    EXPECT_NEAR(back.BoundaryDistance(p), file.BoundaryDistance(p), 1e-12);
+  }
+  // A single-material comparison says why it cannot be made, naming the field.
+  ASSERT_EQ(RunIbrdf("derender " + (dir / "s") + " --stride 4 --out " + (dir / "s.npy")).exit_code, 0);
+  const auto compare = RunIbrdf("compare " + (dir / "s.npy") + " --out " + (dir / "c.json"));
+  EXPECT_NE(compare.exit_code, 0);
+  EXPECT_NE(compare.output.find("truth is spatially varying: no single-material comparison"), std::string::npos)
+      << compare.output;
+  EXPECT_NE(compare.output.find("/material_map"), std::string::npos) << compare.output;
+  EXPECT_FALSE(fs::exists(dir / "c.json"));
+}
+
+TEST(SynthMaterialMapCli, BadMapFilesAreRefusedNamingTheFileAndField) {
+  ScratchDir dir;
+  struct Case {
+    std::function<void(nlohmann::json*)> change;
+    std::string field;  // a word the message must hold
+  };
+  const std::vector<Case> cases = {
+      {[](nlohmann::json* m) { m->erase("stripes"); }, "\"stripes\""},
+      {[](nlohmann::json* m) { (*m)["stripes"] = {0, 1, 2, 0, 1, 0}; }, "stripe material 2"},
+      {[](nlohmann::json* m) {
+         (*m)["blend_mm"] = {0, 1};
+       },
+       "\"blend_mm\""},
+      {[](nlohmann::json* m) {
+         (*m)["axis"] = {0, 0};
+       },
+       "\"axis\""},
+      {[](nlohmann::json* m) { (*m)["kind"] = "rings"; }, "rings"},
+      {[](nlohmann::json* m) {
+         (*m)["materials"] = {"../materials/felt.json", "../materials/none.json"};
+       },
+       "/materials/1"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const std::string map_path = WriteMap(dir, cases[i].change);
+    const std::string out = dir / ("s" + std::to_string(i));
+    const auto run = RunIbrdf("synth --material-map " + map_path + " --out " + out + kSmall);
+    EXPECT_NE(run.exit_code, 0) << i;
+    EXPECT_NE(run.output.find("map.json"), std::string::npos) << i << ": " << run.output;
+    EXPECT_NE(run.output.find(cases[i].field), std::string::npos) << i << ": " << run.output;
+    EXPECT_FALSE(fs::exists(out)) << i;
+  }
+  // Not JSON at all.
+  std::ofstream(dir / "maps/map.json") << "{\"kind\": ";
+  const auto broken = RunIbrdf("synth --material-map " + (dir / "maps/map.json") + " --out " + (dir / "b") + kSmall);
+  EXPECT_NE(broken.exit_code, 0);
+  EXPECT_NE(broken.output.find("map.json"), std::string::npos) << broken.output;
+}
+
+TEST(SynthMaterialMapCli, ExactlyOneOfMaterialAndMapIsGiven) {
+  ScratchDir dir;
+  const std::string map_path = WriteMap(dir);
+  const auto both = RunIbrdf("synth --material " + testing::MaterialPath("felt") + " --material-map " + map_path +
+                             " --out " + (dir / "b") + kSmall);
+  EXPECT_NE(both.exit_code, 0);
+  EXPECT_NE(both.output.find("--material, --material-map"), std::string::npos) << both.output;
+  EXPECT_NE(both.output.find("not both"), std::string::npos) << both.output;
+  const auto neither = RunIbrdf("synth --out " + (dir / "n") + kSmall);
+  EXPECT_NE(neither.exit_code, 0);
+  EXPECT_NE(neither.output.find("--material, --material-map"), std::string::npos) << neither.output;
+  EXPECT_FALSE(fs::exists(dir / "b"));
+  EXPECT_FALSE(fs::exists(dir / "n"));
+}
+
+// A recipe naming a material map (relative to the recipe) runs end to end; the single-material
+// comparison is not applicable, and the summary says why instead of scoring against one material.
+TEST(SynthMaterialMapCli, RecipeWithAMapRunsAndSaysTheTruthIsSpatiallyVarying) {
+  ScratchDir dir;
+  WriteMap(dir);
+  std::ofstream(dir / "maps/recipe.json")
+      << nlohmann::json{{"format", "ibrdf-recipe"},
+                        {"version", 1},
+                        {"name", "striped"},
+                        {"material_map", "map.json"},
+                        {"synth", {"--width", "160", "--height", "120", "--photos", "4", "--effects", "none"}}}
+             .dump();
+  const auto run = RunIbrdf("run " + (dir / "maps") + " --out " + (dir / "r") + " --no-report --no-fits --stride 2",
+                            /*quiet=*/true);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("truth is spatially varying: no single-material comparison"), std::string::npos)
+      << run.output;
+  const nlohmann::json summary = ReadJsonFile(dir / "r/summary.json");
+  EXPECT_EQ(summary.at("stages").at("synth").at("status"), "ran");
+  EXPECT_EQ(summary.at("stages").at("compare").at("status"), "not_applicable");
+  EXPECT_EQ(summary.at("stages").at("compare").at("reason"),
+            "truth is spatially varying: no single-material comparison");
+  EXPECT_EQ(summary.at("truth").at("spatially_varying"), true);
+  EXPECT_FALSE(summary.at("truth").contains("samples_median_rel_error"));
+  EXPECT_FALSE(summary.at("truth").contains("brdf_rel_rmse"));
+  EXPECT_FALSE(fs::exists(dir / "r/truth-comparison.json"));
+  EXPECT_TRUE(ReadJsonFile(dir / "r/synth/truth.json").contains("material_map"));
+}
+
+}  // namespace
+}  // namespace ibrdf
