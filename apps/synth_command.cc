@@ -14,6 +14,8 @@ struct SynthArgs {
 
 void RunSynth(SynthArgs& args) {
   SynthRequest& request = args.request;
+  // A usage error (exit 2, with the usage line), as CLI11's own ->required() would give.
+  if (args.material.empty() && request.material_map.empty()) throw CLI::RequiredError("--material or --material-map");
   request.camera_elevation_given = args.elevation->count() > 0;
   request.light_photos_given = args.light_photos->count() > 0;
   request.merl_lookup_given = args.merl_lookup->count() > 0;
@@ -40,7 +42,8 @@ IBRDF_COMMAND(10, Synth) {
       ->check(CLI::ExistingFile);
   c.add_option("--material-map", r.material_map,
                "A spatially varying sample: stripes of basis materials (JSON, docs/synth.md), instead of --material")
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingFile)
+      ->excludes("--material");
   AddOption(c, "--no-data", r.no_data, "A MERL table's cells without data: skip (masked out), zero (warned) or error")
       ->check(CLI::IsMember({"skip", "zero", "error"}));
   args->merl_lookup = AddOption(c, "--merl-lookup", r.merl_lookup,

@@ -52,7 +52,7 @@ TEST(MessagesCli, IncompleteSessionDraftEndsWithItsOwnWords) {
 
 TEST(MessagesCli, MissingRequiredFlagSaysIbrdfError) {
   ScratchDir dir;
-  ExpectMessage("synth --out " + dir / "s", 2, {"synth: ", "--material is required"}, {});
+  ExpectMessage("synth --out " + dir / "s", 2, {"synth: ", "--material or --material-map is required"}, {});
 }
 
 // CLI11 lists unexpected arguments last to first; the message gives them as typed, with the stage.
