@@ -52,7 +52,7 @@ void EnforceVerdicts(std::vector<Verdict>* verdicts, const AcceptedChecks& accep
         break;
     }
   }
-  if (!failures.empty()) ThrowError(where, "a calibration cannot be trusted:" + failures);
+  if (!failures.empty()) ThrowError(where, "a result cannot be trusted:" + failures);
 }
 
 nlohmann::json VerdictsToJson(const std::vector<Verdict>& verdicts) {

@@ -30,6 +30,32 @@ uint64_t CellKey(const Eigen::Vector3d& point, const Eigen::Vector3d& origin, do
   return key;
 }
 
+// The key of the cell `2^shift` times larger that holds the cell `key` (the same grid origin).
+uint64_t CoarserKey(uint64_t key, int shift) {
+  uint64_t coarse = 0;
+  for (int a = 2; a >= 0; --a) coarse = (coarse << 21) | (((key >> (21 * a)) & ((1u << 21) - 1)) >> shift);
+  return coarse;
+}
+
+// The finest of the cells 1, 2 and 4 times `fine` at which half the usable samples lie in cells with
+// enough of them to be scored: a small capture is judged on coarser cells instead of not at all.
+// `usable_in_cell` and `keys` are per fine cell.
+int CoarseningShift(const std::vector<uint32_t>& usable_in_cell, const std::vector<uint64_t>& keys,
+                    int min_cell_samples, int max_shift) {
+  uint64_t total = 0;
+  for (uint32_t n : usable_in_cell) total += n;
+  for (int shift = 0; shift < max_shift; ++shift) {
+    std::unordered_map<uint64_t, uint64_t> count;
+    for (size_t c = 0; c < keys.size(); ++c) count[CoarserKey(keys[c], shift)] += usable_in_cell[c];
+    uint64_t in_scored = 0;
+    for (const auto& [key, n] : count) {
+      if (n >= uint64_t(min_cell_samples)) in_scored += n;
+    }
+    if (2 * in_scored >= total) return shift;
+  }
+  return max_shift;
+}
+
 // What one sample gives the check: its cell and, per channel, sample / reference (NaN where either is
 // not usable: a channel not measured, or the reference without data or zero there).
 struct Row {
@@ -118,7 +144,7 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
   const auto start = std::chrono::steady_clock::now();
   const SurfaceLocator locator(session);
   UniformityResult result;
-  result.cell_m = options.cell_m > 0.0 ? options.cell_m : locator.BoundingRadius() / 16.0;
+  result.cell_m = options.cell_m > 0.0 ? options.cell_m : locator.BoundingRadius() / 16.0;  // until coarsened
   result.grid_origin =
       locator.BoundingCenter() - Eigen::Vector3d::Constant(1.5 * locator.BoundingRadius() + result.cell_m);
   const Eigen::Vector3d& origin = result.grid_origin;
@@ -166,6 +192,36 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
     entries.push_back(Entry{it->second, {row.ratio[0], row.ratio[1], row.ratio[2]}});
     ++usable_per_photo[sample.image];  // Locate found it: a photo of the session
   });
+
+  // Unless the cell is given, cells too sparse to score are merged into cells 2 or 4 times larger.
+  if (options.cell_m <= 0.0) {
+    std::vector<uint32_t> usable_in_cell(point_sums.size(), 0);
+    for (const Entry& e : entries) ++usable_in_cell[e.cell];
+    const int shift = CoarseningShift(usable_in_cell, keys, options.min_cell_samples, /*max_shift=*/2);
+    if (shift > 0) {
+      std::unordered_map<uint64_t, uint32_t> coarse_of_key;
+      std::vector<uint32_t> coarse_of_fine(keys.size());
+      std::vector<Eigen::Vector3d> coarse_sums;
+      std::vector<uint32_t> coarse_located;
+      std::vector<uint64_t> coarse_keys;
+      for (size_t c = 0; c < keys.size(); ++c) {
+        const auto [it, inserted] = coarse_of_key.emplace(CoarserKey(keys[c], shift), uint32_t(coarse_sums.size()));
+        if (inserted) {
+          coarse_sums.push_back(Eigen::Vector3d::Zero());
+          coarse_located.push_back(0);
+          coarse_keys.push_back(it->first);
+        }
+        coarse_of_fine[c] = it->second;
+        coarse_sums[it->second] += point_sums[c];
+        coarse_located[it->second] += located_in_cell[c];
+      }
+      for (Entry& e : entries) e.cell = coarse_of_fine[e.cell];
+      point_sums = std::move(coarse_sums);
+      located_in_cell = std::move(coarse_located);
+      keys = std::move(coarse_keys);
+      result.cell_m *= double(1 << shift);
+    }
+  }
 
   // The entries grouped by cell (a counting sort), then each cell's median ratio and its noise.
   const size_t n_cells = point_sums.size();
@@ -249,8 +305,8 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
                             Fixed(100.0 * options.fail_fraction, 0) + " % (fail)";
   const std::string remedy =
       "the sample is not one material, and the one BRDF averages its materials (where: the map, uniformity/map.png); "
-      "measure one material's region alone (a session mask), or accept the average with --accept uniformity.cells "
-      "(ibrdf run: --uniformity-args \"--accept uniformity.cells\")";
+      "measure one material's region alone (a session mask), or accept the average (in ibrdf run: "
+      "--uniformity-args \"--accept uniformity.cells\")";
   if (result.cells_scored < 8) {
     result.verdicts.push_back(MakeVerdict(
         "uniformity.cells", double(result.cells_scored),

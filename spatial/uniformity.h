@@ -28,7 +28,8 @@ namespace ibrdf {
 
 struct UniformityOptions {
   // The cells' edge, metres; 0: the sample's bounding radius / 16 (about 2.8 mm on a 9 cm squash,
-  // 16 cells across a stripe of a twelfth of its girth).
+  // 16 cells across a stripe of a twelfth of its girth), or 2 or 4 times that where too few samples
+  // fill those cells (the finest at which half the usable samples lie in cells of min_cell_samples).
   double cell_m = 0.0;
   // Cells with fewer usable samples in a channel are not scored in it.
   int min_cell_samples = 24;

@@ -106,10 +106,11 @@ void AddTruth(const fs::path& dir, const std::string& truth_path, nlohmann::json
   (*summary)["truth"] = truth;
 }
 
-// The calibration stages' and the uniformity check's verdicts (response/response.json, align/alignment.json,
-// lights/white-reference.json, colour/colour.json and uniformity/uniformity.json "verdicts", core/verdict.h), each with its stage, and every
-// stage's warnings in one list: the verdicts that are not ok (an accepted failure included, marked so), align's own
-// warnings and derender's exposure advice.
+// The calibration stages' and the uniformity check's verdicts (response/response.json,
+// align/alignment.json, lights/white-reference.json, colour/colour.json and uniformity/uniformity.json
+// "verdicts", core/verdict.h), each with its stage, and every stage's warnings in one list: the
+// verdicts that are not ok (an accepted failure included, marked so), align's own warnings and
+// derender's exposure advice.
 void AddVerdicts(const fs::path& dir, nlohmann::json* summary) {
   nlohmann::json verdicts = nlohmann::json::array(), warnings = nlohmann::json::array();
   for (const auto& [stage, file] : {std::pair<std::string, std::string>{"response", "response/response.json"},

@@ -130,9 +130,11 @@ TEST(SynthMaterialMapCli, ExactlyOneOfMaterialAndMapIsGiven) {
   EXPECT_FALSE(fs::exists(dir / "n"));
 }
 
-// A recipe naming a material map (relative to the recipe) runs end to end; the single-material
-// comparison is not applicable, and the summary says why instead of scoring against one material.
-TEST(SynthMaterialMapCli, RecipeWithAMapRunsAndSaysTheTruthIsSpatiallyVarying) {
+// A recipe naming a material map (relative to the recipe) runs until the uniformity check, which stops
+// it: the one BRDF averages two materials, and the map says where. Accepted by name, the run goes on;
+// the single-material comparison is not applicable, and the summary says why and records the accepted
+// verdict.
+TEST(SynthMaterialMapCli, RecipeWithAMapStopsAtUniformityAndRunsWhenAccepted) {
   ScratchDir dir;
   WriteMap(dir);
   std::ofstream(dir / "maps/recipe.json")
@@ -142,13 +144,24 @@ TEST(SynthMaterialMapCli, RecipeWithAMapRunsAndSaysTheTruthIsSpatiallyVarying) {
                         {"material_map", "map.json"},
                         {"synth", {"--width", "160", "--height", "120", "--photos", "4", "--effects", "none"}}}
              .dump();
-  const auto run = RunIbrdf("run " + (dir / "maps") + " --out " + (dir / "r") + " --no-report --no-fits --stride 2",
-                            /*quiet=*/true);
+  const std::string run_line = "run " + (dir / "maps") + " --out " + (dir / "r") + " --no-report --no-fits --stride 2";
+  const auto stopped = RunIbrdf(run_line, /*quiet=*/true);
+  EXPECT_EQ(stopped.exit_code, 1) << stopped.output;
+  EXPECT_NE(stopped.output.find("uniformity.cells: fail"), std::string::npos) << stopped.output;
+  EXPECT_NE(stopped.output.find("stage uniformity failed"), std::string::npos) << stopped.output;
+  const nlohmann::json measured = ReadJsonFile(dir / "r/uniformity/uniformity.json");
+  EXPECT_GT(measured.at("deviating_fraction").get<double>(), 0.15);
+  EXPECT_TRUE(fs::exists(dir / "r/uniformity/map.png"));
+
+  const auto run = RunIbrdf(run_line + " --uniformity-args \"--accept uniformity.cells\"", /*quiet=*/true);
   ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("accepted by the user: uniformity.cells"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("truth is spatially varying: no single-material comparison"), std::string::npos)
       << run.output;
   const nlohmann::json summary = ReadJsonFile(dir / "r/summary.json");
-  EXPECT_EQ(summary.at("stages").at("synth").at("status"), "ran");
+  // The second run resumes: synth to reconstruct are complete, uniformity runs again, with the accept.
+  EXPECT_EQ(summary.at("stages").at("synth").at("status"), "skipped");
+  EXPECT_EQ(summary.at("stages").at("uniformity").at("status"), "ran");
   EXPECT_EQ(summary.at("stages").at("compare").at("status"), "not_applicable");
   EXPECT_EQ(summary.at("stages").at("compare").at("reason"),
             "truth is spatially varying: no single-material comparison");
@@ -157,6 +170,11 @@ TEST(SynthMaterialMapCli, RecipeWithAMapRunsAndSaysTheTruthIsSpatiallyVarying) {
   EXPECT_FALSE(summary.at("truth").contains("brdf_rel_rmse"));
   EXPECT_FALSE(fs::exists(dir / "r/truth-comparison.json"));
   EXPECT_TRUE(ReadJsonFile(dir / "r/synth/truth.json").contains("material_map"));
+  bool recorded = false;
+  for (const nlohmann::json& verdict : summary.at("verdicts")) {
+    if (verdict.value("check", "") == "uniformity.cells") recorded = verdict.value("accepted", false);
+  }
+  EXPECT_TRUE(recorded) << summary.at("verdicts").dump(2);
 }
 
 }  // namespace
