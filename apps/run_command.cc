@@ -64,7 +64,6 @@ IBRDF_COMMAND(80, Run) {
     named[] = {{"--calibrate", align, "align", "Calibrate the camera first from the ChArUco photos in this folder"},
                {"--colmap", align, "align", "A COLMAP sparse model whose poses replace the targets'"},
                {"--min-markers", align, "align", "Reference markers a photo needs"},
-               {"--accept", align, "align", "Proceed although these checks fail (docs/verdicts.md)"},
                {"--lobes", reconstruct, "reconstruct", "Lafortune lobes (1 to 3)"},
                {"--bandwidth", reconstruct, "reconstruct", "Kernel radii: given, loo or gcv"},
                {"--max-theta-deg", reconstruct, "reconstruct", "Tabulate up to this theta"},
@@ -92,6 +91,24 @@ IBRDF_COMMAND(80, Run) {
          flag, add, std::string(n.stage) + ": " + n.help + " (passed to `ibrdf " + n.stage + " " + flag + "`)")
         ->type_name("VALUE");
   }
+  // Each check goes to the stage that makes it: uniformity's own, the rest align's; "all" to both.
+  c->add_option_function<std::string>(
+       "--accept",
+       [args](const std::string& value) {
+         std::string to_align, to_uniformity;
+         std::istringstream names(value);
+         for (std::string name; std::getline(names, name, ',');) {
+           const bool all = name == "all", its_own = name.rfind("uniformity.", 0) == 0;
+           if (all || !its_own) to_align += (to_align.empty() ? "" : ",") + name;
+           if (all || its_own) to_uniformity += (to_uniformity.empty() ? "" : ",") + name;
+         }
+         std::vector<std::string>&align_args = args->o.align_args, &uniformity_args = args->o.uniformity_args;
+         if (!to_align.empty()) align_args.insert(align_args.end(), {"--accept", to_align});
+         if (!to_uniformity.empty()) uniformity_args.insert(uniformity_args.end(), {"--accept", to_uniformity});
+       },
+       "align, uniformity: proceed although these checks fail (docs/verdicts.md; uniformity.* to `ibrdf uniformity\n"
+       "--accept`, the others to `ibrdf align --accept`)")
+      ->type_name("CHECK,...");
   c->add_option("--stop-after", o.stop_after,
                 "Stop after this stage (synth, scan, response, align, lights, colour, derender, check,\n"
                 "compare, reconstruct, report); later stages are left as they are");

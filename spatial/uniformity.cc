@@ -304,9 +304,9 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
   const std::string bound = "under " + Fixed(100.0 * options.warn_fraction, 0) + " % of cells (warn), " +
                             Fixed(100.0 * options.fail_fraction, 0) + " % (fail)";
   const std::string remedy =
-      "the sample is not one material, and the one BRDF averages its materials (where: the map, uniformity/map.png); "
-      "measure one material's region alone (a session mask), or accept the average (in ibrdf run: "
-      "--uniformity-args \"--accept uniformity.cells\")";
+      "the sample is not one material, and the one BRDF averages its materials, or its geometry is wrong (the "
+      "sample's shape or pose, the cameras, the light: see align's verdicts); where: the map, uniformity/map.png; "
+      "measure one material's region alone (a session mask), or accept the average";
   if (result.cells_scored < 8) {
     result.verdicts.push_back(MakeVerdict(
         "uniformity.cells", double(result.cells_scored),

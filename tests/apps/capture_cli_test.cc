@@ -152,7 +152,8 @@ TEST(CaptureCli, LowResolutionLightCardStopsAlignWithAVerdict) {
 // Two photos and a wrong radius guess (0.03 m for a 0.04 m sphere), the radius not known: the sphere
 // fit collapses onto the lit limb (a radius of micrometres, the centre far off the platform). run stops
 // at align with the named verdicts, the values, the bounds and the remedy; accepted by name, the run
-// goes on and its summary says the failures were accepted.
+// goes on to the uniformity check, which the wrong geometry fails too; accepted as well, the run ends
+// and its summary says the failures were accepted.
 TEST(CaptureCli, ACollapsedSphereFitStopsTheRunUnlessAccepted) {
   ScratchDir dir;
   const RunResult init =
@@ -166,8 +167,15 @@ TEST(CaptureCli, ACollapsedSphereFitStopsTheRunUnlessAccepted) {
   EXPECT_FALSE(fs::exists(dir / "run/align/session.json"));
   EXPECT_FALSE(fs::exists(dir / "run/samples.npy"));
 
+  // Accepted, the wrong sphere derenders samples that disagree with each other across the surface: the
+  // uniformity check, which knows nothing of align, stops the run again.
+  const RunResult second = RunIbrdf("run " + dir / "s" + " --out " + dir / "run" +
+                                    " --no-fits --accept sphere.radius,sphere.center",
+                                    true);
+  EXPECT_EQ(second.exit_code, 1) << second.output;
+  EXPECT_NE(second.output.find("uniformity.cells: fail"), std::string::npos) << second.output;
   const RunResult accepted = RunIbrdf("run " + dir / "s" + " --out " + dir / "run" +
-                                      " --no-fits --accept sphere.radius,sphere.center",
+                                      " --no-fits --accept sphere.radius,sphere.center,uniformity.cells",
                                       true);
   ASSERT_EQ(accepted.exit_code, 0) << accepted.output;
   const nlohmann::json summary = ReadJsonFile(dir / "run/summary.json");
@@ -175,7 +183,7 @@ TEST(CaptureCli, ACollapsedSphereFitStopsTheRunUnlessAccepted) {
   for (const nlohmann::json& v : summary.at("verdicts")) {
     accepted_failures += v.at("verdict") == "fail" && v.at("accepted") == true;
   }
-  EXPECT_EQ(accepted_failures, 2) << summary.dump(1);
+  EXPECT_EQ(accepted_failures, 3) << summary.dump(1);
   bool said = false;
   for (const nlohmann::json& w : summary.at("warnings")) {
     said |= w.get<std::string>().find("sphere.radius: fail (accepted by the user)") != std::string::npos;
