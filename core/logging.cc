@@ -88,6 +88,12 @@ void ProgressBar::Draw(uint64_t done, bool final) {
   }
 }
 
+std::string Fixed(double value, int digits) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, value);
+  return buffer;
+}
+
 std::string FormatCounts(const RejectionCounts& counts) {
   std::ostringstream out;
   bool first = true;

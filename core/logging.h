@@ -74,4 +74,7 @@ using RejectionCounts = std::map<std::string, uint64_t>;
 // "saturated 12, grazing_incidence 3" (reasons with a zero count are left out).
 std::string FormatCounts(const RejectionCounts& counts);
 
+// `value` with `digits` decimals ("%.*f"): the figures of a stage's messages.
+std::string Fixed(double value, int digits);
+
 }  // namespace ibrdf

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/file_util.h"
+#include "core/logging.h"
 #include "core/statistics.h"
 #include "spatial/surface_points.h"
 
@@ -93,12 +94,6 @@ uint64_t ForEachRow(const std::string& samples_path, const SurfaceLocator& locat
   });
 }
 
-std::string Fixed(double value, int digits) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, value);
-  return buffer;
-}
-
 nlohmann::json Vector(const Eigen::Vector3d& v) {
   nlohmann::json a = nlohmann::json::array();
   for (int c = 0; c < 3; ++c) {
@@ -114,6 +109,7 @@ nlohmann::json Vector(const Eigen::Vector3d& v) {
 }  // namespace
 
 bool UniformityOptions::Check(std::string* why) const {
+  if (!clusters.Check(why)) return false;
   if (!(cell_m >= 0.0)) {
     *why = "the cell size must be at least 0 (0: automatic)";
     return false;
@@ -299,6 +295,14 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
   result.max_ratio = hi;
   result.deviating_fraction = result.cells_scored ? double(result.cells_deviating) / double(result.cells_scored) : 0.0;
 
+  {
+    std::vector<Eigen::Vector3d> relative_ratio;
+    for (const UniformityCell& cell : result.cells) {
+      relative_ratio.push_back(cell.ratio.cwiseQuotient(result.object_ratio));
+    }
+    result.materials = ClusterMaterials(relative_ratio, options.clusters);
+  }
+
   result.map_photo = size_t(std::max_element(usable_per_photo.begin(), usable_per_photo.end()) - usable_per_photo.begin());
 
   const std::string bound = "under " + Fixed(100.0 * options.warn_fraction, 0) + " % of cells (warn), " +
@@ -320,7 +324,8 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
         std::to_string(result.cells_deviating) + " of " + std::to_string(result.cells_scored) + " cells (" +
             Fixed(100.0 * result.deviating_fraction, 1) + " %) differ from the object's BRDF by over " +
             Fixed(1.0 + options.deviation, 2) + "x and " + Fixed(options.noise_sigmas, 0) +
-            " sigma; cell ratios " + Fixed(result.min_ratio, 2) + "x to " + Fixed(result.max_ratio, 2) + "x",
+            " sigma; cell ratios " + Fixed(result.min_ratio, 2) + "x to " + Fixed(result.max_ratio, 2) + "x; " +
+            result.materials.BriefReport(),
         bound, VerdictAbove(result.deviating_fraction, options.warn_fraction, options.fail_fraction), remedy));
   }
   const double located_fraction = result.samples ? double(result.located) / double(result.samples) : 0.0;
@@ -341,7 +346,7 @@ std::string UniformityResult::BriefReport() const {
                      " cells of " + Fixed(cell_m * 1e3, 1) + " mm (" + Fixed(100.0 * deviating_fraction, 1) +
                      " %) deviate from the object's BRDF; spread (p90/p10)";
   for (int k = 0; k < 3; ++k) text += " " + (std::isfinite(spread[k]) ? Fixed(spread[k], 2) + "x" : std::string("n/a"));
-  text += "; " + std::to_string(located) + " of " + std::to_string(samples) + " samples located in " +
+  text += "; " + materials.BriefReport() + "; " + std::to_string(located) + " of " + std::to_string(samples) + " samples located in " +
           Fixed(seconds, 1) + " s";
   return text;
 }
@@ -364,13 +369,16 @@ nlohmann::json UniformityResult::ToJson(bool with_cells) const {
       {"spread_p90_p10", Vector(spread)},
       {"cell_ratio_range", {min_ratio, max_ratio}},
       {"map_photo", map_photo},
+      {"materials", materials.ToJson()},
       {"verdicts", VerdictsToJson(verdicts)},
       {"timings_s", {{"total", seconds}}},
   };
   if (with_cells) {
     nlohmann::json list = nlohmann::json::array();
-    for (const UniformityCell& cell : this->cells) {
+    for (size_t c = 0; c < this->cells.size(); ++c) {
+      const UniformityCell& cell = this->cells[c];
       list.push_back({{"centre", Vector(cell.centre)},
+                      {"material", c < materials.cell_label.size() ? materials.cell_label[c] : -1},
                       {"samples", cell.samples},
                       {"ratio", Vector(cell.ratio)},
                       {"noise", Vector(cell.noise)},

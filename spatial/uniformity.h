@@ -23,6 +23,7 @@
 #include "core/image_io.h"
 #include "core/session.h"
 #include "core/verdict.h"
+#include "spatial/material_clusters.h"
 
 namespace ibrdf {
 
@@ -44,6 +45,9 @@ struct UniformityOptions {
   // Samples read per chunk of the file (memory stays bounded by the per-sample ratios kept, 16 bytes
   // each).
   size_t chunk_rows = 1 << 20;
+  // How the cells are grouped into materials (reported, with each cell's label; the verdict is the
+  // deviating cells' alone).
+  MaterialClusterOptions clusters;
 
   bool Check(std::string* why) const;
 };
@@ -74,6 +78,7 @@ struct UniformityResult {
   // Per channel, the 90th over the 10th percentile of the scored cells' ratios (1 for one material).
   Eigen::Vector3d spread = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   double max_ratio = 0.0, min_ratio = 0.0;  // over scored cells and channels, relative to the object's
+  MaterialClusters materials;     // the cells grouped by their ratios (cells[i] has label materials.cell_label[i])
   std::vector<Verdict> verdicts;  // "uniformity.cells", "uniformity.located"
   size_t map_photo = 0;           // the session photo the map draws on (the one with most scored samples)
   double seconds = 0.0;

@@ -1,0 +1,192 @@
+#include "spatial/material_clusters.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "core/logging.h"
+
+namespace ibrdf {
+namespace {
+
+struct Partition {
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<int> label;
+  double sse = std::numeric_limits<double>::infinity();
+};
+
+// Lloyd's iterations from k-means++ seeds drawn with `rng`.
+Partition KMeans(const std::vector<Eigen::Vector3d>& points, int k, std::mt19937* rng) {
+  Partition p;
+  const size_t n = points.size();
+  std::uniform_int_distribution<size_t> pick(0, n - 1);
+  p.centres.push_back(points[pick(*rng)]);
+  std::vector<double> nearest(n);
+  while (int(p.centres.size()) < k) {
+    double total = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      double d = std::numeric_limits<double>::infinity();
+      for (const Eigen::Vector3d& c : p.centres) d = std::min(d, (points[i] - c).squaredNorm());
+      nearest[i] = d;
+      total += d;
+    }
+    if (!(total > 0.0)) break;  // fewer distinct points than k
+    std::uniform_real_distribution<double> u(0.0, total);
+    double at = u(*rng);
+    size_t chosen = n - 1;
+    for (size_t i = 0; i < n; ++i) {
+      at -= nearest[i];
+      if (at <= 0.0) {
+        chosen = i;
+        break;
+      }
+    }
+    p.centres.push_back(points[chosen]);
+  }
+  p.label.assign(n, 0);
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    bool changed = false;
+    p.sse = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      int best = 0;
+      double best_d = std::numeric_limits<double>::infinity();
+      for (size_t c = 0; c < p.centres.size(); ++c) {
+        const double d = (points[i] - p.centres[c]).squaredNorm();
+        if (d < best_d) {
+          best_d = d;
+          best = int(c);
+        }
+      }
+      changed |= p.label[i] != best;
+      p.label[i] = best;
+      p.sse += best_d;
+    }
+    if (!changed && iteration > 0) break;
+    std::vector<Eigen::Vector3d> sums(p.centres.size(), Eigen::Vector3d::Zero());
+    std::vector<size_t> counts(p.centres.size(), 0);
+    for (size_t i = 0; i < n; ++i) {
+      sums[p.label[i]] += points[i];
+      ++counts[p.label[i]];
+    }
+    for (size_t c = 0; c < p.centres.size(); ++c) {
+      if (counts[c] > 0) p.centres[c] = sums[c] / double(counts[c]);
+    }
+  }
+  return p;
+}
+
+}  // namespace
+
+bool MaterialClusterOptions::Check(std::string* why) const {
+  if (max_materials < 1 || max_materials > 16) {
+    *why = "max materials must be 1 to 16";
+    return false;
+  }
+  if (!(separation > 0.0)) {
+    *why = "separation must be positive";
+    return false;
+  }
+  if (!(min_share >= 0.0 && min_share < 0.5)) {
+    *why = "min share must be in [0, 0.5)";
+    return false;
+  }
+  if (starts < 1) {
+    *why = "starts must be positive";
+    return false;
+  }
+
+  return true;
+}
+
+MaterialClusters ClusterMaterials(const std::vector<Eigen::Vector3d>& cell_ratio, const MaterialClusterOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("material cluster options", why);
+  MaterialClusters result;
+  result.cell_label.assign(cell_ratio.size(), -1);
+  std::vector<Eigen::Vector3d> points;
+  std::vector<size_t> cell_of_point;
+  for (size_t c = 0; c < cell_ratio.size(); ++c) {
+    const Eigen::Vector3d& r = cell_ratio[c];
+    bool all = true;
+    Eigen::Vector3d log_ratio;
+    for (int k = 0; k < 3; ++k) {
+      all &= std::isfinite(r[k]) && r[k] > 0.0;
+      if (all) log_ratio[k] = std::log(r[k]);
+    }
+    if (!all) continue;
+    points.push_back(log_ratio);
+    cell_of_point.push_back(c);
+  }
+  result.clustered = points.size();
+  if (points.empty()) return result;
+
+  const double log_separation = std::log1p(options.separation);
+  Partition taken;
+  taken.centres = {Eigen::Vector3d::Zero()};
+  taken.label.assign(points.size(), 0);
+  {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& p : points) mean += p;
+    taken.centres[0] = mean / double(points.size());
+  }
+  result.tried.push_back("1: always");
+  std::mt19937 rng(1);
+  for (int k = 2; k <= options.max_materials && size_t(k) <= points.size(); ++k) {
+    Partition best;
+    for (int start = 0; start < options.starts; ++start) {
+      Partition p = KMeans(points, k, &rng);
+      if (p.sse < best.sse) best = std::move(p);
+    }
+    // The closest pair of centres (by their largest channel difference) and the smallest cluster.
+    double closest = std::numeric_limits<double>::infinity();
+    for (size_t a = 0; a < best.centres.size(); ++a) {
+      for (size_t b = a + 1; b < best.centres.size(); ++b) {
+        closest = std::min(closest, (best.centres[a] - best.centres[b]).cwiseAbs().maxCoeff());
+      }
+    }
+    std::vector<size_t> counts(best.centres.size(), 0);
+    for (int label : best.label) ++counts[label];
+    const double smallest = double(*std::min_element(counts.begin(), counts.end())) / double(points.size());
+    const bool apart = closest > log_separation, large = smallest >= options.min_share;
+    result.tried.push_back(std::to_string(k) + ": closest centres " + Fixed(std::exp(closest), 2) + "x apart (" +
+                           (apart ? "over " : "not over ") + Fixed(1.0 + options.separation, 2) + "x), smallest " +
+                           Fixed(100.0 * smallest, 1) + " % of cells (" + (large ? "at least " : "under ") +
+                           Fixed(100.0 * options.min_share, 0) + " %)");
+    if (apart && large) taken = std::move(best);
+  }
+
+  result.count = int(taken.centres.size());
+  result.share.assign(result.count, 0.0);
+  for (size_t i = 0; i < points.size(); ++i) {
+    result.cell_label[cell_of_point[i]] = taken.label[i];
+    result.share[taken.label[i]] += 1.0 / double(points.size());
+  }
+  for (const Eigen::Vector3d& c : taken.centres) result.ratio.push_back(c.array().exp().matrix());
+  return result;
+}
+
+std::string MaterialClusters::BriefReport() const {
+  if (count == 0) return "cells not grouped: none scored in all three channels";
+  if (count == 1) return "the cells' ratios form one group";
+  std::string text = "the cells' ratios form " + std::to_string(count) + " groups (cells";
+  for (int c = 0; c < count; ++c) text += (c ? " / " : " ") + Fixed(100.0 * share[c], 0);
+  text += " %; ratios";
+  for (int c = 0; c < count; ++c) {
+    text += (c ? ", " : " ") + Fixed(ratio[c][0], 2) + " " + Fixed(ratio[c][1], 2) + " " + Fixed(ratio[c][2], 2);
+  }
+  return text + ")";
+}
+
+nlohmann::json MaterialClusters::ToJson() const {
+  nlohmann::json clusters = nlohmann::json::array();
+  for (int c = 0; c < count; ++c) {
+    clusters.push_back({{"share", share[c]}, {"ratio", {ratio[c][0], ratio[c][1], ratio[c][2]}}});
+  }
+  return {{"count", count}, {"clustered_cells", clustered}, {"clusters", clusters}, {"tried", tried}};
+}
+
+}  // namespace ibrdf
