@@ -15,7 +15,7 @@ IBRDF_COMMAND(80, Run) {
   auto* c = app.add_subcommand(
       "run",
       "The whole workflow into one folder: (synth, for a recipe) -> scan -> align -> derender -> check -> compare ->\n"
-      "reconstruct -> report, each stage a child `ibrdf` process, skipped when its outputs are newer than its inputs\n"
+      "reconstruct -> uniformity -> report, each stage a child `ibrdf` process, skipped when its outputs are newer than its inputs\n"
       "and its options unchanged (DIR/stamps/): interrupted, it resumes. Writes DIR/summary.json (docs/workflow.md).");
   struct Args {
     std::string input, out;
@@ -111,7 +111,7 @@ IBRDF_COMMAND(80, Run) {
       ->type_name("CHECK,...");
   c->add_option("--stop-after", o.stop_after,
                 "Stop after this stage (synth, scan, response, align, lights, colour, derender, check,\n"
-                "compare, reconstruct, report); later stages are left as they are");
+                "compare, reconstruct, uniformity, report); later stages are left as they are");
   c->callback([args] {
     Timer wall;
     RequireValidOptions(args->o, "ibrdf run");
