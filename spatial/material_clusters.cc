@@ -98,7 +98,6 @@ bool MaterialClusterOptions::Check(std::string* why) const {
     *why = "starts must be positive";
     return false;
   }
-
   return true;
 }
 
@@ -125,14 +124,11 @@ MaterialClusters ClusterMaterials(const std::vector<Eigen::Vector3d>& cell_ratio
   if (points.empty()) return result;
 
   const double log_separation = std::log1p(options.separation);
+  // k = 1: every cell in one group about the mean.
   Partition taken;
   taken.centres = {Eigen::Vector3d::Zero()};
+  for (const Eigen::Vector3d& p : points) taken.centres[0] += p / double(points.size());
   taken.label.assign(points.size(), 0);
-  {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& p : points) mean += p;
-    taken.centres[0] = mean / double(points.size());
-  }
   result.tried.push_back("1: always");
   std::mt19937 rng(1);
   for (int k = 2; k <= options.max_materials && size_t(k) <= points.size(); ++k) {

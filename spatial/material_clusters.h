@@ -1,17 +1,15 @@
 // How many materials do the uniformity check's cells show, and which cell is which? The first step
 // of Lensch et al. 2003's spatially varying BRDF: group the surface into a few basis materials. Here
-// the cells of the uniformity check (spatial/uniformity.h) are grouped by their ratio to the object's one BRDF, per channel
-// and in logarithms: cells of one material share a ratio (its albedo and lobe against the average),
-// whatever their directions, within the reconstruction's smoothing. k-means (k-means++ seeding from a
-// fixed seed, several starts, the lowest within-cluster sum kept) for k = 1 ... max_materials; the
-// number of materials is the largest k whose clusters are all told apart: every pair of centres more
-// than `separation` apart in some channel (the uniformity check's own 1.25x), and every cluster at
-// least `min_share` of the cells. One material always qualifies, so a uniform sample gives one.
+// the cells of the uniformity check (spatial/uniformity.h) are grouped by their ratio to the object's
+// one BRDF, per channel and in logarithms. k-means (k-means++ seeding from a fixed seed, several
+// starts, the lowest within-cluster sum kept) for k = 1 ... max_materials; the number of groups is the
+// largest k whose clusters are all told apart: every pair of centres more than `separation` apart in
+// some channel (the uniformity check's own 1.25x), and every cluster at least `min_share` of the
+// cells. One group always qualifies, so a uniform sample gives one.
 // A group is a material where the materials differ in albedo more than in lobe (Lambertian stripes:
 // every cell labelled right); a glossy material's ratio to the average changes with the directions
-// each cell saw and may split into groups (docs/spatial.md gives the figures). Lensch's iteration,
-// each cluster's own BRDF fitted and the cells reassigned to the one that predicts them best, is the
-// step that makes groups materials.
+// each cell saw, so it may share a group or split (docs/spatial.md gives the figures, and those of
+// Lensch's per-group refit, which was tried and did not help).
 #pragma once
 
 #include <string>
@@ -19,7 +17,6 @@
 
 #include <Eigen/Core>
 #include <nlohmann/json_fwd.hpp>
-
 
 namespace ibrdf {
 
@@ -33,7 +30,7 @@ struct MaterialClusterOptions {
 };
 
 struct MaterialClusters {
-  int count = 0;                   // the materials found (0: no cell had all three channels scored)
+  int count = 0;                   // the groups found (0: no cell had all three channels scored)
   std::vector<int> cell_label;     // per cell: its cluster, -1 for cells not clustered
   std::vector<Eigen::Vector3d> ratio;  // per cluster, its centre as a ratio to the object's (per channel)
   std::vector<double> share;       // per cluster, its fraction of the clustered cells

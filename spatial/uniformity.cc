@@ -346,8 +346,8 @@ std::string UniformityResult::BriefReport() const {
                      " cells of " + Fixed(cell_m * 1e3, 1) + " mm (" + Fixed(100.0 * deviating_fraction, 1) +
                      " %) deviate from the object's BRDF; spread (p90/p10)";
   for (int k = 0; k < 3; ++k) text += " " + (std::isfinite(spread[k]) ? Fixed(spread[k], 2) + "x" : std::string("n/a"));
-  text += "; " + materials.BriefReport() + "; " + std::to_string(located) + " of " + std::to_string(samples) + " samples located in " +
-          Fixed(seconds, 1) + " s";
+  text += "; " + materials.BriefReport() + "; " + std::to_string(located) + " of " + std::to_string(samples) +
+          " samples located in " + Fixed(seconds, 1) + " s";
   return text;
 }
 
