@@ -36,6 +36,9 @@ IBRDF_COMMAND(80, Run) {
   AddClearingFlag(*c, "--no-fits", o.fits, "reconstruct: skip the Lafortune and GGX fits");
   c->add_flag("--check-regression", o.check_regression, "check: also the regression checks (held-out photos)");
   AddClearingFlag(*c, "--no-report", o.report, "Skip the HTML report");
+  c->add_flag("--spatial", o.spatial,
+              "materials: measure each group of the uniformity check's cells as a material of its own (accepts\n"
+              "uniformity.cells, recorded; docs/spatial.md)");
   c->add_flag("--force", o.force, "Re-run every stage, up to date or not");
   AddClearingFlag(*c, "--sequential", o.concurrent_sample_stages,
                   "Run check and compare after reconstruct, not beside it (the outputs are the same)");
@@ -46,7 +49,8 @@ IBRDF_COMMAND(80, Run) {
                   align = &MeasurementOptions::align_args, lights = &MeasurementOptions::lights_args,
                   colour = &MeasurementOptions::colour_args, derender = &MeasurementOptions::derender_args,
                   check = &MeasurementOptions::check_args, reconstruct = &MeasurementOptions::reconstruct_args,
-                  uniformity = &MeasurementOptions::uniformity_args, report = &MeasurementOptions::report_args;
+                  uniformity = &MeasurementOptions::uniformity_args, materials = &MeasurementOptions::materials_args,
+                  report = &MeasurementOptions::report_args;
   const struct {
     const char* flag;
     StageArgs target;
@@ -60,6 +64,7 @@ IBRDF_COMMAND(80, Run) {
               {"--check-args", check, "check", "--theta-bin-deg 5 --phi-bin-deg 10"},
               {"--reconstruct-args", reconstruct, "reconstruct", "--degree 1 --no-fold"},
               {"--uniformity-args", uniformity, "uniformity", "--cell-mm 4 --accept uniformity.cells"},
+              {"--materials-args", materials, "materials", "--margin-mm 3 --min-group-samples 5000"},
               {"--report-args", report, "report", "--angles-deg 20,40,60"}},
     named[] = {{"--calibrate", align, "align", "Calibrate the camera first from the ChArUco photos in this folder"},
                {"--colmap", align, "align", "A COLMAP sparse model whose poses replace the targets'"},
@@ -111,7 +116,7 @@ IBRDF_COMMAND(80, Run) {
       ->type_name("CHECK,...");
   c->add_option("--stop-after", o.stop_after,
                 "Stop after this stage (synth, scan, response, align, lights, colour, derender, check,\n"
-                "compare, reconstruct, uniformity, report); later stages are left as they are");
+                "compare, reconstruct, uniformity, materials, report); later stages are left as they are");
   c->callback([args] {
     Timer wall;
     RequireValidOptions(args->o, "ibrdf run");

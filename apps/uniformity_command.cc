@@ -44,6 +44,8 @@ IBRDF_COMMAND(55, Uniformity) {
   AddOption(*c, "--deviation", args->options.deviation,
             "A cell deviates beyond this relative difference (0.25: 1.25x or 1 / 1.25x)");
   AddOption(*c, "--noise-sigmas", args->options.noise_sigmas, "... and beyond this many standard errors of its own");
+  AddOption(*c, "--cluster-min-theta-h-deg", args->options.cluster_min_theta_h_deg,
+            "The cells are grouped by their samples with theta_h at least this (0: all)");
   c->add_option("--accept", args->accept.names,
                 "Proceed although these checks fail (comma-separated, or all); recorded in uniformity.json")
       ->delimiter(',')

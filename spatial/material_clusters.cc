@@ -86,8 +86,8 @@ bool MaterialClusterOptions::Check(std::string* why) const {
     *why = "max materials must be 1 to 16";
     return false;
   }
-  if (!(separation > 0.0)) {
-    *why = "separation must be positive";
+  if (!(separation > 0.0) || !(blend_tolerance > 0.0)) {
+    *why = "separation and blend tolerance must be positive";
     return false;
   }
   if (!(min_share >= 0.0 && min_share < 0.5)) {
@@ -123,7 +123,7 @@ MaterialClusters ClusterMaterials(const std::vector<Eigen::Vector3d>& cell_ratio
   result.clustered = points.size();
   if (points.empty()) return result;
 
-  const double log_separation = std::log1p(options.separation);
+  const double log_separation = std::log1p(options.separation), log_blend = std::log1p(options.blend_tolerance);
   // k = 1: every cell in one group about the mean.
   Partition taken;
   taken.centres = {Eigen::Vector3d::Zero()};
@@ -162,27 +162,73 @@ MaterialClusters ClusterMaterials(const std::vector<Eigen::Vector3d>& cell_ratio
     result.share[taken.label[i]] += 1.0 / double(points.size());
   }
   for (const Eigen::Vector3d& c : taken.centres) result.ratio.push_back(c.array().exp().matrix());
+
+  // A group whose centre is, within the blend tolerance, a mix of two others' (the cells of a smooth
+  // boundary between two materials) is their blend: the others are the materials.
+  result.blend_of.assign(result.count, {-1, -1});
+  for (int c = 0; c < result.count && result.count >= 3; ++c) {
+    double best = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < result.count; ++a) {
+      for (int b = a + 1; b < result.count; ++b) {
+        if (a == c || b == c) continue;
+        // The closest point of the segment between the two centres (linear ratios), by the largest
+        // channel difference of the logarithms, over a fine sweep of the mix.
+        for (int step = 1; step < 100; ++step) {
+          const double t = step / 100.0;
+          const Eigen::Vector3d mix = (1.0 - t) * result.ratio[a] + t * result.ratio[b];
+          const double d = (mix.array().log() - taken.centres[c].array()).abs().maxCoeff();
+          if (d < best) {
+            best = d;
+            if (d < log_blend) result.blend_of[c] = {a, b};
+          }
+        }
+      }
+    }
+  }
+  // Blends of blends are not materials either, but at least two materials remain.
+  int blends = 0;
+  for (const auto& pair : result.blend_of) blends += pair[0] >= 0;
+  if (result.count - blends < 2) result.blend_of.assign(result.count, {-1, -1});
+  result.materials = result.count;
+  for (const auto& pair : result.blend_of) result.materials -= pair[0] >= 0;
   return result;
+}
+
+bool MaterialClusters::IsBlend(int group) const {
+  return group >= 0 && size_t(group) < blend_of.size() && blend_of[group][0] >= 0;
 }
 
 std::string MaterialClusters::BriefReport() const {
   if (count == 0) return "cells not grouped: none scored in all three channels";
-  if (count == 1) return "the cells' ratios form one group";
-  std::string text = "the cells' ratios form " + std::to_string(count) + " groups (cells";
+  if (count == 1) return "the cells form one group";
+  std::string text = "the cells form " + std::to_string(count) + " groups (cells";
   for (int c = 0; c < count; ++c) text += (c ? " / " : " ") + Fixed(100.0 * share[c], 0);
-  text += " %; ratios";
+  text += " %; off-peak values";
   for (int c = 0; c < count; ++c) {
     text += (c ? ", " : " ") + Fixed(ratio[c][0], 2) + " " + Fixed(ratio[c][1], 2) + " " + Fixed(ratio[c][2], 2);
   }
-  return text + ")";
+  text += " of the median cell's)";
+  if (materials < count) {
+    text += ": " + std::to_string(materials) + " materials";
+    for (int c = 0; c < count; ++c) {
+      if (IsBlend(c)) {
+        text += ", group " + std::to_string(c) + " a blend of " + std::to_string(blend_of[c][0]) + " and " +
+                std::to_string(blend_of[c][1]);
+      }
+    }
+  }
+  return text;
 }
 
 nlohmann::json MaterialClusters::ToJson() const {
   nlohmann::json clusters = nlohmann::json::array();
   for (int c = 0; c < count; ++c) {
-    clusters.push_back({{"share", share[c]}, {"ratio", {ratio[c][0], ratio[c][1], ratio[c][2]}}});
+    nlohmann::json entry = {{"share", share[c]}, {"ratio", {ratio[c][0], ratio[c][1], ratio[c][2]}}};
+    if (IsBlend(c)) entry["blend_of"] = {blend_of[c][0], blend_of[c][1]};
+    clusters.push_back(entry);
   }
-  return {{"count", count}, {"clustered_cells", clustered}, {"clusters", clusters}, {"tried", tried}};
+  return {{"count", count},         {"materials", materials}, {"clustered_cells", clustered},
+          {"clusters", clusters}, {"tried", tried}};
 }
 
 }  // namespace ibrdf

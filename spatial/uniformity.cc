@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/file_util.h"
 #include "core/logging.h"
+#include "core/math.h"
 #include "core/statistics.h"
 #include "spatial/surface_points.h"
 
@@ -20,16 +21,6 @@ namespace ibrdf {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-
-// A cell's key: its integer grid coordinates, 21 bits each (a million cells along each axis).
-uint64_t CellKey(const Eigen::Vector3d& point, const Eigen::Vector3d& origin, double cell_m) {
-  uint64_t key = 0;
-  for (int a = 0; a < 3; ++a) {
-    const int64_t i = std::clamp<int64_t>(int64_t(std::floor((point[a] - origin[a]) / cell_m)), 0, (1 << 21) - 1);
-    key = (key << 21) | uint64_t(i);
-  }
-  return key;
-}
 
 // The key of the cell `2^shift` times larger that holds the cell `key` (the same grid origin).
 uint64_t CoarserKey(uint64_t key, int shift) {
@@ -63,6 +54,8 @@ struct Row {
   SurfaceLocator::Outcome outcome = SurfaceLocator::Outcome::kMissed;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   float ratio[3] = {kNaN, kNaN, kNaN};
+  float value[3] = {kNaN, kNaN, kNaN};  // the sample's own BRDF value where measured
+  float cos_h = 1.0f;                   // of the half vector's angle to the normal
   bool usable = false;
 };
 
@@ -72,9 +65,11 @@ Row Examine(const SurfaceLocator& locator, const BrdfModel& reference, const Brd
   if (row.outcome != SurfaceLocator::Outcome::kFound) return row;
   const Eigen::Vector3d wi(s.wi[0], s.wi[1], s.wi[2]), wo(s.wo[0], s.wo[1], s.wo[2]);
   const Eigen::Vector3d f = reference.Eval(wi, wo);
+  row.cos_h = float((wi + wo).normalized().z());
   for (int c = 0; c < 3; ++c) {
     if (!s.Valid(c) || !(f[c] > 0.0) || !std::isfinite(f[c])) continue;
     row.ratio[c] = float(s.brdf[c] / f[c]);
+    row.value[c] = s.brdf[c];
     row.usable = true;
   }
   return row;
@@ -108,6 +103,15 @@ nlohmann::json Vector(const Eigen::Vector3d& v) {
 
 }  // namespace
 
+uint64_t UniformityCellKey(const Eigen::Vector3d& point, const Eigen::Vector3d& origin, double cell_m) {
+  uint64_t key = 0;
+  for (int a = 0; a < 3; ++a) {
+    const int64_t i = std::clamp<int64_t>(int64_t(std::floor((point[a] - origin[a]) / cell_m)), 0, (1 << 21) - 1);
+    key = (key << 21) | uint64_t(i);
+  }
+  return key;
+}
+
 bool UniformityOptions::Check(std::string* why) const {
   if (!clusters.Check(why)) return false;
   if (!(cell_m >= 0.0)) {
@@ -130,6 +134,10 @@ bool UniformityOptions::Check(std::string* why) const {
     *why = "chunk rows must be positive";
     return false;
   }
+  if (!(cluster_min_theta_h_deg >= 0.0 && cluster_min_theta_h_deg < 80.0)) {
+    *why = "the clustering's theta_h limit must be in [0, 80) degrees";
+    return false;
+  }
   return true;
 }
 
@@ -149,6 +157,8 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
   struct Entry {
     uint32_t cell;
     float ratio[3];
+    float value[3];
+    float cos_h;
   };
   std::vector<Entry> entries;
   std::unordered_map<uint64_t, uint32_t> cell_of_key;
@@ -173,7 +183,7 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
     }
     ++result.located;
     const auto [it, inserted] =
-        cell_of_key.emplace(CellKey(row.point, origin, result.cell_m), uint32_t(point_sums.size()));
+        cell_of_key.emplace(UniformityCellKey(row.point, origin, result.cell_m), uint32_t(point_sums.size()));
     if (inserted) {
       point_sums.push_back(Eigen::Vector3d::Zero());
       located_in_cell.push_back(0);
@@ -185,7 +195,8 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
       ++result.no_reference;
       return;
     }
-    entries.push_back(Entry{it->second, {row.ratio[0], row.ratio[1], row.ratio[2]}});
+    entries.push_back(Entry{it->second, {row.ratio[0], row.ratio[1], row.ratio[2]},
+                            {row.value[0], row.value[1], row.value[2]}, row.cos_h});
     ++usable_per_photo[sample.image];  // Locate found it: a photo of the session
   });
 
@@ -225,11 +236,16 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
   for (const Entry& e : entries) ++begin[e.cell + 1];
   for (size_t c = 0; c < n_cells; ++c) begin[c + 1] += begin[c];
   std::vector<float> grouped(entries.size() * 3);
+  std::vector<float> off_peak_value(entries.size() * 3, kNaN);  // NaN but at theta_h >= cluster_min_theta_h_deg
   {
+    const float max_cos_h = float(std::cos(options.cluster_min_theta_h_deg * kDegree));
     std::vector<size_t> next(begin.begin(), begin.end() - 1);
     for (const Entry& e : entries) {
       const size_t at = next[e.cell]++;
       for (int k = 0; k < 3; ++k) grouped[at * 3 + k] = e.ratio[k];
+      if (e.cos_h <= max_cos_h) {
+        for (int k = 0; k < 3; ++k) off_peak_value[at * 3 + k] = e.value[k];
+      }
     }
   }
   entries = {};
@@ -254,6 +270,11 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
       const double mad = PercentileInPlace(&deviations, 0.5);
       out.ratio[k] = median;
       out.noise[k] = 1.4826 * mad * 1.2533 / std::sqrt(double(values.size()));
+      values.clear();
+      for (size_t i = begin[cell]; i < begin[cell + 1]; ++i) {
+        if (std::isfinite(off_peak_value[i * 3 + k])) values.push_back(off_peak_value[i * 3 + k]);
+      }
+      if (values.size() >= size_t(options.min_cell_samples)) out.off_peak_brdf[k] = PercentileInPlace(&values, 0.5);
     }
   });
 
@@ -296,11 +317,24 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
   result.deviating_fraction = result.cells_scored ? double(result.cells_deviating) / double(result.cells_scored) : 0.0;
 
   {
+    // Grouped by their BRDF values away from the peaks, relative to the median cell's: there a
+    // material's value hardly changes with the directions each cell saw (its diffuse part), while its
+    // ratio to the reconstructed average does (the average is another mix at each direction).
+    Eigen::Vector3d object_off_peak = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    for (int k = 0; k < 3; ++k) {
+      std::vector<double> values;
+      for (const UniformityCell& cell : result.cells) {
+        if (std::isfinite(cell.off_peak_brdf[k])) values.push_back(cell.off_peak_brdf[k]);
+      }
+      if (!values.empty()) object_off_peak[k] = Median(values);
+    }
     std::vector<Eigen::Vector3d> relative_ratio;
     for (const UniformityCell& cell : result.cells) {
-      relative_ratio.push_back(cell.ratio.cwiseQuotient(result.object_ratio));
+      relative_ratio.push_back(cell.off_peak_brdf.cwiseQuotient(object_off_peak));
     }
     result.materials = ClusterMaterials(relative_ratio, options.clusters);
+    result.cluster_min_theta_h_deg = options.cluster_min_theta_h_deg;
+    result.object_off_peak_brdf = object_off_peak;
   }
 
   result.map_photo = size_t(std::max_element(usable_per_photo.begin(), usable_per_photo.end()) - usable_per_photo.begin());
@@ -356,6 +390,7 @@ nlohmann::json UniformityResult::ToJson(bool with_cells) const {
       {"format", "ibrdf-uniformity"},
       {"version", 1},
       {"cell_m", cell_m},
+      {"grid_origin", Vector(grid_origin)},
       {"samples",
        {{"rows", samples},
         {"located", located},
@@ -370,6 +405,8 @@ nlohmann::json UniformityResult::ToJson(bool with_cells) const {
       {"cell_ratio_range", {min_ratio, max_ratio}},
       {"map_photo", map_photo},
       {"materials", materials.ToJson()},
+      {"cluster_min_theta_h_deg", cluster_min_theta_h_deg},
+      {"object_off_peak_brdf", Vector(object_off_peak_brdf)},
       {"verdicts", VerdictsToJson(verdicts)},
       {"timings_s", {{"total", seconds}}},
   };
@@ -377,11 +414,13 @@ nlohmann::json UniformityResult::ToJson(bool with_cells) const {
     nlohmann::json list = nlohmann::json::array();
     for (size_t c = 0; c < this->cells.size(); ++c) {
       const UniformityCell& cell = this->cells[c];
-      list.push_back({{"centre", Vector(cell.centre)},
+      list.push_back({{"key", cell.key},
+                      {"centre", Vector(cell.centre)},
                       {"material", c < materials.cell_label.size() ? materials.cell_label[c] : -1},
                       {"samples", cell.samples},
                       {"ratio", Vector(cell.ratio)},
                       {"noise", Vector(cell.noise)},
+                      {"off_peak_brdf", Vector(cell.off_peak_brdf)},
                       {"deviates", cell.deviates}});
     }
     value["cell_list"] = list;
@@ -419,7 +458,7 @@ Image UniformityMap(const Session& session, const std::string& samples_path, con
       if (s.image != result.map_photo) continue;
       Eigen::Vector3d point;
       if (locator.Locate(s, &point) != SurfaceLocator::Outcome::kFound) continue;
-      const auto it = cell_of_key.find(CellKey(point, result.grid_origin, result.cell_m));
+      const auto it = cell_of_key.find(UniformityCellKey(point, result.grid_origin, result.cell_m));
       if (it == cell_of_key.end()) continue;
       const UniformityCell& cell = result.cells[it->second];
       // The channel furthest from the object's ratio.

@@ -48,6 +48,9 @@ struct UniformityOptions {
   // How the cells are grouped into materials (reported, with each cell's label; the verdict is the
   // deviating cells' alone).
   MaterialClusterOptions clusters;
+  // The cells are grouped by the median BRDF value of their samples whose half vector is at least this
+  // far from the normal (degrees; 0: all samples): away from a glossy material's specular peak.
+  double cluster_min_theta_h_deg = 20.0;
 
   bool Check(std::string* why) const;
 };
@@ -57,6 +60,9 @@ struct UniformityCell {
   uint32_t samples = 0;                               // samples located in the cell
   Eigen::Vector3d ratio = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());  // NaN: not scored
   Eigen::Vector3d noise = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());  // of the ratio
+  // The median BRDF value of its samples away from the peaks (UniformityOptions::
+  // cluster_min_theta_h_deg), which the groups are formed from; NaN where too few.
+  Eigen::Vector3d off_peak_brdf = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   bool deviates = false;
   uint64_t key = 0;  // its grid coordinates (UniformityResult::grid_origin, cell_m), packed
 };
@@ -79,6 +85,9 @@ struct UniformityResult {
   Eigen::Vector3d spread = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   double max_ratio = 0.0, min_ratio = 0.0;  // over scored cells and channels, relative to the object's
   MaterialClusters materials;     // the cells grouped by their ratios (cells[i] has label materials.cell_label[i])
+  double cluster_min_theta_h_deg = 0.0;  // the samples they were grouped by (UniformityOptions)
+  // The median cell's off-peak BRDF value, per channel: the groups' centres are relative to it.
+  Eigen::Vector3d object_off_peak_brdf = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   std::vector<Verdict> verdicts;  // "uniformity.cells", "uniformity.located"
   size_t map_photo = 0;           // the session photo the map draws on (the one with most scored samples)
   double seconds = 0.0;
@@ -88,6 +97,11 @@ struct UniformityResult {
   // The summary (no per-cell list) and the verdicts, plus "cells" when `with_cells`.
   nlohmann::json ToJson(bool with_cells) const;
 };
+
+// The key of the cell that holds `point` in the grid of cells of edge `cell_m` from corner `origin`: its
+// integer grid coordinates, 21 bits each (a million cells along each axis), as UniformityCell::key and
+// uniformity.json's "key" hold them.
+uint64_t UniformityCellKey(const Eigen::Vector3d& point, const Eigen::Vector3d& origin, double cell_m);
 
 // Measures the session's samples (the file at `samples_path`) against `reference`, the BRDF
 // reconstructed from them. Throws Error naming the file for unreadable samples, and naming the session

@@ -79,6 +79,7 @@ const StageArgsKey kStageArgs[] = {{"scan_args", "--scan-args", &MeasurementOpti
                                    {"check_args", "--check-args", &MeasurementOptions::check_args},
                                    {"reconstruct_args", "--reconstruct-args", &MeasurementOptions::reconstruct_args},
                                    {"uniformity_args", "--uniformity-args", &MeasurementOptions::uniformity_args},
+                                   {"materials_args", "--materials-args", &MeasurementOptions::materials_args},
                                    {"report_args", "--report-args", &MeasurementOptions::report_args}};
 
 // Reads an "options" block on top of `options`.
@@ -90,6 +91,7 @@ void ReadOptions(JsonObject block, MeasurementOptions* options) {
   options->fits = block.Boolean("fits", options->fits);
   options->report = block.Boolean("report", options->report);
   options->check_regression = block.Boolean("check_regression", options->check_regression);
+  options->spatial = block.Boolean("spatial", options->spatial);
   for (const StageArgsKey& stage : kStageArgs) {
     if (!block.Has(stage.key)) continue;
     std::vector<std::string>& words = options->*stage.member;
@@ -212,6 +214,7 @@ std::vector<std::string> RunArguments(const BatchEntry& entry) {
   if (!o.fits) arguments.push_back("--no-fits");
   if (!o.report) arguments.push_back("--no-report");
   if (o.check_regression) arguments.push_back("--check-regression");
+  if (o.spatial) arguments.push_back("--spatial");
   for (const StageArgsKey& stage : kStageArgs) {
     const std::vector<std::string>& words = o.*stage.member;
     if (words.empty()) continue;

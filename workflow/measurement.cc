@@ -296,9 +296,33 @@ void Planner::SampleStages() {
                                 current, "--out", At("uniformity"), "--overwrite"},
                                {At("samples.npy"), At("samples.npy.json"), At("reconstruction/brdf.binary"), current},
                                {At("uniformity/uniformity.json"), At("uniformity/map.png")});
+  // Asked to measure each group, a sample that is not one material is what the materials stage
+  // handles: the failed check is accepted, and so recorded.
+  if (options_.spatial) uniformity.arguments.insert(uniformity.arguments.end(), {"--accept", "uniformity.cells"});
   uniformity.arguments.insert(uniformity.arguments.end(), options_.uniformity_args.begin(),
                               options_.uniformity_args.end());
   Execute(uniformity);
+
+  // Each group of cells as a material of its own, only when asked (a uniform object keeps one BRDF and
+  // its cost).
+  Stage materials = MakeStage("materials",
+                              {"materials", At("samples.npy"), "--uniformity", At("uniformity/uniformity.json"),
+                               "--session", current, "--out", At("materials"), "--overwrite"},
+                              {At("samples.npy"), At("samples.npy.json"), At("uniformity/uniformity.json"), current},
+                              {At("materials/materials.json")});
+  if (!options_.spatial) {
+    materials.not_applicable = "not asked (run --spatial measures each group of the uniformity check's cells)";
+  } else {
+    if (!truth_path.empty()) {
+      materials.arguments.insert(materials.arguments.end(), {"--truth", truth_path});
+      materials.inputs.push_back(truth_path);
+    }
+    if (!options_.fits) materials.arguments.push_back("--no-fits");
+    if (!material_name.empty()) materials.arguments.insert(materials.arguments.end(), {"--name", material_name});
+    materials.arguments.insert(materials.arguments.end(), options_.materials_args.begin(),
+                               options_.materials_args.end());
+  }
+  Execute(materials);
 
   Stage report = MakeStage("report", {"report", run_->run_dir(), "--out", At("report"), "--overwrite"}, {},
                            {At("report/index.html")});
@@ -309,6 +333,7 @@ void Planner::SampleStages() {
     report.inputs = {At("samples.npy"), At("samples.npy.json"), At("consistency.json"),
                      At("reconstruction/summary.json"), At("reconstruction/brdf.binary"),
                      At("uniformity/uniformity.json")};
+    if (options_.spatial) report.inputs.push_back(At("materials/materials.json"));
     if (!truth_path.empty() && !truth_spatially_varying) report.inputs.push_back(At("truth-comparison.json"));
     for (const Stage& stage : run_->stages()) {
       if (run_->outcome(stage.name).status != StageStatus::kNotApplicable) {
@@ -324,7 +349,7 @@ void Planner::SampleStages() {
 const std::vector<std::string>& MeasurementStageNames() {
   static const std::vector<std::string> kStages = {"synth",    "scan",  "response", "align",       "lights", "colour",
                                                    "derender", "check", "compare",  "reconstruct", "uniformity",
-                                                   "report"};
+                                                   "materials", "report"};
   return kStages;
 }
 
@@ -344,7 +369,7 @@ bool MeasurementOptions::Check(std::string* why) const {
   const std::vector<std::string>& stages = MeasurementStageNames();
   if (!stop_after.empty() && std::find(stages.begin(), stages.end(), stop_after) == stages.end()) {
     *why = "--stop-after: unknown stage \"" + stop_after +
-           "\" (synth, scan, response, align, lights, colour, derender, check, compare, reconstruct, uniformity, report)";
+           "\" (synth, scan, response, align, lights, colour, derender, check, compare, reconstruct, uniformity, materials, report)";
     return false;
   }
   return true;

@@ -1,5 +1,5 @@
 // The plan of a measurement: (synth, for a recipe) -> scan -> (response) -> align -> (lights) -> (colour) -> derender
-// -> check -> compare -> reconstruct -> uniformity -> report, each stage an `ibrdf` subcommand run through a launcher the caller
+// -> check -> compare -> reconstruct -> uniformity -> (materials) -> report, each stage an `ibrdf` subcommand run through a launcher the caller
 // gives (apps/run_command.cc: a child process of the same binary), with the inputs, outputs and applicability of
 // docs/workflow.md. Each stage is planned from the session the previous one wrote (core/session.h), never from raw
 // JSON.
@@ -27,6 +27,7 @@ struct MeasurementOptions {
   bool fits = true;               // reconstruct's Lafortune and GGX fits (--no-fits)
   bool check_regression = false;  // check --regression (slower: three held-out fits)
   bool report = true;             // the HTML report (--no-report)
+  bool spatial = false;           // each group of the uniformity check's cells measured as a material (--spatial)
   bool force = false;             // re-run every stage (--force)
   // check and compare run beside reconstruct (they only read the samples; their output is shown when
   // they end); false: one stage after another (--sequential).
@@ -34,9 +35,10 @@ struct MeasurementOptions {
   std::string stop_after;  // the last stage to run ("": all of them) (--stop-after)
   // Extra arguments appended to a stage's command line as given (--scan-args, --response-args,
   // --align-args, --lights-args, --colour-args, --derender-args, --check-args, --reconstruct-args,
-  // --uniformity-args, --report-args, and run's named pass-through options); part of the stage's stamp.
+  // --uniformity-args, --materials-args, --report-args, and run's named pass-through options); part of the
+  // stage's stamp.
   std::vector<std::string> scan_args, response_args, align_args, lights_args, colour_args;
-  std::vector<std::string> derender_args, check_args, reconstruct_args, uniformity_args, report_args;
+  std::vector<std::string> derender_args, check_args, reconstruct_args, uniformity_args, materials_args, report_args;
 
   // The messages name the flag: "--stride must be at least 1".
   bool Check(std::string* why) const;

@@ -106,6 +106,27 @@ void AddTruth(const fs::path& dir, const std::string& truth_path, nlohmann::json
   (*summary)["truth"] = truth;
 }
 
+// With --spatial: the groups measured as materials (materials/materials.json): per group its samples,
+// the folder of its reconstruction and, with a truth, its material and error; the labels' score.
+void AddMaterials(const fs::path& dir, nlohmann::json* summary) {
+  const std::optional<StageJson> m = StageJson::ReadIfExists((dir / "materials" / "materials.json").string());
+  if (!m) return;
+  nlohmann::json groups = nlohmann::json::array();
+  for (const nlohmann::json& g : m->ValueOr("/groups", nlohmann::json::array())) {
+    nlohmann::json entry = {{"samples", g.value("samples", 0)}, {"reconstructed", g.value("reconstructed", false)}};
+    if (g.contains("folder")) entry["folder"] = "materials/" + g["folder"].get<std::string>();
+    if (g.contains("truth_name")) entry["truth_name"] = g["truth_name"];
+    if (g.contains("error_against_truth")) {
+      entry["brdf_rel_rmse_all"] = g["error_against_truth"].value("rel_rms_error_all", nlohmann::json());
+    }
+    groups.push_back(entry);
+  }
+  nlohmann::json materials = {{"groups", groups}};
+  const nlohmann::json labels = m->ValueOr("/labels", nlohmann::json());
+  if (labels.is_object()) materials["labels_right_fraction"] = labels.value("right_fraction", nlohmann::json());
+  (*summary)["materials"] = materials;
+}
+
 // The calibration stages' and the uniformity check's verdicts (response/response.json,
 // align/alignment.json, lights/white-reference.json, colour/colour.json and uniformity/uniformity.json
 // "verdicts", core/verdict.h), each with its stage, and every stage's warnings in one list: the
@@ -191,6 +212,7 @@ nlohmann::json BuildRunSummary(const WorkflowRun& run, const std::string& input,
   AddReconstruction(dir, &summary);
   AddTruth(dir, truth_path, &summary);
   AddVerdicts(dir, &summary);
+  AddMaterials(dir, &summary);
   const std::string report = (dir / "report" / "index.html").string();
   if (fs::exists(report)) summary["report"] = report;
   return summary;

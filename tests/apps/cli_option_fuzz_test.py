@@ -145,6 +145,8 @@ BASE = {
     ("reconstruct",): (["--no-fits", "--no-bsdf"], ["r/samples.npy", "--out", "OUT"]),
     ("check",): ([], ["r/samples.npy", "--out", "OUT.json"]),
     ("uniformity",): ([], ["r/samples.npy", "--brdf", "r/reconstruction/brdf.binary", "--out", "OUT"]),
+    ("materials",): (["--no-fits", "--no-bsdf"],
+                     ["r/samples.npy", "--uniformity", "r/uniformity/uniformity.json", "--out", "OUT"]),
     ("report",): (["--render-size-px", "32", "--no-explorer"], ["r", "--out", "OUT", "--held-out", "0"]),
     ("run",): (["--no-report", "--no-fits", "--stride", "2"], ["s", "--out", "OUT"]),
     ("batch",): (["-n"], ["b.json"]),

@@ -1,6 +1,6 @@
 // The uniformity cells grouped into materials: clusters of known ratios are found with their cells, a
 // uniform scatter and materials closer than the separation give one, a cluster of too few cells is not
-// counted; on a synthetic sphere of three materials in six sharp stripes the cells' labels match the
+// counted, a mix of two is their blend; on a synthetic sphere of three materials in six sharp stripes the cells' labels match the
 // map's away from the boundaries.
 #include "spatial/material_clusters.h"
 
@@ -64,11 +64,36 @@ TEST(MaterialClusters, ThreeMaterialsAreFoundWithTheirCells) {
   EXPECT_NE(clusters.BriefReport().find("form 3 groups"), std::string::npos) << clusters.BriefReport();
 }
 
+// Three materials and the cells of a smooth boundary between two of them (their values halfway): four
+// groups, of which the halfway one is named their blend, and three materials.
+TEST(MaterialClusters, ABoundarysMixIsABlendNotAMaterial) {
+  std::vector<int> truth;
+  const Eigen::Vector3d a(3.0, 1.0, 0.3), b(0.3, 1.0, 3.0), dark(0.2, 0.2, 0.2);
+  const std::vector<Eigen::Vector3d> cells =
+      Scatter({a, b, dark, 0.5 * (a + b)}, {300, 300, 300, 100}, 0.03, &truth);
+  const MaterialClusters clusters = ClusterMaterials(cells, MaterialClusterOptions());
+  ASSERT_EQ(clusters.count, 4) << clusters.BriefReport();
+  EXPECT_EQ(clusters.materials, 3) << clusters.BriefReport();
+  const int mix = clusters.cell_label.back(), of_a = clusters.cell_label.front(), of_b = clusters.cell_label[300];
+  EXPECT_TRUE(clusters.IsBlend(mix));
+  EXPECT_FALSE(clusters.IsBlend(of_a));
+  EXPECT_FALSE(clusters.IsBlend(clusters.cell_label[600]));
+  EXPECT_EQ(std::min(clusters.blend_of[mix][0], clusters.blend_of[mix][1]), std::min(of_a, of_b));
+  EXPECT_EQ(std::max(clusters.blend_of[mix][0], clusters.blend_of[mix][1]), std::max(of_a, of_b));
+  EXPECT_NE(clusters.BriefReport().find("3 materials, group " + std::to_string(mix) + " a blend"), std::string::npos)
+      << clusters.BriefReport();
+  // Two materials and their mix: the mix is their blend too (two materials remain).
+  truth.clear();
+  const MaterialClusters two = ClusterMaterials(Scatter({a, b, 0.5 * (a + b)}, {300, 300, 300}, 0.03, &truth), {});
+  ASSERT_EQ(two.count, 3) << two.BriefReport();
+  EXPECT_EQ(two.materials, 2) << two.BriefReport();
+}
+
 TEST(MaterialClusters, OneMaterialCloseMaterialsAndATinyPatchGiveOne) {
   std::vector<int> truth;
   EXPECT_EQ(ClusterMaterials(Scatter({{1.0, 1.0, 1.0}}, {1000}, 0.05, &truth), {}).count, 1);
   truth.clear();
-  // 1.15x apart in red only: under the 1.25x separation.
+  // 1.15x apart in red only: under the 1.6x separation.
   EXPECT_EQ(ClusterMaterials(Scatter({{1.0, 1.0, 1.0}, {1.15, 1.0, 1.0}}, {500, 500}, 0.01, &truth), {}).count, 1);
   truth.clear();
   // 2x apart but 2 % of the cells: under the 5 % share.

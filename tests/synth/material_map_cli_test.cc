@@ -1,9 +1,12 @@
 // `ibrdf synth --material-map FILE` on the command line: the map replaces --material, truth.json keeps
 // the map (materials embedded), a bad map is refused naming its file and field, and the tools that
-// compare with one true material say that this truth has none.
+// compare with one true material say that this truth has none; `run --spatial` measures each group of
+// the map's recipe as a material of its own.
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <set>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -175,6 +178,28 @@ TEST(SynthMaterialMapCli, RecipeWithAMapStopsAtUniformityAndRunsWhenAccepted) {
     if (verdict.value("check", "") == "uniformity.cells") recorded = verdict.value("accepted", false);
   }
   EXPECT_TRUE(recorded) << summary.at("verdicts").dump(2);
+  EXPECT_EQ(summary.at("stages").at("materials").at("status"), "not_applicable");
+
+  // --spatial: the groups measured as materials, scored against the map. At 160 x 120 and stride 2
+  // the felt's group holds under the default 1000 samples a group needs: 500 here.
+  const auto spatial = RunIbrdf(run_line + " --spatial --materials-args \"--min-group-samples 500\"", /*quiet=*/true);
+  ASSERT_EQ(spatial.exit_code, 0) << spatial.output;
+  const nlohmann::json with = ReadJsonFile(dir / "r/summary.json");
+  EXPECT_EQ(with.at("stages").at("materials").at("status"), "ran");
+  const nlohmann::json materials = ReadJsonFile(dir / "r/materials/materials.json");
+  ASSERT_EQ(materials.at("groups").size(), 2u) << materials.dump(2);
+  EXPECT_EQ(materials.at("truth"), "map");
+  // Labels on this small capture (the squash's 98 % bound is for 800 x 600, docs/spatial.md).
+  EXPECT_GE(materials.at("labels").at("right_fraction").get<double>(), 0.85) << materials.dump(2);
+  std::set<std::string> names;
+  for (const nlohmann::json& group : materials.at("groups")) {
+    ASSERT_TRUE(group.at("reconstructed").get<bool>()) << group.dump(2);
+    EXPECT_TRUE(fs::exists(dir / ("r/materials/" + group.at("folder").get<std::string>() + "/brdf.binary")));
+    names.insert(group.at("truth_name").get<std::string>());
+  }
+  EXPECT_EQ(names.size(), 2u) << materials.dump(2);
+  EXPECT_EQ(with.at("materials").at("groups").size(), 2u);
+  EXPECT_NE(spatial.output.find("labels right on"), std::string::npos) << spatial.output;
 }
 
 }  // namespace

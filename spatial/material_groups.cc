@@ -1,0 +1,433 @@
+#include "spatial/material_groups.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <unordered_map>
+
+#include <tbb/parallel_for.h>
+#include <nanoflann.hpp>
+
+#include "core/error.h"
+#include "core/file_util.h"
+#include "core/json_reader.h"
+#include "core/logging.h"
+#include "core/math.h"
+#include "core/sample_file.h"
+#include "spatial/surface_points.h"
+#include "spatial/uniformity.h"
+#include "synth/material_map.h"
+
+namespace ibrdf {
+namespace {
+
+// The grid and labels of uniformity.json: cell key -> group.
+struct GroupedCells {
+  double cell_m = 0.0;
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  int groups = 0;
+  std::vector<std::array<int, 2>> blend_of;  // per group ({-1, -1}: a material)
+  std::vector<Eigen::Vector3d> log_centre;   // per group: log of its off-peak value (absolute)
+  double max_cos_h = 1.0;                    // samples at theta_h beyond the clustering's limit are off-peak
+  std::unordered_map<uint64_t, int> group_of_key;
+};
+
+// The off-peak samples' surface points and groups, searched for each sample's nearest.
+struct OffPeakCloud {
+  std::vector<Eigen::Vector3f> points;
+  std::vector<int8_t> group;
+  size_t kdtree_get_point_count() const { return points.size(); }
+  float kdtree_get_pt(size_t index, size_t dim) const { return points[index][int(dim)]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+using OffPeakTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, OffPeakCloud>, OffPeakCloud, 3, uint32_t>;
+
+// Every string of `value` equal to `from` becomes `to`.
+void ReplaceString(nlohmann::json* value, const std::string& from, const std::string& to) {
+  if (value->is_string()) {
+    if (value->get<std::string>() == from) *value = to;
+  } else if (value->is_structured()) {
+    for (nlohmann::json& item : *value) ReplaceString(&item, from, to);
+  }
+}
+
+constexpr int kOnPeak = -1;  // OffPeakGroup: no off-peak value (or a channel not measured)
+constexpr int kMixed = -2;   // a value beyond `purity` of every group's centre: a mix of materials
+
+// The group whose off-peak value is nearest the sample's (in logarithms), kMixed when that is further
+// than `log_purity` in some channel, kOnPeak for a sample on the peak or with a channel not measured or
+// not positive.
+int OffPeakGroup(const BrdfSample& s, const GroupedCells& cells, double log_purity) {
+  const Eigen::Vector3d wi(s.wi[0], s.wi[1], s.wi[2]), wo(s.wo[0], s.wo[1], s.wo[2]);
+  if (!((wi + wo).normalized().z() <= cells.max_cos_h)) return kOnPeak;
+  Eigen::Vector3d value;
+  for (int k = 0; k < 3; ++k) {
+    if (!s.Valid(k) || !(s.brdf[k] > 0.0f)) return kOnPeak;
+    value[k] = std::log(double(s.brdf[k]));
+  }
+  int best = -1;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (size_t g = 0; g < cells.log_centre.size(); ++g) {
+    const double d = (value - cells.log_centre[g]).squaredNorm();
+    if (d < best_d) {
+      best_d = d;
+      best = int(g);
+    }
+  }
+  if (best >= 0 && (value - cells.log_centre[best]).cwiseAbs().maxCoeff() > log_purity) return kMixed;
+  return best;
+}
+
+GroupedCells ReadGroupedCells(const nlohmann::json& uniformity, const std::string& path) {
+  GroupedCells cells;
+  if (!uniformity.contains("cell_m") || !uniformity["cell_m"].is_number() ||
+      !(uniformity["cell_m"].get<double>() > 0)) {
+    ThrowError(path, "has no positive \"cell_m\" (not a uniformity.json of `ibrdf uniformity`)");
+  }
+  cells.cell_m = uniformity["cell_m"].get<double>();
+  const nlohmann::json* origin = uniformity.contains("grid_origin") ? &uniformity["grid_origin"] : nullptr;
+  if (!origin || !origin->is_array() || origin->size() != 3 || !(*origin)[0].is_number() || !(*origin)[1].is_number() ||
+      !(*origin)[2].is_number()) {
+    ThrowError(path, "has no \"grid_origin\" [x, y, z]: written by an older ibrdf; run `ibrdf uniformity` again");
+  }
+  for (int a = 0; a < 3; ++a) cells.origin[a] = (*origin)[a].get<double>();
+  if (!uniformity.contains("materials") || !uniformity["materials"].contains("count") ||
+      !uniformity["materials"]["count"].is_number_integer()) {
+    ThrowError(path, "has no \"materials\".\"count\"");
+  }
+  cells.groups = uniformity["materials"]["count"].get<int>();
+  cells.blend_of.assign(std::max(cells.groups, 0), {-1, -1});
+  const nlohmann::json clusters = uniformity["materials"].value("clusters", nlohmann::json::array());
+  const nlohmann::json object = uniformity.value("object_off_peak_brdf", nlohmann::json());
+  const auto finite_triple = [](const nlohmann::json& v) {
+    return v.is_array() && v.size() == 3 && v[0].is_number() && v[1].is_number() && v[2].is_number();
+  };
+  if (cells.groups > 1 && (!finite_triple(object) || clusters.size() != size_t(cells.groups) ||
+                           !uniformity.contains("cluster_min_theta_h_deg"))) {
+    ThrowError(path,
+               "has no \"object_off_peak_brdf\", \"cluster_min_theta_h_deg\" or a centre per group: written "
+               "by an older ibrdf; run `ibrdf uniformity` again");
+  }
+  if (uniformity.contains("cluster_min_theta_h_deg") && uniformity["cluster_min_theta_h_deg"].is_number()) {
+    cells.max_cos_h = std::cos(uniformity["cluster_min_theta_h_deg"].get<double>() * kDegree);
+  }
+  for (size_t g = 0; g < clusters.size() && g < cells.blend_of.size(); ++g) {
+    const nlohmann::json centre = clusters[g].value("ratio", nlohmann::json());
+    if (finite_triple(object) && finite_triple(centre)) {
+      Eigen::Vector3d c;
+      for (int k = 0; k < 3; ++k) c[k] = std::log(centre[k].get<double>() * object[k].get<double>());
+      cells.log_centre.push_back(c);
+    }
+    const nlohmann::json& pair = clusters[g].contains("blend_of") ? clusters[g]["blend_of"] : nlohmann::json();
+    if (pair.is_array() && pair.size() == 2 && pair[0].is_number_integer() && pair[1].is_number_integer()) {
+      cells.blend_of[g] = {pair[0].get<int>(), pair[1].get<int>()};
+    }
+  }
+  if (!uniformity.contains("cell_list") || !uniformity["cell_list"].is_array()) {
+    ThrowError(path, "has no \"cell_list\" (written without its cells)");
+  }
+  for (const nlohmann::json& cell : uniformity["cell_list"]) {
+    if (!cell.contains("key") || !cell["key"].is_number_unsigned() || !cell.contains("material") ||
+        !cell["material"].is_number_integer()) {
+      ThrowError(path, "a cell of \"cell_list\" has no \"key\" or \"material\": run `ibrdf uniformity` again");
+    }
+    const int group = cell["material"].get<int>();
+    if (group >= cells.groups) ThrowError(path, "a cell's material " + std::to_string(group) + " is not a group");
+    if (group >= 0) cells.group_of_key.emplace(cell["key"].get<uint64_t>(), group);
+  }
+  return cells;
+}
+
+// Where one sample lies: its group (-1 none, -2 not located), and with a map its true material at
+// the point (-1 within the margin of a boundary).
+constexpr int kNotLocated = -2, kMixedSample = -3;
+struct Placed {
+  int group = kNotLocated;  // or -1: no group, kMixedSample: on a boundary or a blend
+  int truth = -1;
+};
+
+// Pass 1 of the split: the off-peak samples' points and nearest groups.
+struct OffPeakSample {
+  Eigen::Vector3f point;
+  int group = kOnPeak;
+};
+
+}  // namespace
+
+bool MaterialGroupsOptions::Check(std::string* why) const {
+  if (!reconstruct.Check(why)) return false;
+  if (!(boundary_margin_m >= 0.0)) {
+    *why = "the boundary margin must be at least 0";
+    return false;
+  }
+  if (chunk_rows == 0) {
+    *why = "chunk rows must be positive";
+    return false;
+  }
+  if (!(purity > 0.0)) {
+    *why = "the purity must be positive";
+    return false;
+  }
+  if (neighbours < 1 || neighbours > 64) {
+    *why = "neighbours must be 1 to 64";
+    return false;
+  }
+  return true;
+}
+
+MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::string& samples_path,
+                                           const nlohmann::json& uniformity, const std::string& uniformity_path,
+                                           const MaterialMap* truth_map, const std::string& truth_file,
+                                           const MaterialGroupsOptions& options, const std::string& out_dir) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("material groups options", why);
+  if (truth_map && !truth_file.empty()) ThrowError(truth_file, "a map truth and a material truth together");
+  const auto start = std::chrono::steady_clock::now();
+  const GroupedCells cells = ReadGroupedCells(uniformity, uniformity_path);
+  const SurfaceLocator locator(session);
+  MaterialGroupsResult result;
+  result.truth_kind = truth_map ? "map" : truth_file.empty() ? "" : "material";
+  const size_t n_truth = truth_map ? truth_map->NumMaterials() : 0;
+  for (size_t k = 0; k < n_truth; ++k) result.truth_materials.push_back(truth_map->Name(k));
+  result.confusion.assign(std::max(cells.groups, 0), std::vector<uint64_t>(n_truth, 0));
+  std::vector<std::vector<BrdfSample>> grouped(std::max(cells.groups, 0));
+
+  // One group: the object's own reconstruction is the group's; the samples are only counted.
+  const bool split = cells.groups > 1;
+  // Pass 1 (with groups): each off-peak sample's point and the group its own value is nearest. The
+  // cells' groups are the cells' majority; a cell on a sharp boundary holds two materials, so each
+  // sample takes the group most of its nearest off-peak samples (of any photo) carry instead.
+  OffPeakCloud cloud;
+  std::vector<OffPeakSample> off_peak;
+  const double log_purity = std::log1p(options.purity);
+  if (split) {
+    ForEachSampleChunk(samples_path, options.chunk_rows, [&](const BrdfSample* rows, size_t count, uint64_t) {
+      off_peak.assign(count, OffPeakSample{});
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 4096), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t i = range.begin(); i < range.end(); ++i) {
+          const int group = OffPeakGroup(rows[i], cells, log_purity);
+          if (group == kOnPeak) continue;
+          Eigen::Vector3d point;
+          if (locator.Locate(rows[i], &point) != SurfaceLocator::Outcome::kFound) continue;
+          off_peak[i] = OffPeakSample{point.cast<float>(), group};
+        }
+      });
+      for (const OffPeakSample& o : off_peak) {
+        if (o.group == kOnPeak) continue;
+        cloud.points.push_back(o.point);
+        cloud.group.push_back(int8_t(o.group));
+      }
+    });
+    result.off_peak_samples = cloud.points.size();
+  }
+  OffPeakTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  if (!cloud.points.empty()) tree.buildIndex();
+  const int k_nearest = std::min<int>(options.neighbours, int(cloud.points.size()));
+  const float max_distance_sq = float(cells.cell_m * cells.cell_m);
+
+  std::vector<Placed> placed;
+  result.samples =
+      ForEachSampleChunk(samples_path, options.chunk_rows, [&](const BrdfSample* rows, size_t count, uint64_t) {
+        placed.assign(count, Placed{});
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 4096), [&](const tbb::blocked_range<size_t>& range) {
+          std::vector<uint32_t> index(std::max(k_nearest, 1));
+          std::vector<float> distance_sq(std::max(k_nearest, 1));
+          std::vector<int> votes(std::max(cells.groups, 1) + 1);  // the last: mixed
+          for (size_t i = range.begin(); i < range.end(); ++i) {
+            Eigen::Vector3d point;
+            if (locator.Locate(rows[i], &point) != SurfaceLocator::Outcome::kFound) continue;
+            const auto it = cells.group_of_key.find(UniformityCellKey(point, cells.origin, cells.cell_m));
+            placed[i].group = it == cells.group_of_key.end() ? -1 : it->second;
+            if (k_nearest > 0) {
+              const Eigen::Vector3f query = point.cast<float>();
+              const size_t found = tree.knnSearch(query.data(), size_t(k_nearest), index.data(), distance_sq.data());
+              std::fill(votes.begin(), votes.end(), 0);
+              int near = 0;
+              for (size_t j = 0; j < found; ++j) {
+                if (distance_sq[j] > max_distance_sq) continue;
+                const int group = cloud.group[index[j]];
+                ++votes[group == kMixed ? cells.groups : group];
+                ++near;
+              }
+              // Within a cell's edge of the point: the neighbours' majority, unless most of them are mixes or
+              // another group has a vote (a boundary or a blend: the sample belongs to no one basis); with
+              // no neighbours so near, the cell's group.
+              if (near > 0) {
+                const int most = int(std::max_element(votes.begin(), votes.end() - 1) - votes.begin());
+                const int mixed = votes.back(), others = near - mixed - votes[most];
+                placed[i].group = 2 * mixed >= near || others > 0 ? kMixedSample : most;
+              }
+            }
+            if (truth_map && truth_map->BoundaryDistance(point) >= options.boundary_margin_m) {
+              placed[i].truth = truth_map->Label(point);
+            }
+          }
+        });
+        for (size_t i = 0; i < count; ++i) {
+          const Placed& p = placed[i];
+          if (p.group == kNotLocated) {
+            ++result.not_located;
+            continue;
+          }
+          if (p.group == kMixedSample) {
+            ++result.mixed;
+            if (p.truth >= 0) ++result.mixed_scored;
+            continue;
+          }
+          if (p.group < 0) {
+            ++result.ungrouped;
+            continue;
+          }
+          if (split) grouped[p.group].push_back(rows[i]);
+          if (p.truth >= 0) ++result.confusion[p.group][p.truth];
+        }
+      });
+
+  result.groups.resize(grouped.size());
+  for (size_t g = 0; g < grouped.size(); ++g) {
+    MaterialGroup& group = result.groups[g];
+    group.samples = split ? grouped[g].size() : result.samples - result.not_located - result.ungrouped;
+    group.blend_of = cells.blend_of[g];
+    if (n_truth > 0) {
+      const std::vector<uint64_t>& row = result.confusion[g];
+      const auto most = std::max_element(row.begin(), row.end());
+      if (*most > 0) {
+        group.truth_material = int(most - row.begin());
+        group.truth_name = truth_map->Name(group.truth_material);
+        // A blend's samples away from the truth's boundaries are one material each, not a blend.
+        if (group.blend_of[0] < 0) result.labels_right += double(*most);
+      }
+      for (uint64_t n : row) result.scored += n;
+    }
+  }
+  // A sample away from the truth's boundaries that was called a mix is one material: not right.
+  result.scored += result.mixed_scored;
+  if (result.scored > 0) result.labels_right /= double(result.scored);
+
+  for (size_t g = 0; split && g < grouped.size(); ++g) {
+    MaterialGroup& group = result.groups[g];
+    if (group.blend_of[0] >= 0) {
+      Log(1, "materials: group " + std::to_string(g) + " not reconstructed: a blend of groups " +
+                 std::to_string(group.blend_of[0]) + " and " + std::to_string(group.blend_of[1]) + " (" +
+                 std::to_string(group.samples) + " samples)");
+      continue;
+    }
+    if (group.samples < options.min_group_samples) {
+      Log(1, "materials: group " + std::to_string(g) + " not reconstructed: " + std::to_string(group.samples) +
+                 " samples, under " + std::to_string(options.min_group_samples));
+      continue;
+    }
+    ReconstructOptions reconstruct = options.reconstruct;
+    reconstruct.overwrite = false;
+    reconstruct.name = (options.reconstruct.name.empty() ? std::string("material") : options.reconstruct.name) +
+                       "-group-" + std::to_string(g);
+    const std::filesystem::path folder = std::filesystem::path(out_dir) / ("group-" + std::to_string(g));
+    if (group.truth_material >= 0) {
+      // The group is scored against the material most of its samples carry, written beside it.
+      const std::filesystem::path truth =
+          std::filesystem::path(out_dir) / ("group-" + std::to_string(g) + "-truth.json");
+      WriteJsonFile(truth.string(), truth_map->Material(group.truth_material).ToJson());
+      reconstruct.truth_file = truth.string();
+    } else {
+      reconstruct.truth_file = truth_file;
+    }
+    Log(1, "materials: group " + std::to_string(g) + ": " + std::to_string(group.samples) + " samples" +
+               (group.truth_name.empty() ? "" : " (mostly " + group.truth_name + ")"));
+    group.reconstruction = Reconstruct(grouped[g], reconstruct, folder.string(), samples_path);
+    if (group.truth_material >= 0) {
+      // The truth beside the group is named as the output folder will hold it (out_dir may be a
+      // temporary name until committed).
+      const std::string summary = (folder / "summary.json").string();
+      nlohmann::json written = ReadJsonFile(summary);
+      ReplaceString(&written, reconstruct.truth_file,
+                    "../" + std::filesystem::path(reconstruct.truth_file).filename().string());
+      WriteJsonFile(summary, written);
+    }
+    std::vector<BrdfSample>().swap(grouped[g]);
+    group.reconstructed = true;
+    group.folder = folder.filename().string();
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+std::string MaterialGroupsResult::BriefReport() const {
+  const uint64_t grouped = samples - not_located - ungrouped - mixed;
+  std::string text = "materials: " + std::to_string(groups.size()) + (groups.size() == 1 ? " group" : " groups");
+  if (groups.size() > 1) {
+    text += " (";
+    for (size_t g = 0; g < groups.size(); ++g) {
+      text += (g ? " / " : "") + Fixed(grouped ? 100.0 * double(groups[g].samples) / double(grouped) : 0.0, 0);
+    }
+    text += " % of " + std::to_string(grouped) + " grouped samples)";
+  } else {
+    text += ": one material, measured as reconstruction/ (not reconstructed again)";
+  }
+  text += "; " + std::to_string(mixed) + " samples on a boundary or blend (no basis), " + std::to_string(ungrouped) +
+          " in no group, " + std::to_string(not_located) + " not located";
+  if (truth_kind == "map" && scored > 0) {
+    text += "; labels right on " + Fixed(100.0 * labels_right, 1) + " % of " + std::to_string(scored) +
+            " samples away from the truth's boundaries";
+  }
+  for (size_t g = 0; g < groups.size(); ++g) {
+    const MaterialGroup& group = groups[g];
+    if (group.blend_of[0] >= 0) {
+      text += "; group " + std::to_string(g) + " a blend of " + std::to_string(group.blend_of[0]) + " and " +
+              std::to_string(group.blend_of[1]);
+    }
+    if (!group.reconstructed || !group.reconstruction.scored) continue;
+    text += "; group " + std::to_string(g) + (group.truth_name.empty() ? "" : " (" + group.truth_name + ")") +
+            " table rel. RMS " + Fixed(100.0 * group.reconstruction.error_against_truth.rel_rms_all, 1) + " %";
+  }
+  return text + "; " + Fixed(seconds, 1) + " s";
+}
+
+nlohmann::json MaterialGroupsResult::ToJson() const {
+  nlohmann::json list = nlohmann::json::array();
+  for (size_t g = 0; g < groups.size(); ++g) {
+    const MaterialGroup& group = groups[g];
+    nlohmann::json entry = {{"group", g}, {"samples", group.samples}, {"reconstructed", group.reconstructed}};
+    if (group.blend_of[0] >= 0) entry["blend_of"] = {group.blend_of[0], group.blend_of[1]};
+    if (group.reconstructed) {
+      entry["folder"] = group.folder;
+      entry["summary"] = group.folder + "/summary.json";
+      entry["chosen_model"] = group.reconstruction.chosen_model;
+      if (group.reconstruction.scored) {
+        entry["error_against_truth"] = ibrdf::ToJson(group.reconstruction.error_against_truth);
+      }
+    }
+    if (group.truth_material >= 0) {
+      entry["truth_material"] = group.truth_material;
+      entry["truth_name"] = group.truth_name;
+    }
+    list.push_back(entry);
+  }
+  nlohmann::json value = {{"format", "ibrdf-materials"},
+                          {"version", 1},
+                          {"samples",
+                           {{"rows", samples},
+                            {"not_located", not_located},
+                            {"off_peak", off_peak_samples},
+                            {"mixed", mixed},
+                            {"mixed_away_from_boundaries", mixed_scored},
+                            {"ungrouped", ungrouped}}},
+                          {"groups", list},
+                          {"truth", truth_kind.empty() ? nlohmann::json(nullptr) : nlohmann::json(truth_kind)},
+                          {"timings_s", {{"total", seconds}}}};
+  if (truth_kind == "map") {
+    value["labels"] = {{"truth_materials", truth_materials},
+                       {"confusion_groups_by_materials", confusion},
+                       {"scored_samples", scored},
+                       {"right_fraction", labels_right}};
+  }
+  return value;
+}
+
+}  // namespace ibrdf

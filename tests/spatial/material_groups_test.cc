@@ -1,0 +1,124 @@
+// The uniformity check's groups measured as materials: on a synthetic sphere of two materials in four
+// sharp stripes the samples are split by their nearest off-peak samples' groups (those on a boundary
+// by neither), each group matches one material of the map on the samples away from its boundaries and
+// is reconstructed close to it; a uniform sphere gives
+// one group and no second reconstruction; a uniformity.json without its grid is refused by name.
+#include "spatial/material_groups.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "core/sample_file.h"
+#include "derender/derenderer.h"
+#include "spatial/uniformity.h"
+#include "synth/material_map.h"
+#include "synth/synthetic.h"
+#include "tests/test_util.h"
+
+namespace ibrdf {
+namespace {
+
+using testing::ScratchDir;
+
+SynthOptions Small() {
+  SynthOptions options;
+  options.rig.width = 320;
+  options.rig.height = 240;
+  options.rig.num_photos = 6;
+  return options;
+}
+
+MaterialGroupsOptions Quick() {
+  MaterialGroupsOptions options;
+  options.reconstruct.fits = false;
+  options.reconstruct.bsdf = false;
+  return options;
+}
+
+const std::vector<std::shared_ptr<const BrdfModel>> kMaterials = {
+    std::make_shared<LambertianBrdf>(Eigen::Vector3d(0.6, 0.25, 0.1)),
+    std::make_shared<LambertianBrdf>(Eigen::Vector3d(0.1, 0.25, 0.6))};
+
+TEST(MaterialGroups, TwoMaterialsAreSplitLabelledAndReconstructedEach) {
+  ScratchDir dir;
+  const SynthOptions synth = Small();
+  const MaterialMap map({"red", "blue"}, kMaterials, synth.scene.origin, Eigen::Vector3d::UnitZ(), {0, 1, 0, 1},
+                        std::vector<double>(4, 0.0), "test map");
+  WriteSyntheticSession(synth, map, "test map", dir / "session", /*overwrite=*/true);
+  const Session session = Session::Load(dir / "session/session.json");
+  const std::vector<BrdfSample> samples = DerenderAnalytic(session, DerenderOptions()).samples;
+  WriteSamples(dir / "samples.npy", samples);
+  UniformityOptions uniformity;
+  uniformity.cell_m = session.sample.radius / 8.0;
+  const LambertianBrdf average(Eigen::Vector3d(0.35, 0.25, 0.35));
+  const UniformityResult cells = MeasureUniformity(session, dir / "samples.npy", average, uniformity);
+  ASSERT_EQ(cells.materials.count, 2) << cells.materials.BriefReport();
+
+  std::filesystem::create_directories(dir / "out");
+  const MaterialGroupsResult result = MeasureMaterialGroups(session, dir / "samples.npy", cells.ToJson(true),
+                                                            "uniformity.json", &map, "", Quick(), dir / "out");
+  ASSERT_EQ(result.groups.size(), 2u) << result.BriefReport();
+  EXPECT_EQ(result.samples, samples.size());
+  EXPECT_EQ(result.not_located, 0u);
+  // Every located sample in a cell the check grouped, but for cells not scored in all channels.
+  EXPECT_LT(double(result.ungrouped), 0.05 * double(result.samples)) << result.BriefReport();
+  EXPECT_EQ(result.groups[0].samples + result.groups[1].samples + result.ungrouped + result.mixed, result.samples);
+  // The samples on a sharp boundary (their neighbours of both groups) go into neither basis: a few
+  // percent, and hardly any of them away from the boundaries.
+  EXPECT_GT(result.mixed, 0u);
+  EXPECT_LT(double(result.mixed), 0.1 * double(result.samples)) << result.BriefReport();
+  EXPECT_LT(double(result.mixed_scored), 0.01 * double(result.scored)) << result.BriefReport();
+  EXPECT_GT(result.off_peak_samples, samples.size() / 2);
+  EXPECT_GT(result.scored, samples.size() / 2);
+  EXPECT_GE(result.labels_right, 0.98) << result.BriefReport();
+  EXPECT_NE(result.groups[0].truth_material, result.groups[1].truth_material);
+  for (const MaterialGroup& group : result.groups) {
+    ASSERT_TRUE(group.reconstructed);
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir / "out") / group.folder / "brdf.binary"))
+        << group.folder;
+    ASSERT_TRUE(group.reconstruction.scored);
+    // The one-material average is off by about 2x in red or blue; each group's own table is close.
+    EXPECT_LT(group.reconstruction.error_against_truth.rel_rms_all, 0.05)
+        << group.truth_name << ": " << group.reconstruction.error_against_truth.Brief();
+  }
+  const nlohmann::json json = result.ToJson();
+  EXPECT_EQ(json["labels"]["confusion_groups_by_materials"].size(), 2u);
+  EXPECT_NE(result.BriefReport().find("labels right on"), std::string::npos) << result.BriefReport();
+  std::printf("%s\n", result.BriefReport().c_str());
+}
+
+TEST(MaterialGroups, OneMaterialIsOneGroupNotReconstructedAgain) {
+  ScratchDir dir;
+  const LambertianBrdf grey(Eigen::Vector3d(0.5, 0.4, 0.3));
+  const Session session = Session::Load(testing::MakeSession(dir / "session", Small(), grey));
+  WriteSamples(dir / "samples.npy", DerenderAnalytic(session, DerenderOptions()).samples);
+  UniformityOptions uniformity;
+  uniformity.cell_m = session.sample.radius / 8.0;
+  const UniformityResult cells = MeasureUniformity(session, dir / "samples.npy", grey, uniformity);
+  ASSERT_EQ(cells.materials.count, 1);
+  std::filesystem::create_directories(dir / "out");
+  const MaterialGroupsResult result = MeasureMaterialGroups(session, dir / "samples.npy", cells.ToJson(true),
+                                                            "uniformity.json", nullptr, "", Quick(), dir / "out");
+  ASSERT_EQ(result.groups.size(), 1u);
+  EXPECT_FALSE(result.groups[0].reconstructed);
+  EXPECT_GT(result.groups[0].samples, result.samples / 2);
+  EXPECT_TRUE(std::filesystem::is_empty(dir / "out"));
+  EXPECT_NE(result.BriefReport().find("one material"), std::string::npos) << result.BriefReport();
+
+  nlohmann::json old = cells.ToJson(true);
+  old.erase("grid_origin");
+  try {
+    MeasureMaterialGroups(session, dir / "samples.npy", old, "old/uniformity.json", nullptr, "", Quick(), dir / "out");
+    FAIL() << "a uniformity.json without its grid was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("old/uniformity.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("grid_origin"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace ibrdf
