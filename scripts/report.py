@@ -381,7 +381,8 @@ def stamps(run_dir):
     return result
 
 
-STAGE_ORDER = ("synth", "scan", "align", "derender", "check", "compare", "reconstruct", "uniformity", "report")
+STAGE_ORDER = ("synth", "scan", "align", "derender", "check", "compare", "reconstruct", "uniformity", "materials",
+               "report")
 
 
 def timings_figure(times, counts, out):
@@ -1081,7 +1082,35 @@ def uniformity_html(run_dir):
                      f'alt="map.png" style="max-width:640px"><figcaption>where: each sample pixel of photo '
                      f'{u.get("map_photo")} coloured by its cell\'s ratio to the object\'s BRDF (red above, blue below, '
                      f'full colour at 2x; pale: within the bound) (uniformity/map.png)</figcaption></figure>')
-    return "<h2>One material?</h2>\n" + text
+    return "<h2>One material?</h2>\n" + text + materials_html(run_dir)
+
+
+def materials_html(run_dir):
+    """With `run --spatial` (materials/materials.json, docs/spatial.md): each group of cells measured as a material of
+    its own, the blends and the samples in no basis, and the scores against a synthetic truth."""
+    m = load_json(os.path.join(run_dir, "materials", "materials.json"))
+    if not m:
+        return ""
+    counts = m.get("samples", {})
+    rows = []
+    for g in m.get("groups", []):
+        if "blend_of" in g:
+            what = f"a blend of groups {g['blend_of'][0]} and {g['blend_of'][1]}: not reconstructed"
+        elif g.get("reconstructed"):
+            e = g.get("error_against_truth")
+            what = (f"reconstructed in materials/{html.escape(g['folder'])}/"
+                    + (f"; against {html.escape(g.get('truth_name', 'the truth'))}: relative RMS "
+                       f"{100 * e['rel_rms_error_all']:.1f} %" if e else ""))
+        else:
+            what = "not reconstructed (too few samples, or the object's one material: reconstruction/)"
+        rows.append(f"<tr><td>{g['group']}</td><td>{g['samples']}</td><td>{what}</td></tr>")
+    labels = m.get("labels")
+    score = (f" Against the synthetic map: labels right on {100 * labels['right_fraction']:.1f} % of "
+             f"{labels['scored_samples']} samples away from its boundaries." if labels else "")
+    return (f"<h3>Materials (run --spatial)</h3>\n<p>Each group measured as a material of its own; "
+            f"{counts.get('mixed', 0)} of {counts.get('rows', 0)} samples lie on a boundary or in a blend and are in no "
+            f"group's reconstruction.{score} The BRDF above is still the whole object's average.</p>\n"
+            f"<table><tr><th>group</th><th>samples</th><th>measured as</th></tr>{''.join(rows)}</table>\n")
 
 
 def notices_html(run_dir, side):
