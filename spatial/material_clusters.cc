@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <random>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 
 #include "core/error.h"
 #include "core/logging.h"
@@ -19,63 +19,18 @@ struct Partition {
   double sse = std::numeric_limits<double>::infinity();
 };
 
-// Lloyd's iterations from k-means++ seeds drawn with `rng`.
-Partition KMeans(const std::vector<Eigen::Vector3d>& points, int k, std::mt19937* rng) {
+// OpenCV's k-means (k-means++ seeds, `starts` attempts, the most compact kept), from a fixed seed so
+// that the same cells give the same groups.
+Partition KMeans(const cv::Mat& points, int k, int starts) {
+  cv::theRNG().state = 1;
+  cv::Mat labels, centres;
   Partition p;
-  const size_t n = points.size();
-  std::uniform_int_distribution<size_t> pick(0, n - 1);
-  p.centres.push_back(points[pick(*rng)]);
-  std::vector<double> nearest(n);
-  while (int(p.centres.size()) < k) {
-    double total = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-      double d = std::numeric_limits<double>::infinity();
-      for (const Eigen::Vector3d& c : p.centres) d = std::min(d, (points[i] - c).squaredNorm());
-      nearest[i] = d;
-      total += d;
-    }
-    if (!(total > 0.0)) break;  // fewer distinct points than k
-    std::uniform_real_distribution<double> u(0.0, total);
-    double at = u(*rng);
-    size_t chosen = n - 1;
-    for (size_t i = 0; i < n; ++i) {
-      at -= nearest[i];
-      if (at <= 0.0) {
-        chosen = i;
-        break;
-      }
-    }
-    p.centres.push_back(points[chosen]);
+  p.sse = cv::kmeans(points, k, labels, cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-9),
+                     starts, cv::KMEANS_PP_CENTERS, centres);
+  for (int c = 0; c < centres.rows; ++c) {
+    p.centres.emplace_back(centres.at<float>(c, 0), centres.at<float>(c, 1), centres.at<float>(c, 2));
   }
-  p.label.assign(n, 0);
-  for (int iteration = 0; iteration < 100; ++iteration) {
-    bool changed = false;
-    p.sse = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-      int best = 0;
-      double best_d = std::numeric_limits<double>::infinity();
-      for (size_t c = 0; c < p.centres.size(); ++c) {
-        const double d = (points[i] - p.centres[c]).squaredNorm();
-        if (d < best_d) {
-          best_d = d;
-          best = int(c);
-        }
-      }
-      changed |= p.label[i] != best;
-      p.label[i] = best;
-      p.sse += best_d;
-    }
-    if (!changed && iteration > 0) break;
-    std::vector<Eigen::Vector3d> sums(p.centres.size(), Eigen::Vector3d::Zero());
-    std::vector<size_t> counts(p.centres.size(), 0);
-    for (size_t i = 0; i < n; ++i) {
-      sums[p.label[i]] += points[i];
-      ++counts[p.label[i]];
-    }
-    for (size_t c = 0; c < p.centres.size(); ++c) {
-      if (counts[c] > 0) p.centres[c] = sums[c] / double(counts[c]);
-    }
-  }
+  p.label.assign(labels.begin<int>(), labels.end<int>());
   return p;
 }
 
@@ -130,13 +85,12 @@ MaterialClusters ClusterMaterials(const std::vector<Eigen::Vector3d>& cell_ratio
   for (const Eigen::Vector3d& p : points) taken.centres[0] += p / double(points.size());
   taken.label.assign(points.size(), 0);
   result.tried.push_back("1: always");
-  std::mt19937 rng(1);
+  cv::Mat data(int(points.size()), 3, CV_32F);
+  for (size_t i = 0; i < points.size(); ++i) {
+    for (int a = 0; a < 3; ++a) data.at<float>(int(i), a) = float(points[i][a]);
+  }
   for (int k = 2; k <= options.max_materials && size_t(k) <= points.size(); ++k) {
-    Partition best;
-    for (int start = 0; start < options.starts; ++start) {
-      Partition p = KMeans(points, k, &rng);
-      if (p.sse < best.sse) best = std::move(p);
-    }
+    const Partition best = KMeans(data, k, options.starts);
     // The closest pair of centres (by their largest channel difference) and the smallest cluster.
     double closest = std::numeric_limits<double>::infinity();
     for (size_t a = 0; a < best.centres.size(); ++a) {
@@ -152,7 +106,7 @@ MaterialClusters ClusterMaterials(const std::vector<Eigen::Vector3d>& cell_ratio
                            (apart ? "over " : "not over ") + Fixed(1.0 + options.separation, 2) + "x), smallest " +
                            Fixed(100.0 * smallest, 1) + " % of cells (" + (large ? "at least " : "under ") +
                            Fixed(100.0 * options.min_share, 0) + " %)");
-    if (apart && large) taken = std::move(best);
+    if (apart && large) taken = best;
   }
 
   result.count = int(taken.centres.size());

@@ -4,7 +4,7 @@
 // value away from the specular peak, relative to the median cell's, per channel and in logarithms
 // (there a material's value hardly depends on the directions each cell saw; its ratio to the one
 // reconstructed BRDF does, since that is another mix of the materials at each direction). k-means
-// (k-means++ seeding from a fixed seed, several starts, the lowest within-cluster sum kept) for k = 1
+// (OpenCV's, k-means++ seeding from a fixed seed, several starts, the most compact kept) for k = 1
 // ... max_materials; the number of groups is the largest k whose clusters are all told apart: every
 // pair of centres more than `separation` apart in some channel (1.6x), and every cluster at least
 // `min_share` of the cells. One group always qualifies, so a uniform sample gives one. A group whose
@@ -30,7 +30,7 @@ struct MaterialClusterOptions {
   // A group within this of a mix of two others' centres (1.25x) is their blend.
   double blend_tolerance = 0.25;
   double min_share = 0.05;   // of the clustered cells
-  int starts = 8;            // k-means++ starts per k
+  int starts = 8;            // k-means++ attempts per k
 
   bool Check(std::string* why) const;
 };
