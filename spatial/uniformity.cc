@@ -344,7 +344,8 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
   const std::string remedy =
       "the sample is not one material, and the one BRDF averages its materials, or its geometry is wrong (the "
       "sample's shape or pose, the cameras, the light: see align's verdicts); where: the map, uniformity/map.png; "
-      "measure one material's region alone (a session mask), or accept the average";
+      "measure each material (ibrdf run --spatial), one material's region alone (a session mask), or accept the "
+      "average";
   if (result.cells_scored < 8) {
     result.verdicts.push_back(MakeVerdict(
         "uniformity.cells", double(result.cells_scored),
