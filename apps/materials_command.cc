@@ -12,6 +12,7 @@
 #include "core/session.h"
 #include "core/truth_file.h"
 #include "spatial/material_groups.h"
+#include "spatial/surface_points.h"
 #include "synth/material_map.h"
 
 namespace ibrdf {
@@ -55,15 +56,7 @@ IBRDF_COMMAND(57, Materials) {
     args->options.boundary_margin_m = args->margin_mm * 1e-3;
     std::string why;
     if (!args->options.Check(&why)) ThrowError("materials", why);
-    std::string session_path = args->session;
-    if (session_path.empty()) {
-      const nlohmann::json sidecar = ReadJsonFile(SidecarPath(args->samples));
-      if (!sidecar.contains("session") || !sidecar["session"].is_string()) {
-        ThrowError(SidecarPath(args->samples), "names no session: pass --session");
-      }
-      session_path = sidecar["session"].get<std::string>();
-    }
-    const Session session = Session::Load(session_path);
+    const Session session = Session::Load(SessionOfSamples(args->samples, args->session));
     RequireWritableOutput(
         args->out, args->overwrite,
         {args->samples, SidecarPath(args->samples), args->uniformity, args->truth, session.manifest_path});

@@ -10,6 +10,7 @@
 #include "core/png_writer.h"
 #include "core/sample_file.h"
 #include "core/session.h"
+#include "spatial/surface_points.h"
 #include "spatial/uniformity.h"
 
 namespace ibrdf {
@@ -55,15 +56,7 @@ IBRDF_COMMAND(55, Uniformity) {
     args->options.cell_m = args->cell_mm * 1e-3;
     std::string why;
     if (!args->options.Check(&why)) ThrowError("uniformity", why);
-    std::string session_path = args->session;
-    if (session_path.empty()) {
-      const nlohmann::json sidecar = ReadJsonFile(SidecarPath(args->samples));
-      if (!sidecar.contains("session") || !sidecar["session"].is_string()) {
-        ThrowError(SidecarPath(args->samples), "names no session: pass --session");
-      }
-      session_path = sidecar["session"].get<std::string>();
-    }
-    const Session session = Session::Load(session_path);
+    const Session session = Session::Load(SessionOfSamples(args->samples, args->session));
     RequireWritableOutput(args->out, args->overwrite, {args->samples, SidecarPath(args->samples), args->brdf,
                                                         session.manifest_path});
     const MerlBrdf reference(args->brdf);

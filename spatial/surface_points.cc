@@ -4,8 +4,11 @@
 #include <cmath>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
 #include "core/error.h"
 #include "core/file_util.h"
+#include "core/json_reader.h"
 #include "core/kind.h"
 #include "derender/analytic_sample.h"
 #include "derender/mesh_sample.h"
@@ -59,5 +62,14 @@ SurfaceLocator::Outcome SurfaceLocator::Locate(const BrdfSample& sample, Eigen::
 
 Eigen::Vector3d SurfaceLocator::BoundingCenter() const { return surface_->BoundingCenter(); }
 double SurfaceLocator::BoundingRadius() const { return surface_->BoundingRadius(); }
+
+std::string SessionOfSamples(const std::string& samples_path, const std::string& given) {
+  if (!given.empty()) return given;
+  const nlohmann::json sidecar = ReadJsonFile(SidecarPath(samples_path));
+  if (!sidecar.contains("session") || !sidecar["session"].is_string()) {
+    ThrowError(SidecarPath(samples_path), "names no session: pass --session");
+  }
+  return sidecar["session"].get<std::string>();
+}
 
 }  // namespace ibrdf

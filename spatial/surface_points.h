@@ -8,6 +8,7 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -19,6 +20,11 @@
 namespace ibrdf {
 
 class SampleSurface;  // derender/analytic_sample.h
+
+// The session manifest a sample file was derendered from: `given` when not empty, else the one the
+// file's sidecar names ("session"). Throws Error naming the sidecar when it is unreadable or names none
+// (the remedy: pass the session).
+std::string SessionOfSamples(const std::string& samples_path, const std::string& given);
 
 class SurfaceLocator {
  public:
