@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "core/sample_file.h"
 #include "derender/derenderer.h"
 #include "spatial/surface_points.h"
@@ -150,6 +152,23 @@ TEST(Uniformity, TwoMaterialsFailAndTheMapShowsWhere) {
     if (std::abs(r - b) > 0.5f) ++coloured;
   }
   EXPECT_GT(coloured, 1000u);
+}
+
+// The session of a sample file: the one given, else its sidecar's; a sidecar naming none is refused
+// by its path.
+TEST(SurfaceLocator, SessionOfSamplesIsGivenOrTheSidecars) {
+  ScratchDir dir;
+  EXPECT_EQ(SessionOfSamples(dir / "samples.npy", "given/session.json"), "given/session.json");
+  std::ofstream(dir / "samples.npy.json") << R"({"session": "s/session.json"})";
+  EXPECT_EQ(SessionOfSamples(dir / "samples.npy", ""), "s/session.json");
+  std::ofstream(dir / "samples.npy.json") << R"({"format": "ibrdf-samples"})";
+  try {
+    SessionOfSamples(dir / "samples.npy", "");
+    FAIL() << "a sidecar naming no session was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(dir / "samples.npy.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("pass --session"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Uniformity, OptionsAreChecked) {
