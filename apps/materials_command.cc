@@ -11,6 +11,7 @@
 #include "core/sample_file.h"
 #include "core/session.h"
 #include "core/truth_file.h"
+#include "core/verdict.h"
 #include "spatial/material_groups.h"
 #include "spatial/surface_points.h"
 #include "synth/material_map.h"
@@ -31,6 +32,7 @@ IBRDF_COMMAND(57, Materials) {
     bool overwrite = false;
     double margin_mm = 2.0;
     MaterialGroupsOptions options;
+    AcceptedChecks accept;
   };
   auto args = std::make_shared<Args>();
   ReconstructOptions& r = args->options.reconstruct;
@@ -48,6 +50,11 @@ IBRDF_COMMAND(57, Materials) {
             "Each sample takes the group of its nearest off-peak samples (this many, within a cell)");
   AddOption(*c, "--purity", args->options.purity,
             "An off-peak value beyond this of every group's centre (0.25: 1.25x) is a mix");
+  c->add_option("--accept", args->accept.names,
+                "Proceed although these checks fail (materials.measured, materials.cells, or all); recorded in "
+                "materials.json")
+      ->delimiter(',')
+      ->type_name("CHECK[,CHECK...]");
   AddClearingFlag(*c, "--no-fits", r.fits, "Skip each group's Lafortune and GGX fits");
   AddClearingFlag(*c, "--no-bsdf", r.bsdf, "Skip each group's NAME.bsdf");
   c->add_option("--name", r.name, "Name of the groups' materials (NAME-group-K; default: material-group-K)");
@@ -74,6 +81,13 @@ IBRDF_COMMAND(57, Materials) {
     const std::string folder = directory.temporary_path();
     MaterialGroupsResult result = MeasureMaterialGroups(session, args->samples, uniformity, args->uniformity,
                                                         map ? &*map : nullptr, truth_file, args->options, folder);
+    // The evidence is written whatever the verdict: a failed check points at its cells.
+    std::optional<Error> failure;
+    try {
+      EnforceVerdicts(&result.verdicts, args->accept, args->samples + ": materials");
+    } catch (const Error& error) {
+      failure = error;
+    }
     nlohmann::json json = result.ToJson();
     json["samples_file"] = std::filesystem::absolute(args->samples).lexically_normal().string();
     json["uniformity"] = std::filesystem::absolute(args->uniformity).lexically_normal().string();
@@ -83,6 +97,7 @@ IBRDF_COMMAND(57, Materials) {
     directory.Commit();
     Log(1, result.BriefReport());
     Log(1, "materials written to " + args->out);
+    if (failure) throw *failure;
   });
 }
 

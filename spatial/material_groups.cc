@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <unordered_map>
 
 #include <tbb/parallel_for.h>
@@ -13,9 +15,12 @@
 
 #include "core/error.h"
 #include "core/file_util.h"
+#include "core/brdf_model.h"
 #include "core/json_reader.h"
 #include "core/logging.h"
 #include "core/math.h"
+#include "core/merl_brdf.h"
+#include "core/statistics.h"
 #include "core/sample_file.h"
 #include "spatial/surface_points.h"
 #include "spatial/uniformity.h"
@@ -151,6 +156,8 @@ constexpr int kNotLocated = -2, kMixedSample = -3;
 struct Placed {
   int group = kNotLocated;  // or -1: no group, kMixedSample: on a boundary or a blend
   int truth = -1;
+  Eigen::Vector3f point = Eigen::Vector3f::Zero();
+  uint64_t key = 0;
 };
 
 // Pass 1 of the split: the off-peak samples' points and nearest groups.
@@ -158,6 +165,89 @@ struct OffPeakSample {
   Eigen::Vector3f point;
   int group = kOnPeak;
 };
+
+// A group as a basis of the projection: its table where measured, else its chosen fit (each group
+// saw the surface from its own directions, so its table lacks data where another's has it); no value
+// (negative) where neither has one. The evaluations the fit served are counted.
+class TableOrFit : public BrdfModel {
+ public:
+  TableOrFit(const std::filesystem::path& folder, const std::string& chosen_model)
+      : table_((folder / "brdf.binary").string()) {
+    const std::filesystem::path fit = folder / (chosen_model + ".json");
+    if (chosen_model != "none" && !chosen_model.empty() && std::filesystem::exists(fit)) fit_ = LoadMaterial(fit.string());
+  }
+  Eigen::Vector3d Eval(const Eigen::Vector3d& wi, const Eigen::Vector3d& wo) const override {
+    if (!(wi.z() > 0.0 && wo.z() > 0.0)) return Eigen::Vector3d::Zero();
+    Eigen::Vector3d f = table_.Lookup(wi.normalized(), wo.normalized());
+    if ((f.array() >= 0.0).all() || !fit_) return f;
+    fitted_.fetch_add(1, std::memory_order_relaxed);
+    const Eigen::Vector3d model = fit_->Eval(wi, wo);
+    for (int k = 0; k < 3; ++k) {
+      if (f[k] < 0.0) f[k] = model[k];
+    }
+    return f;
+  }
+  nlohmann::json ToJson() const override { return table_.ToJson(); }
+  std::string ModelName() const override { return "merl"; }
+  uint64_t fitted() const { return fitted_.load(); }
+
+ private:
+  MerlBrdf table_;
+  std::unique_ptr<BrdfModel> fit_;
+  mutable std::atomic<uint64_t> fitted_{0};
+};
+
+// Every cell of `located` as a combination of the reconstructed groups (their tables and fits, read back
+// from `out_dir`), and with a map truth the weights scored against the truth's.
+void ProjectCells(const std::string& out_dir, const MaterialMap* truth_map, const MaterialGroupsOptions& options,
+                  std::vector<LocatedSample>* located, MaterialGroupsResult* result) {
+  std::vector<std::unique_ptr<TableOrFit>> tables;
+  std::vector<const BrdfModel*> bases;
+  for (size_t g = 0; g < result->groups.size(); ++g) {
+    const MaterialGroup& group = result->groups[g];
+    if (!group.reconstructed) continue;
+    tables.push_back(std::make_unique<TableOrFit>(std::filesystem::path(out_dir) / group.folder,
+                                                  group.reconstruction.chosen_model));
+    bases.push_back(tables.back().get());
+    result->bases.push_back(int(g));
+  }
+  if (bases.empty()) return;
+  result->weights = ProjectOntoBases(located, bases, options.weights);
+  uint64_t fitted = 0;
+  for (const auto& table : tables) fitted += table->fitted();
+  result->basis_evaluations = uint64_t(located->size()) * bases.size();
+  result->basis_fit_evaluations = fitted;
+  Log(1, "materials: " + result->weights.BriefReport(options.weights));
+  if (!truth_map) return;
+  // ProjectOntoBases left the samples sorted by cell, in the order of its cells.
+  const size_t n_truth = truth_map->NumMaterials();
+  std::vector<double> errors, mixed_errors;
+  size_t at = 0;
+  for (const CellWeights& cell : result->weights.cells) {
+    Eigen::VectorXd truth = Eigen::VectorXd::Zero(Eigen::Index(n_truth));
+    for (uint32_t i = 0; i < cell.samples; ++i, ++at) truth += truth_map->Weights((*located)[at].point.cast<double>());
+    if (!cell.fitted || !(cell.weights.sum() > 0.0)) continue;
+    truth /= double(cell.samples);
+    Eigen::VectorXd measured = Eigen::VectorXd::Zero(Eigen::Index(n_truth));
+    bool mapped = true;
+    for (size_t b = 0; b < bases.size(); ++b) {
+      const int material = result->groups[size_t(result->bases[b])].truth_material;
+      if (material < 0) mapped = false;
+      else measured[material] += cell.weights[Eigen::Index(b)] / cell.weights.sum();
+    }
+    if (!mapped) continue;
+    const double error = 0.5 * (measured - truth).cwiseAbs().sum();
+    errors.push_back(error);
+    if (truth.maxCoeff() < 0.95) mixed_errors.push_back(error);
+  }
+  result->weights_scored_cells = errors.size();
+  result->weights_mixed_cells = mixed_errors.size();
+  if (!errors.empty()) {
+    result->weights_error_median = Median(errors);
+    result->weights_error_p95 = Percentile(errors, 0.95);
+  }
+  if (!mixed_errors.empty()) result->weights_mixed_error_median = Median(mixed_errors);
+}
 
 }  // namespace
 
@@ -197,7 +287,10 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
   const size_t n_truth = truth_map ? truth_map->NumMaterials() : 0;
   for (size_t k = 0; k < n_truth; ++k) result.truth_materials.push_back(truth_map->Name(k));
   result.confusion.assign(std::max(cells.groups, 0), std::vector<uint64_t>(n_truth, 0));
-  std::vector<std::vector<BrdfSample>> grouped(std::max(cells.groups, 0));
+  // With groups: every located sample, its cell and group (each group's reconstruction takes its own,
+  // and every cell is projected onto the reconstructed groups).
+  std::vector<LocatedSample> located;
+  std::vector<uint64_t> group_samples(std::max(cells.groups, 0), 0);
 
   // One group: the object's own reconstruction is the group's; the samples are only counted.
   const bool split = cells.groups > 1;
@@ -243,7 +336,9 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
           for (size_t i = range.begin(); i < range.end(); ++i) {
             Eigen::Vector3d point;
             if (locator.Locate(rows[i], &point) != SurfaceLocator::Outcome::kFound) continue;
-            const auto it = cells.group_of_key.find(UniformityCellKey(point, cells.origin, cells.cell_m));
+            placed[i].point = point.cast<float>();
+            placed[i].key = UniformityCellKey(point, cells.origin, cells.cell_m);
+            const auto it = cells.group_of_key.find(placed[i].key);
             placed[i].group = it == cells.group_of_key.end() ? -1 : it->second;
             if (k_nearest > 0) {
               const Eigen::Vector3f query = point.cast<float>();
@@ -276,6 +371,7 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
             ++result.not_located;
             continue;
           }
+          if (split) located.push_back(LocatedSample{rows[i], p.point, int8_t(p.group), p.key});
           if (p.group == kMixedSample) {
             ++result.mixed;
             if (p.truth >= 0) ++result.mixed_scored;
@@ -285,15 +381,15 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
             ++result.ungrouped;
             continue;
           }
-          if (split) grouped[p.group].push_back(rows[i]);
+          ++group_samples[p.group];
           if (p.truth >= 0) ++result.confusion[p.group][p.truth];
         }
       });
 
-  result.groups.resize(grouped.size());
-  for (size_t g = 0; g < grouped.size(); ++g) {
+  result.groups.resize(group_samples.size());
+  for (size_t g = 0; g < group_samples.size(); ++g) {
     MaterialGroup& group = result.groups[g];
-    group.samples = split ? grouped[g].size() : result.samples - result.not_located - result.ungrouped;
+    group.samples = split ? group_samples[g] : result.samples - result.not_located - result.ungrouped;
     group.blend_of = cells.blend_of[g];
     if (n_truth > 0) {
       const std::vector<uint64_t>& row = result.confusion[g];
@@ -311,7 +407,8 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
   result.scored += result.mixed_scored;
   if (result.scored > 0) result.labels_right /= double(result.scored);
 
-  for (size_t g = 0; split && g < grouped.size(); ++g) {
+  std::vector<std::string> not_measured;  // the material groups too small to reconstruct
+  for (size_t g = 0; split && g < group_samples.size(); ++g) {
     MaterialGroup& group = result.groups[g];
     if (group.blend_of[0] >= 0) {
       Log(1, "materials: group " + std::to_string(g) + " not reconstructed: a blend of groups " +
@@ -322,6 +419,7 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
     if (group.samples < options.min_group_samples) {
       Log(1, "materials: group " + std::to_string(g) + " not reconstructed: " + std::to_string(group.samples) +
                  " samples, under " + std::to_string(options.min_group_samples));
+      not_measured.push_back("group " + std::to_string(g) + ": " + std::to_string(group.samples) + " samples");
       continue;
     }
     ReconstructOptions reconstruct = options.reconstruct;
@@ -340,7 +438,12 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
     }
     Log(1, "materials: group " + std::to_string(g) + ": " + std::to_string(group.samples) + " samples" +
                (group.truth_name.empty() ? "" : " (mostly " + group.truth_name + ")"));
-    group.reconstruction = Reconstruct(grouped[g], reconstruct, folder.string(), samples_path);
+    std::vector<BrdfSample> own;
+    own.reserve(group.samples);
+    for (const LocatedSample& s : located) {
+      if (s.group == int(g)) own.push_back(s.sample);
+    }
+    group.reconstruction = Reconstruct(own, reconstruct, folder.string(), samples_path);
     if (group.truth_material >= 0) {
       // The truth beside the group is named as the output folder will hold it (out_dir may be a
       // temporary name until committed).
@@ -350,9 +453,42 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
                     "../" + std::filesystem::path(reconstruct.truth_file).filename().string());
       WriteJsonFile(summary, written);
     }
-    std::vector<BrdfSample>().swap(grouped[g]);
     group.reconstructed = true;
     group.folder = folder.filename().string();
+  }
+  if (split) {
+    ProjectCells(out_dir, truth_map, options, &located, &result);
+    const std::string size_bound = "every group that is a material has at least " +
+                                   std::to_string(options.min_group_samples) + " samples (--min-group-samples)";
+    std::string measured;
+    for (const std::string& item : not_measured) measured += (measured.empty() ? "" : "; ") + item;
+    result.verdicts.push_back(MakeVerdict(
+        "materials.measured", double(not_measured.size()),
+        not_measured.empty() ? "every material group reconstructed"
+                             : std::to_string(not_measured.size()) + " material group(s) too small to reconstruct (" +
+                                   measured + ")",
+        size_bound, not_measured.empty() ? VerdictLevel::kOk : VerdictLevel::kFail,
+        "a material was found but not measured: photograph its region from more directions, or lower "
+        "--min-group-samples; accepted, its cells are expressed by the other groups (materials.json's weights)"));
+    const MaterialWeightsOptions& w = options.weights;
+    if (result.weights.cells_fitted < 8) {
+      result.verdicts.push_back(MakeVerdict(
+          "materials.cells", double(result.weights.cells_fitted),
+          std::to_string(result.weights.cells_fitted) + " cells with at least " + std::to_string(w.min_cell_samples) +
+              " samples usable against every reconstructed group",
+          "at least 8 fitted cells to judge the groups", VerdictLevel::kWarn,
+          "the groups' combinations not judged: too few samples per cell (more photos, or a larger cell in "
+          "`ibrdf uniformity --cell-mm`)"));
+    } else {
+      result.verdicts.push_back(MakeVerdict(
+          "materials.cells", result.weights.not_fitting_fraction, result.weights.BriefReport(w),
+          "under " + Fixed(100.0 * w.warn_fraction, 0) + " % of fitted cells (warn), " +
+              Fixed(100.0 * w.fail_fraction, 0) + " % (fail)",
+          VerdictAbove(result.weights.not_fitting_fraction, w.warn_fraction, w.fail_fraction),
+          "the cells that fit no combination of the measured groups hold a material no group measured (a group "
+          "too small to reconstruct, or two materials within the clustering's 1.6x of each other off the peak), "
+          "or the geometry is wrong there (see align's verdicts); where: materials.json's weights.cell_list"));
+    }
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
@@ -385,6 +521,15 @@ std::string MaterialGroupsResult::BriefReport() const {
     if (!group.reconstructed || !group.reconstruction.scored) continue;
     text += "; group " + std::to_string(g) + (group.truth_name.empty() ? "" : " (" + group.truth_name + ")") +
             " table rel. RMS " + Fixed(100.0 * group.reconstruction.error_against_truth.rel_rms_all, 1) + " %";
+  }
+  if (!bases.empty()) {
+    text += "; " + std::to_string(weights.cells_not_fitting) + " of " + std::to_string(weights.cells_fitted) +
+            " cells fit no combination of the groups";
+    if (weights_scored_cells > 0) {
+      text += "; weights off the truth's by " + Fixed(100.0 * weights_error_median, 1) + " % median (" +
+              Fixed(100.0 * weights_mixed_error_median, 1) + " % in " + std::to_string(weights_mixed_cells) +
+              " mixed cells)";
+    }
   }
   return text + "; " + Fixed(seconds, 1) + " s";
 }
@@ -421,6 +566,51 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
                           {"groups", list},
                           {"truth", truth_kind.empty() ? nlohmann::json(nullptr) : nlohmann::json(truth_kind)},
                           {"timings_s", {{"total", seconds}}}};
+  if (!bases.empty()) {
+    nlohmann::json cell_list = nlohmann::json::array();
+    const auto triple = [](const Eigen::Vector3d& v) {
+      nlohmann::json out = nlohmann::json::array();
+      for (int k = 0; k < 3; ++k) out.push_back(std::isfinite(v[k]) ? nlohmann::json(v[k]) : nlohmann::json(nullptr));
+      return out;
+    };
+    for (const CellWeights& cell : weights.cells) {
+      nlohmann::json entry = {{"key", cell.key},
+                              {"centre", {cell.centre.x(), cell.centre.y(), cell.centre.z()}},
+                              {"samples", cell.samples},
+                              {"fitted", cell.fitted}};
+      if (cell.fitted) {
+        entry["weights"] = std::vector<double>(cell.weights.data(), cell.weights.data() + cell.weights.size());
+        entry["ratio"] = triple(cell.ratio);
+        entry["noise"] = triple(cell.noise);
+        entry["rel_rms"] = cell.rel_rms;
+        entry["fits"] = cell.fits;
+        entry["dominant_group"] = bases[size_t(cell.dominant)];
+      }
+      cell_list.push_back(entry);
+    }
+    nlohmann::json w = {{"bases", bases},
+                        {"cells", weights.cells.size()},
+                        {"cells_fitted", weights.cells_fitted},
+                        {"cells_not_fitting", weights.cells_not_fitting},
+                        {"not_fitting_fraction", weights.not_fitting_fraction},
+                        {"median_rel_rms", weights.median_rel_rms},
+                        {"basis_evaluations", basis_evaluations},
+                        {"basis_fit_evaluations", basis_fit_evaluations},
+                        {"bases_are",
+                         "each group's table where it has data, else its chosen fit (basis_fit_evaluations of "
+                         "basis_evaluations)"},
+                        {"seconds", weights.seconds},
+                        {"cell_list", cell_list}};
+    if (truth_kind == "map") {
+      w["truth"] = {{"scored_cells", weights_scored_cells},
+                    {"error_median", weights_error_median},
+                    {"error_p95", weights_error_p95},
+                    {"mixed_cells", weights_mixed_cells},
+                    {"mixed_error_median", weights_mixed_error_median}};
+    }
+    value["weights"] = w;
+  }
+  value["verdicts"] = VerdictsToJson(verdicts);
   if (truth_kind == "map") {
     value["labels"] = {{"truth_materials", truth_materials},
                        {"confusion_groups_by_materials", confusion},

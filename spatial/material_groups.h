@@ -12,7 +12,11 @@
 // against the material most of its samples carry.
 // A single group is not reconstructed again: the object's own reconstruction is that group's. A group
 // the check found to be a blend of two others (material_clusters.h) is counted, not reconstructed: its
-// points are mixes, whose weights over the materials are the next step.
+// points are mixes. Then every cell of the surface, blends and boundaries included, is expressed as a
+// non-negative combination of the reconstructed materials (material_weights.h, Lensch's projection),
+// with its residual and whether any combination fits it. Two verdicts (core/verdict.h) judge the
+// result: "materials.measured" (every group that is a material was reconstructed) and
+// "materials.cells" (the cells no combination fits).
 #pragma once
 
 #include <array>
@@ -23,7 +27,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/session.h"
+#include "core/verdict.h"
 #include "reconstruct/reconstruction_stage.h"
+#include "spatial/material_weights.h"
 
 namespace ibrdf {
 
@@ -45,6 +51,8 @@ struct MaterialGroupsOptions {
   // group, lies on a boundary or in a blend and goes into no basis (counted as mixed).
   double purity = 0.25;
   size_t chunk_rows = 1 << 20;  // samples read (and traced in parallel) per chunk
+  // Each cell's weights over the reconstructed materials, and the verdict on the cells none fits.
+  MaterialWeightsOptions weights;
 
   bool Check(std::string* why) const;
 };
@@ -75,6 +83,19 @@ struct MaterialGroupsResult {
   uint64_t scored = 0;
   double labels_right = 0.0;
   std::string truth_kind;  // "map", "material" (one material scores every group) or "" (no truth)
+  // The cells' weights over the reconstructed groups (`bases`, by group index; none with one group).
+  std::vector<int> bases;
+  MaterialWeightsResult weights;
+  // Each basis is its group's table where that has data, else its chosen fit: the evaluations (samples x
+  // bases) and those the fit served (a fit outside its group's data, stated).
+  uint64_t basis_evaluations = 0, basis_fit_evaluations = 0;
+  // With a map truth: per fitted cell, half the L1 distance between its weights (normalised to sum 1,
+  // each basis counted as its group's majority material) and the truth's mean weights over its samples;
+  // the median and 95th percentile over all such cells and over the cells the truth mixes (no material
+  // over 0.95).
+  uint64_t weights_scored_cells = 0, weights_mixed_cells = 0;
+  double weights_error_median = 0.0, weights_error_p95 = 0.0, weights_mixed_error_median = 0.0;
+  std::vector<Verdict> verdicts;  // "materials.measured", "materials.cells" (with more than one group)
   double seconds = 0.0;
 
   // "3 groups: 41 / 33 / 26 % of 1.2 M samples, reconstructed in 12.3 s; labels right on 97.1 % ..."
@@ -84,7 +105,8 @@ struct MaterialGroupsResult {
 
 // Splits the samples at `samples_path` by the groups of `uniformity` (uniformity.json as written by
 // `ibrdf uniformity`, read from `uniformity_path`, named in errors) and reconstructs each group into
-// `out_dir`/group-K (out_dir must exist). `truth_map` scores the labels and each group against its
+// `out_dir`/group-K (out_dir must exist), then projects every cell onto the reconstructed groups and
+// states the verdicts (not enforced here: the caller writes the evidence first). `truth_map` scores the labels and each group against its
 // majority material (nullptr: none); `truth_file`, a single-material truth, scores every group
 // against it ("" for none; not with a map). Throws Error naming the file for a uniformity.json without
 // its grid or cells, or unreadable samples.

@@ -107,7 +107,8 @@ void AddTruth(const fs::path& dir, const std::string& truth_path, nlohmann::json
 }
 
 // With --spatial: the groups measured as materials (materials/materials.json): per group its samples,
-// the folder of its reconstruction and, with a truth, its material and error; the labels' score.
+// the folder of its reconstruction and, with a truth, its material and error; the labels' score; the
+// cells' weights over the groups (the fraction no combination fits; with a truth, the weights' error).
 void AddMaterials(const fs::path& dir, nlohmann::json* summary) {
   const std::optional<StageJson> m = StageJson::ReadIfExists((dir / "materials" / "materials.json").string());
   if (!m) return;
@@ -124,12 +125,21 @@ void AddMaterials(const fs::path& dir, nlohmann::json* summary) {
   nlohmann::json materials = {{"groups", groups}};
   const nlohmann::json labels = m->ValueOr("/labels", nlohmann::json());
   if (labels.is_object()) materials["labels_right_fraction"] = labels.value("right_fraction", nlohmann::json());
+  const nlohmann::json weights = m->ValueOr("/weights", nlohmann::json());
+  if (weights.is_object()) {
+    nlohmann::json w = {{"bases", weights.value("bases", nlohmann::json::array())},
+                        {"cells_fitted", weights.value("cells_fitted", 0)},
+                        {"not_fitting_fraction", weights.value("not_fitting_fraction", nlohmann::json())},
+                        {"median_rel_rms", weights.value("median_rel_rms", nlohmann::json())}};
+    if (weights.contains("truth")) w["truth"] = weights["truth"];
+    materials["weights"] = w;
+  }
   (*summary)["materials"] = materials;
 }
 
-// The calibration stages' and the uniformity check's verdicts (response/response.json,
-// align/alignment.json, lights/white-reference.json, colour/colour.json and uniformity/uniformity.json
-// "verdicts", core/verdict.h), each with its stage, and every stage's warnings in one list: the
+// The calibration stages', the uniformity check's and the materials stage's verdicts
+// (response/response.json, align/alignment.json, lights/white-reference.json, colour/colour.json,
+// uniformity/uniformity.json and materials/materials.json "verdicts", core/verdict.h), each with its stage, and every stage's warnings in one list: the
 // verdicts that are not ok (an accepted failure included, marked so), align's own warnings and
 // derender's exposure advice.
 void AddVerdicts(const fs::path& dir, nlohmann::json* summary) {
@@ -138,7 +148,8 @@ void AddVerdicts(const fs::path& dir, nlohmann::json* summary) {
                                     std::pair<std::string, std::string>{"align", "align/alignment.json"},
                                     std::pair<std::string, std::string>{"lights", "lights/white-reference.json"},
                                     std::pair<std::string, std::string>{"colour", "colour/colour.json"},
-                                    std::pair<std::string, std::string>{"uniformity", "uniformity/uniformity.json"}}) {
+                                    std::pair<std::string, std::string>{"uniformity", "uniformity/uniformity.json"},
+                                    std::pair<std::string, std::string>{"materials", "materials/materials.json"}}) {
     const std::optional<StageJson> stage_json = StageJson::ReadIfExists((dir / file).string());
     if (!stage_json) continue;
     const nlohmann::json list = stage_json->ValueOr("/verdicts", nlohmann::json::array());

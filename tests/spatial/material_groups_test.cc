@@ -1,10 +1,12 @@
 // The uniformity check's groups measured as materials: on a synthetic sphere of two materials in four
 // sharp stripes the samples are split by their nearest off-peak samples' groups (those on a boundary
 // by neither), each group matches one material of the map on the samples away from its boundaries and
-// is reconstructed close to it; a uniform sphere gives
+// is reconstructed close to it, and every cell is the right combination of the two; a material too
+// small to reconstruct fails both verdicts; a uniform sphere gives
 // one group and no second reconstruction; a uniformity.json without its grid is refused by name.
 #include "spatial/material_groups.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -89,6 +91,37 @@ TEST(MaterialGroups, TwoMaterialsAreSplitLabelledAndReconstructedEach) {
   EXPECT_EQ(json["labels"]["confusion_groups_by_materials"].size(), 2u);
   EXPECT_NE(result.BriefReport().find("labels right on"), std::string::npos) << result.BriefReport();
   std::printf("%s\n", result.BriefReport().c_str());
+
+  // Every cell as a combination of the two groups, its weights those of the truth (its mean over each
+  // cell's samples).
+  EXPECT_EQ(result.bases, (std::vector<int>{0, 1}));
+  EXPECT_GT(result.weights.cells_fitted, 20u) << result.weights.BriefReport(Quick().weights);
+  EXPECT_LE(result.weights.not_fitting_fraction, 0.05) << result.weights.BriefReport(Quick().weights);
+  EXPECT_EQ(result.weights_scored_cells, result.weights.cells_fitted);
+  // (The stripes' boundaries lie on the cells' grid planes here, so no cell straddles one.)
+  EXPECT_LT(result.weights_error_median, 0.02) << result.BriefReport();
+  EXPECT_LT(result.weights_error_p95, 0.05) << result.BriefReport();
+  ASSERT_EQ(result.verdicts.size(), 2u);
+  EXPECT_EQ(result.verdicts[0].check, "materials.measured");
+  EXPECT_EQ(result.verdicts[0].level, VerdictLevel::kOk) << result.verdicts[0].Line();
+  EXPECT_EQ(result.verdicts[1].check, "materials.cells");
+  EXPECT_EQ(result.verdicts[1].level, VerdictLevel::kOk) << result.verdicts[1].Line();
+  EXPECT_EQ(json["weights"]["cell_list"].size(), result.weights.cells.size());
+  EXPECT_EQ(json["verdicts"].size(), 2u);
+
+  // A group too small to reconstruct: a material found and not measured fails, and its cells, expressed
+  // by the other group alone, fit no combination.
+  MaterialGroupsOptions strict = Quick();
+  strict.min_group_samples = std::max(result.groups[0].samples, result.groups[1].samples);
+  std::filesystem::create_directories(dir / "strict");
+  const MaterialGroupsResult missed = MeasureMaterialGroups(session, dir / "samples.npy", cells.ToJson(true),
+                                                            "uniformity.json", &map, "", strict, dir / "strict");
+  ASSERT_EQ(missed.bases.size(), 1u);
+  ASSERT_EQ(missed.verdicts.size(), 2u);
+  EXPECT_EQ(missed.verdicts[0].level, VerdictLevel::kFail) << missed.verdicts[0].Line();
+  EXPECT_NE(missed.verdicts[0].measured.find("too small"), std::string::npos) << missed.verdicts[0].Line();
+  EXPECT_EQ(missed.verdicts[1].level, VerdictLevel::kFail) << missed.verdicts[1].Line();
+  EXPECT_GT(missed.weights.not_fitting_fraction, 0.3) << missed.weights.BriefReport(strict.weights);
 }
 
 TEST(MaterialGroups, OneMaterialIsOneGroupNotReconstructedAgain) {
@@ -108,6 +141,8 @@ TEST(MaterialGroups, OneMaterialIsOneGroupNotReconstructedAgain) {
   EXPECT_GT(result.groups[0].samples, result.samples / 2);
   EXPECT_TRUE(std::filesystem::is_empty(dir / "out"));
   EXPECT_NE(result.BriefReport().find("one material"), std::string::npos) << result.BriefReport();
+  EXPECT_TRUE(result.bases.empty());
+  EXPECT_TRUE(result.verdicts.empty());
 
   nlohmann::json old = cells.ToJson(true);
   old.erase("grid_origin");

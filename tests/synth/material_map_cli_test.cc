@@ -181,7 +181,14 @@ TEST(SynthMaterialMapCli, RecipeWithAMapStopsAtUniformityAndRunsWhenAccepted) {
   EXPECT_EQ(summary.at("stages").at("materials").at("status"), "not_applicable");
 
   // --spatial: the groups measured as materials, scored against the map. At 160 x 120 and stride 2
-  // the felt's group holds under the default 1000 samples a group needs: 500 here.
+  // the felt's group holds under the default 1000 samples a group needs: a material found and not
+  // measured stops the run, its evidence written.
+  const auto too_small = RunIbrdf(run_line + " --spatial", /*quiet=*/true);
+  EXPECT_EQ(too_small.exit_code, 1) << too_small.output;
+  EXPECT_NE(too_small.output.find("materials.measured: fail"), std::string::npos) << too_small.output;
+  EXPECT_NE(too_small.output.find("--accept materials.measured"), std::string::npos) << too_small.output;
+  EXPECT_EQ(ReadJsonFile(dir / "r/materials/materials.json").at("verdicts").at(0).at("verdict"), "fail");
+  // With 500 samples enough for a group, both are measured.
   const auto spatial = RunIbrdf(run_line + " --spatial --materials-args \"--min-group-samples 500\"", /*quiet=*/true);
   ASSERT_EQ(spatial.exit_code, 0) << spatial.output;
   const nlohmann::json with = ReadJsonFile(dir / "r/summary.json");
@@ -199,6 +206,15 @@ TEST(SynthMaterialMapCli, RecipeWithAMapStopsAtUniformityAndRunsWhenAccepted) {
   }
   EXPECT_EQ(names.size(), 2u) << materials.dump(2);
   EXPECT_EQ(with.at("materials").at("groups").size(), 2u);
+  // Every cell as a combination of the two, judged and scored against the map.
+  EXPECT_EQ(with.at("materials").at("weights").at("bases").size(), 2u) << with.at("materials").dump(2);
+  EXPECT_GT(with.at("materials").at("weights").at("cells_fitted").get<int>(), 0);
+  EXPECT_TRUE(with.at("materials").at("weights").contains("truth"));
+  std::set<std::string> checks;
+  for (const nlohmann::json& verdict : with.at("verdicts")) {
+    if (verdict.value("stage", "") == "materials") checks.insert(verdict.value("check", ""));
+  }
+  EXPECT_EQ(checks, (std::set<std::string>{"materials.measured", "materials.cells"})) << with.at("verdicts").dump(2);
   EXPECT_NE(spatial.output.find("labels right on"), std::string::npos) << spatial.output;
 }
 
