@@ -620,21 +620,43 @@ ScanMesh ReadPly(const std::string& path) {
 }
 
 void WritePly(const std::string& path, const ScanMesh& mesh) {
+  WritePly(path, mesh, {}, "ibrdf scan (lengths in metres)");
+}
+
+void WritePly(const std::string& path, const ScanMesh& mesh, const std::vector<PlyVertexProperty>& extra,
+              const std::string& comment) {
   const size_t n = mesh.points.size();
   const bool normals = mesh.normals.size() == n && n > 0;
   const bool rms = mesh.fit_rms_m.size() == n && n > 0;
   const bool neighbours = mesh.fit_neighbours.size() == n && n > 0;
   const bool hull = mesh.hull_distance_m.size() == n && n > 0;
+  for (const PlyVertexProperty& property : extra) {
+    if (property.values.size() != n) {
+      throw InternalError(path + ": vertex property " + property.name + " has " +
+                          std::to_string(property.values.size()) + " values for " + std::to_string(n) + " vertices");
+    }
+  }
+  const auto type_name = [](PlyPropertyType type) -> const char* {
+    switch (type) {
+      case PlyPropertyType::kUchar: return "uchar";
+      case PlyPropertyType::kInt: return "int";
+      case PlyPropertyType::kFloat: return "float";
+    }
+    UnhandledKind("PlyPropertyType", int(type));
+  };
   AtomicFile file(path);
   {
     std::ofstream out(file.temporary_path(), std::ios::binary);
     if (!out) ThrowError(path, "cannot open for writing");
-    out << "ply\nformat binary_little_endian 1.0\ncomment ibrdf scan (lengths in metres)\n";
+    out << "ply\nformat binary_little_endian 1.0\ncomment " << comment << "\n";
     out << "element vertex " << n << "\nproperty double x\nproperty double y\nproperty double z\n";
     if (normals) out << "property float nx\nproperty float ny\nproperty float nz\n";
     if (rms) out << "property float quality\n";
     if (neighbours) out << "property int fit_neighbours\n";
     if (hull) out << "property float hull_distance\n";
+    for (const PlyVertexProperty& property : extra) {
+      out << "property " << type_name(property.type) << " " << property.name << "\n";
+    }
     out << "element face " << mesh.faces.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
     static_assert(sizeof(float) == 4 && sizeof(int32_t) == 4, "PLY sizes");
     auto put = [&out](const auto& value) { out.write(reinterpret_cast<const char*>(&value), sizeof(value)); };
@@ -646,6 +668,20 @@ void WritePly(const std::string& path, const ScanMesh& mesh) {
       if (rms) put(mesh.fit_rms_m[i]);
       if (neighbours) put(static_cast<int32_t>(mesh.fit_neighbours[i]));
       if (hull) put(mesh.hull_distance_m[i]);
+      for (const PlyVertexProperty& property : extra) {
+        const double v = property.values[i];
+        switch (property.type) {
+          case PlyPropertyType::kUchar:
+            put(static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L)));
+            break;
+          case PlyPropertyType::kInt:
+            put(static_cast<int32_t>(std::lround(v)));
+            break;
+          case PlyPropertyType::kFloat:
+            put(static_cast<float>(v));
+            break;
+        }
+      }
     }
     for (const Eigen::Vector3i& f : mesh.faces) {
       put(static_cast<uint8_t>(3));

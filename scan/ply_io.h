@@ -14,7 +14,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
+#include "core/kind.h"
 #include "scan/scan_mesh.h"
 
 namespace ibrdf {
@@ -28,5 +30,26 @@ ScanMesh ReadPly(const std::string& path);
 // local-plane fit's RMS residual, metres); int fit_neighbours; float hull_distance (metres). Faces:
 // list uchar int vertex_indices. See docs/scan.md.
 void WritePly(const std::string& path, const ScanMesh& mesh);
+
+// The type of an extra vertex property (a closed set: the switch in ply_io.cc lists each).
+enum class PlyPropertyType {
+  kUchar,  // 0-255 (colours: red, green, blue)
+  kInt,
+  kFloat,
+  IBRDF_DUMMY_KIND
+};
+
+// A vertex property beyond the mesh's own, one value per vertex (written as its type: rounded and
+// clamped for uchar, rounded for int).
+struct PlyVertexProperty {
+  std::string name;
+  PlyPropertyType type = PlyPropertyType::kFloat;
+  std::vector<double> values;
+};
+
+// The same, with `extra` properties after the mesh's own (each of mesh.points.size() values, else an
+// InternalError) and `comment` as the header's comment line.
+void WritePly(const std::string& path, const ScanMesh& mesh, const std::vector<PlyVertexProperty>& extra,
+              const std::string& comment);
 
 }  // namespace ibrdf

@@ -458,6 +458,11 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
   }
   if (split) {
     ProjectCells(out_dir, truth_map, options, &located, &result);
+    if (!result.bases.empty()) {
+      result.mesh = WriteMaterialMesh(session, result.weights, result.bases, cells.origin, cells.cell_m,
+                                      (std::filesystem::path(out_dir) / "materials.ply").string());
+      Log(1, "materials: " + result.mesh.BriefReport());
+    }
     const std::string size_bound = "every group that is a material has at least " +
                                    std::to_string(options.min_group_samples) + " samples (--min-group-samples)";
     std::string measured;
@@ -609,6 +614,18 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
                     {"mixed_error_median", weights_mixed_error_median}};
     }
     value["weights"] = w;
+    nlohmann::json mesh_json = {{"written", mesh.written}};
+    if (mesh.written) {
+      mesh_json.update({{"file", "materials.ply"},
+                        {"vertices", mesh.vertices},
+                        {"from_own_cell", mesh.own_cell},
+                        {"from_near_cell", mesh.near_cell},
+                        {"from_none", mesh.none},
+                        {"in_cells_not_fitting", mesh.not_fitting}});
+    } else {
+      mesh_json["reason"] = mesh.not_written;
+    }
+    value["mesh"] = mesh_json;
   }
   value["verdicts"] = VerdictsToJson(verdicts);
   if (truth_kind == "map") {

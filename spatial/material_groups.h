@@ -29,6 +29,7 @@
 #include "core/session.h"
 #include "core/verdict.h"
 #include "reconstruct/reconstruction_stage.h"
+#include "spatial/material_mesh.h"
 #include "spatial/material_weights.h"
 
 namespace ibrdf {
@@ -89,6 +90,8 @@ struct MaterialGroupsResult {
   // Each basis is its group's table where that has data, else its chosen fit: the evaluations (samples x
   // bases) and those the fit served (a fit outside its group's data, stated).
   uint64_t basis_evaluations = 0, basis_fit_evaluations = 0;
+  // The mesh with each vertex's weights (out_dir/materials.ply; a mesh sample with more than one group).
+  MaterialMeshResult mesh;
   // With a map truth: per fitted cell, half the L1 distance between its weights (normalised to sum 1,
   // each basis counted as its group's majority material) and the truth's mean weights over its samples;
   // the median and 95th percentile over all such cells and over the cells the truth mixes (no material

@@ -4,6 +4,9 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 
@@ -125,6 +128,41 @@ TEST(PlyIo, WriteThenReadKeepsEverything) {
   EXPECT_EQ(back.faces[0], mesh.faces[0]);
   ASSERT_EQ(back.normals.size(), 3u);
   EXPECT_EQ(back.normals[2], mesh.normals[2]);
+}
+
+TEST(PlyIo, ExtraVertexPropertiesAreWrittenAndSkippedOnReading) {
+  ScratchDir dir;
+  ScanMesh mesh;
+  mesh.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  mesh.faces = {{0, 1, 2}};
+  WritePly(dir / "extra.ply", mesh,
+           {{"label", PlyPropertyType::kInt, {-1, 2, 3}},
+            {"weight", PlyPropertyType::kFloat, {0.25, 0.5, 1.0}},
+            {"red", PlyPropertyType::kUchar, {-4, 127.6, 300}}},
+           "a test");
+  const ScanMesh back = ReadPly(dir / "extra.ply");
+  ASSERT_EQ(back.points.size(), 3u);
+  EXPECT_EQ(back.points[1], mesh.points[1]);
+  EXPECT_EQ(back.faces[0], mesh.faces[0]);
+  std::ifstream in(dir / "extra.ply", std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t body = text.find("end_header\n");
+  ASSERT_NE(body, std::string::npos);
+  EXPECT_NE(text.find("comment a test\n"), std::string::npos);
+  EXPECT_NE(text.find("property int label\nproperty float weight\nproperty uchar red\n"), std::string::npos);
+  // Vertex 1: x y z (doubles), label, weight, red.
+  const char* v1 = text.data() + body + 11 + (24 + 4 + 4 + 1);
+  int32_t label = 0;
+  float weight = 0;
+  std::memcpy(&label, v1 + 24, 4);
+  std::memcpy(&weight, v1 + 28, 4);
+  EXPECT_EQ(label, 2);
+  EXPECT_EQ(weight, 0.5f);
+  EXPECT_EQ(uint8_t(v1[32]), 128);                                  // rounded
+  EXPECT_EQ(uint8_t(text[body + 11 + 32]), 0);                      // clamped below
+  EXPECT_EQ(uint8_t(text[body + 11 + 2 * 33 + 32]), 255);           // and above
+  EXPECT_THROW(WritePly(dir / "bad.ply", mesh, {{"label", PlyPropertyType::kInt, {1, 2}}}, "x"), InternalError);
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.ply"));
 }
 
 TEST(PlyIo, ReadsTheBunnyRangeGrid) {
