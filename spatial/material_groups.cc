@@ -455,13 +455,38 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
     }
     group.reconstructed = true;
     group.folder = folder.filename().string();
+    group.material_name = reconstruct.name;
   }
   if (split) {
     ProjectCells(out_dir, truth_map, options, &located, &result);
     if (!result.bases.empty()) {
+      VertexMaterials vertices;
       result.mesh = WriteMaterialMesh(session, result.weights, result.bases, cells.origin, cells.cell_m,
-                                      (std::filesystem::path(out_dir) / "materials.ply").string());
+                                      (std::filesystem::path(out_dir) / "materials.ply").string(), &vertices);
       Log(1, "materials: " + result.mesh.BriefReport());
+      if (result.mesh.written) {
+        // The photo with the most located samples, rendered from the measured groups' pbrt-v4 materials.
+        std::vector<uint64_t> per_photo(session.photos.size(), 0);
+        for (const LocatedSample& s : located) {
+          if (s.sample.image < per_photo.size()) ++per_photo[s.sample.image];
+        }
+        const size_t photo = size_t(std::max_element(per_photo.begin(), per_photo.end()) - per_photo.begin());
+        std::vector<std::string> snippets, names;
+        for (int g : result.bases) {
+          const MaterialGroup& group = result.groups[size_t(g)];
+          snippets.push_back(group.folder + "/" + group.material_name + ".pbrt");
+          names.push_back(group.material_name);
+        }
+        const bool exported = std::all_of(snippets.begin(), snippets.end(), [&](const std::string& snippet) {
+          return std::filesystem::exists(std::filesystem::path(out_dir) / snippet);
+        });
+        if (exported) {
+          result.pbrt = WritePbrtScene(session, photo, vertices, snippets, names, out_dir, options.pbrt);
+        } else {
+          result.pbrt.not_written = "a group has no pbrt-v4 material (its fits were not run: --no-fits)";
+        }
+        Log(1, "materials: " + result.pbrt.BriefReport());
+      }
     }
     const std::string size_bound = "every group that is a material has at least " +
                                    std::to_string(options.min_group_samples) + " samples (--min-group-samples)";
@@ -547,6 +572,7 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
     if (group.blend_of[0] >= 0) entry["blend_of"] = {group.blend_of[0], group.blend_of[1]};
     if (group.reconstructed) {
       entry["folder"] = group.folder;
+      entry["material_name"] = group.material_name;
       entry["summary"] = group.folder + "/summary.json";
       entry["chosen_model"] = group.reconstruction.chosen_model;
       if (group.reconstruction.scored) {
@@ -626,6 +652,22 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
       mesh_json["reason"] = mesh.not_written;
     }
     value["mesh"] = mesh_json;
+    nlohmann::json pbrt_json = {{"written", pbrt.written}};
+    if (pbrt.written) {
+      pbrt_json.update({{"scene", pbrt.file},
+                        {"image", pbrt.image},
+                        {"photo", pbrt.photo},
+                        {"materials", pbrt.materials},
+                        {"faces", pbrt.faces},
+                        {"faces_without_weights", pbrt.faces_unmeasured},
+                        {"undistorted", pbrt.undistorted},
+                        {"render", "cd " + std::filesystem::path(pbrt.file).parent_path().string() + " && pbrt " +
+                                       std::filesystem::path(pbrt.file).filename().string() + " (writes " +
+                                       pbrt.image + " there)"}});
+    } else {
+      pbrt_json["reason"] = pbrt.not_written.empty() ? mesh_json.value("reason", "") : pbrt.not_written;
+    }
+    value["pbrt"] = pbrt_json;
   }
   value["verdicts"] = VerdictsToJson(verdicts);
   if (truth_kind == "map") {

@@ -30,6 +30,7 @@
 #include "core/verdict.h"
 #include "reconstruct/reconstruction_stage.h"
 #include "spatial/material_mesh.h"
+#include "spatial/material_scene.h"
 #include "spatial/material_weights.h"
 
 namespace ibrdf {
@@ -54,6 +55,7 @@ struct MaterialGroupsOptions {
   size_t chunk_rows = 1 << 20;  // samples read (and traced in parallel) per chunk
   // Each cell's weights over the reconstructed materials, and the verdict on the cells none fits.
   MaterialWeightsOptions weights;
+  PbrtSceneOptions pbrt;
 
   bool Check(std::string* why) const;
 };
@@ -64,6 +66,7 @@ struct MaterialGroup {
   std::array<int, 2> blend_of = {-1, -1};
   bool reconstructed = false;
   std::string folder;  // "group-0", relative to the output folder ("" when not reconstructed)
+  std::string material_name;  // its exported materials' name (NAME-group-K)
   ReconstructResult reconstruction;
   int truth_material = -1;  // with a map truth: the material most of its scored samples carry
   std::string truth_name;   // its name in the map ("" without one)
@@ -92,6 +95,8 @@ struct MaterialGroupsResult {
   uint64_t basis_evaluations = 0, basis_fit_evaluations = 0;
   // The mesh with each vertex's weights (out_dir/materials.ply; a mesh sample with more than one group).
   MaterialMeshResult mesh;
+  // A pbrt-v4 scene of the photo with the most samples, rendered from the measured model.
+  PbrtSceneResult pbrt;
   // With a map truth: per fitted cell, half the L1 distance between its weights (normalised to sum 1,
   // each basis counted as its group's majority material) and the truth's mean weights over its samples;
   // the median and 95th percentile over all such cells and over the cells the truth mixes (no material

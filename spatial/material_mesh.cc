@@ -52,7 +52,7 @@ std::string MaterialMeshResult::BriefReport() const {
 
 MaterialMeshResult WriteMaterialMesh(const Session& session, const MaterialWeightsResult& weights,
                                      const std::vector<int>& bases, const Eigen::Vector3d& origin, double cell_m,
-                                     const std::string& path) {
+                                     const std::string& path, VertexMaterials* vertices) {
   MaterialMeshResult result;
   switch (session.sample.kind) {
     case SampleSpec::Kind::kSphere:
@@ -66,7 +66,12 @@ MaterialMeshResult WriteMaterialMesh(const Session& session, const MaterialWeigh
   ScanMesh mesh = ReadTriangleMeshFile(file);
   const size_t n = mesh.points.size();
   for (Eigen::Vector3d& p : mesh.points) p = session.sample.world_from_mesh * p;
+  std::vector<Eigen::Vector3d> normals = std::move(mesh.normals);
   mesh.ClearPointData();
+  if (normals.size() == n) {
+    for (Eigen::Vector3d& normal : normals) normal = session.sample.world_from_mesh.rotation * normal;
+    mesh.normals = std::move(normals);
+  }
 
   std::unordered_map<uint64_t, size_t> cell_of_key;
   CentreCloud centres;
@@ -136,10 +141,24 @@ MaterialMeshResult WriteMaterialMesh(const Session& session, const MaterialWeigh
     }
     for (int k = 0; k < 3; ++k) properties[red + size_t(k)].values[v] = colour[k];
   }
+  if (vertices) {
+    vertices->bases = bases;
+    vertices->weights = Eigen::MatrixXd::Zero(Eigen::Index(n), Eigen::Index(n_bases));
+    vertices->label.assign(n, -1);
+    vertices->fits.assign(n, 0);
+    vertices->from.assign(n, VertexWeightsFrom::kNone);
+    for (size_t v = 0; v < n; ++v) {
+      for (size_t b = 0; b < n_bases; ++b) vertices->weights(Eigen::Index(v), Eigen::Index(b)) = properties[1 + b].values[v];
+      vertices->label[v] = int(properties[0].values[v]);
+      vertices->fits[v] = uint8_t(properties[fits].values[v]);
+      vertices->from[v] = static_cast<VertexWeightsFrom>(uint8_t(properties[from].values[v]));
+    }
+  }
   WritePly(path, mesh, properties,
            "ibrdf materials: the mesh in the world frame (metres) with each vertex's weights over the measured "
            "groups (docs/spatial.md)");
   result.written = true;
+  if (vertices) vertices->mesh = std::move(mesh);
   return result;
 }
 

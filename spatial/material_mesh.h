@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "core/session.h"
+#include "scan/scan_mesh.h"
 #include "spatial/material_weights.h"
 
 namespace ibrdf {
@@ -38,15 +39,28 @@ struct MaterialMeshResult {
   std::string BriefReport() const;
 };
 
+// The vertices' materials as WriteMaterialMesh computed them (for the renderer scenes,
+// material_scene.h).
+struct VertexMaterials {
+  ScanMesh mesh;              // world frame (metres), with the mesh file's normals rotated where it has them
+  std::vector<int> bases;     // the groups of the weights' columns
+  Eigen::MatrixXd weights;    // vertices x bases, each row normalised to sum 1 (zero: no weights)
+  std::vector<int> label;     // the group of the largest weight, -1 none
+  std::vector<uint8_t> fits;  // 1: its cell fits its combination
+  std::vector<VertexWeightsFrom> from;
+};
+
 // Writes `path` (binary PLY, atomically): the session's mesh in the world frame (metres, the frame of
-// the cameras), faces as the mesh file has them, and per vertex: `label` (the group of the largest
+// the cameras), faces as the mesh file has them, its normals (rotated) where it has them, and per
+// vertex: `label` (the group of the largest
 // weight, -1 none), one float `weight_group_K` per basis K of `bases` (normalised to sum 1; 0 none),
 // `residual` (the cell's relative RMS, -1 none), uchar `fits` (1: the cell fits its combination),
 // uchar `weights_from` (VertexWeightsFrom), and red, green, blue (the bases' colours mixed by weight;
 // magenta where the cell fits no combination, grey where none). `origin` and `cell_m` are the cells'
-// grid. Throws Error naming the mesh file when it cannot be read.
+// grid. Fills `vertices` when given and written. Throws Error naming the mesh file when it cannot be
+// read.
 MaterialMeshResult WriteMaterialMesh(const Session& session, const MaterialWeightsResult& weights,
                                      const std::vector<int>& bases, const Eigen::Vector3d& origin, double cell_m,
-                                     const std::string& path);
+                                     const std::string& path, VertexMaterials* vertices = nullptr);
 
 }  // namespace ibrdf

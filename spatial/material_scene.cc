@@ -1,0 +1,213 @@
+#include "spatial/material_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/file_util.h"
+#include "core/kind.h"
+#include "core/logging.h"
+#include "scan/ply_io.h"
+
+namespace ibrdf {
+namespace {
+
+// A face's material: basis `a` alone (amount 0), or pbrt's mix of a and b picking b with `amount`.
+struct FaceMaterial {
+  int a = -1, b = -1;
+  int steps = 0;  // amount = steps * amount_step
+  bool operator<(const FaceMaterial& o) const {
+    return std::tie(a, b, steps) < std::tie(o.a, o.b, o.steps);
+  }
+};
+
+std::string Number(double value) {
+  std::ostringstream out;
+  out.precision(12);
+  out << value;
+  return out.str();
+}
+
+}  // namespace
+
+bool PbrtSceneOptions::Check(std::string* why) const {
+  if (!(amount_step > 0.0 && amount_step <= 0.5)) {
+    *why = "the mixes' amount step must be in (0, 0.5]";
+    return false;
+  }
+  if (samples_per_pixel < 1) {
+    *why = "samples per pixel must be positive";
+    return false;
+  }
+  return true;
+}
+
+std::string PbrtSceneResult::BriefReport() const {
+  if (!written) return "pbrt-v4 scene not written: " + not_written;
+  return file + ": photo " + std::to_string(photo) + ", " + std::to_string(faces) + " faces in " +
+         std::to_string(materials) + " materials (" +
+         Fixed(faces ? 100.0 * double(faces_unmeasured) / double(faces) : 0.0, 1) +
+         " % of faces without weights, black); render: cd " + std::filesystem::path(file).parent_path().string() +
+         " && pbrt " + std::filesystem::path(file).filename().string();
+}
+
+PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const VertexMaterials& vertices,
+                               const std::vector<std::string>& basis_snippets,
+                               const std::vector<std::string>& basis_names, const std::string& out_dir,
+                               const PbrtSceneOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) ThrowError("pbrt scene options", why);
+  PbrtSceneResult result;
+  result.photo = photo;
+  if (photo >= session.photos.size() || !session.photos[photo].camera_from_world) {
+    result.not_written = "photo " + std::to_string(photo) + " has no pose";
+    return result;
+  }
+  result.undistorted = session.camera.HasDistortion();
+  const size_t n_bases = vertices.bases.size();
+  if (basis_snippets.size() != n_bases || basis_names.size() != n_bases || n_bases == 0) {
+    throw InternalError("WritePbrtScene: a snippet and a name per basis");
+  }
+  const ScanMesh& mesh = vertices.mesh;
+
+  // Each face: the mean of its vertices' weights, the two largest renormalised and rounded.
+  std::map<FaceMaterial, std::vector<size_t>> parts;
+  std::vector<size_t> unmeasured;
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    const Eigen::Vector3i& face = mesh.faces[f];
+    Eigen::VectorXd w = Eigen::VectorXd::Zero(Eigen::Index(n_bases));
+    bool measured = true;
+    for (int k = 0; k < 3; ++k) {
+      measured = measured && vertices.from[size_t(face[k])] != VertexWeightsFrom::kNone;
+      w += vertices.weights.row(face[k]).transpose();
+    }
+    if (!measured || !(w.sum() > 0.0)) {
+      unmeasured.push_back(f);
+      continue;
+    }
+    FaceMaterial material;
+    Eigen::Index first = 0;
+    w.maxCoeff(&first);
+    material.a = int(first);
+    double second_weight = 0.0;
+    for (Eigen::Index b = 0; b < w.size(); ++b) {
+      if (b != first && w[b] > second_weight) {
+        second_weight = w[b];
+        material.b = int(b);
+      }
+    }
+    if (material.b >= 0) {
+      material.steps = int(std::lround(second_weight / (w[first] + second_weight) / options.amount_step));
+      if (material.steps == 0) material.b = -1;
+    }
+    parts[material].push_back(f);
+  }
+  result.faces = mesh.faces.size();
+  result.faces_unmeasured = unmeasured.size();
+
+  const std::filesystem::path folder = std::filesystem::path(out_dir) / "pbrt";
+  std::filesystem::create_directories(folder);
+  // One PLY per material: its faces and the vertices they use (normals kept).
+  const auto write_part = [&](const std::vector<size_t>& faces, const std::string& name) {
+    ScanMesh part;
+    std::vector<int> index(mesh.points.size(), -1);
+    const bool normals = mesh.normals.size() == mesh.points.size();
+    for (size_t f : faces) {
+      Eigen::Vector3i face;
+      for (int k = 0; k < 3; ++k) {
+        int& at = index[size_t(mesh.faces[f][k])];
+        if (at < 0) {
+          at = int(part.points.size());
+          part.points.push_back(mesh.points[size_t(mesh.faces[f][k])]);
+          if (normals) part.normals.push_back(mesh.normals[size_t(mesh.faces[f][k])]);
+        }
+        face[k] = at;
+      }
+      part.faces.push_back(face);
+    }
+    WritePly((folder / name).string(), part, {}, "ibrdf materials: part of the mesh in one material (world frame, metres)");
+  };
+
+  const Camera& camera = session.camera;
+  const Rigid3d& camera_from_world = *session.photos[photo].camera_from_world;
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topLeftCorner<3, 3>() = camera_from_world.rotation.toRotationMatrix();
+  m.topRightCorner<3, 1>() = camera_from_world.translation;
+  const double fx = camera.FocalX(), fy = camera.FocalY(), cx = camera.PrincipalX(), cy = camera.PrincipalY();
+  const double w = double(camera.width), h = double(camera.height);
+
+  std::ostringstream scene;
+  scene << "# pbrt-v4: photo " << photo << " of " << session.manifest_path
+        << " rendered from ibrdf's measured spatially varying model\n"
+        << "# (each face a mix of the two groups of the largest weights, amounts in steps of "
+        << Number(options.amount_step) << "; faces without weights black).\n"
+        << "# The light has unit intensity: a pixel over (cos theta_i / r^2) of its point is the rendered BRDF.\n"
+        << (result.undistorted ? "# The photo's lens distortion is not rendered (pbrt-v4's perspective camera has none): photo "
+                                 "pixel p is\n# rendered at (fx x + cx, fy y + cy), (x, y) the undistorted image-plane point of p.\n"
+                               : "")
+        << "Film \"rgb\" \"integer xresolution\" [ " << camera.width << " ] \"integer yresolution\" [ "
+        << camera.height << " ]\n    \"string filename\" \"photo-" << photo << ".exr\" \"bool savefp16\" false\n"
+        << "PixelFilter \"box\" \"float xradius\" [ 0.5 ] \"float yradius\" [ 0.5 ]\n"
+        << "Sampler \"zsobol\" \"integer pixelsamples\" [ " << options.samples_per_pixel << " ]\n"
+        << "Integrator \"path\" \"integer maxdepth\" [ 1 ]\n"
+        << "# The photo's camera_from_world, y flipped: pbrt's camera looks down +z with +y up, the photo's y is down.\n"
+        << "Scale 1 -1 1\nConcatTransform [";
+  for (int col = 0; col < 4; ++col) {
+    for (int row = 0; row < 4; ++row) scene << " " << Number(m(row, col));
+  }
+  // fov 90: screen coordinates are x / z and y / z; the window puts pixel (cx, cy) on the axis.
+  scene << " ]\nCamera \"perspective\" \"float fov\" [ 90 ] \"float screenwindow\" [ " << Number(-cx / fx) << " "
+        << Number((w - cx) / fx) << " " << Number((cy - h) / fy) << " " << Number(cy / fy) << " ]\n"
+        << "WorldBegin\n";
+  const Light& light = session.lights[session.photos[photo].light];
+  switch (light.kind) {
+    case Light::Kind::kPoint:
+      scene << "LightSource \"point\" \"point3 from\" [ " << Number(light.position.x()) << " "
+            << Number(light.position.y()) << " " << Number(light.position.z()) << " ]\n";
+      break;
+    case Light::Kind::kDirectional:
+      scene << "LightSource \"distant\" \"point3 from\" [ " << Number(light.direction.x()) << " "
+            << Number(light.direction.y()) << " " << Number(light.direction.z()) << " ] \"point3 to\" [ 0 0 0 ]\n";
+      break;
+  }
+  for (size_t b = 0; b < n_bases; ++b) scene << "Include \"../" << basis_snippets[b] << "\"\n";
+  scene << "MakeNamedMaterial \"unmeasured\" \"string type\" \"diffuse\" \"rgb reflectance\" [ 0 0 0 ]\n";
+  int part = 0;
+  for (const auto& [material, faces] : parts) {
+    std::string name = basis_names[size_t(material.a)];
+    if (material.b >= 0) {
+      const double amount = material.steps * options.amount_step;
+      name = "mix-" + std::to_string(vertices.bases[size_t(material.a)]) + "-" +
+             std::to_string(vertices.bases[size_t(material.b)]) + "-" + Fixed(amount, 2);
+      scene << "MakeNamedMaterial \"" << name << "\" \"string type\" \"mix\"\n    \"string materials\" [ \""
+            << basis_names[size_t(material.a)] << "\" \"" << basis_names[size_t(material.b)]
+            << "\" ] \"float amount\" " << Number(amount) << "\n";
+    }
+    const std::string file = "part-" + std::to_string(part++) + ".ply";
+    write_part(faces, file);
+    scene << "AttributeBegin\n  NamedMaterial \"" << name << "\"\n  Shape \"plymesh\" \"string filename\" \"" << file
+          << "\"\nAttributeEnd\n";
+  }
+  result.materials = n_bases + int(std::count_if(parts.begin(), parts.end(),
+                                                 [](const auto& p) { return p.first.b >= 0; }));
+  if (!unmeasured.empty()) {
+    write_part(unmeasured, "unmeasured.ply");
+    scene << "AttributeBegin\n  NamedMaterial \"unmeasured\"\n  Shape \"plymesh\" \"string filename\" \"unmeasured.ply\"\n"
+          << "AttributeEnd\n";
+  }
+  result.file = "pbrt/photo-" + std::to_string(photo) + ".pbrt";
+  result.image = "photo-" + std::to_string(photo) + ".exr";
+  const std::string path = (std::filesystem::path(out_dir) / result.file).string();
+  std::ofstream out(path);
+  out << scene.str();
+  out.close();
+  if (!out) ThrowError(path, "write failed (disk full?)");
+  result.written = true;
+  return result;
+}
+
+}  // namespace ibrdf
