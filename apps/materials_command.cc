@@ -55,6 +55,10 @@ IBRDF_COMMAND(57, Materials) {
                 "materials.json")
       ->delimiter(',')
       ->type_name("CHECK[,CHECK...]");
+  AddOption(*c, "--photo", args->options.photo,
+            "The photo predicted from the model and written as a pbrt-v4 scene (-1: the one with the most samples)");
+  c->add_flag("--hold-out", args->options.hold_out,
+              "Leave --photo's samples out of the groups, reconstructions and weights: a held-out prediction");
   AddClearingFlag(*c, "--no-fits", r.fits, "Skip each group's Lafortune and GGX fits");
   AddClearingFlag(*c, "--no-bsdf", r.bsdf, "Skip each group's NAME.bsdf");
   c->add_option("--name", r.name, "Name of the groups' materials (NAME-group-K; default: material-group-K)");

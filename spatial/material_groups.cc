@@ -22,6 +22,7 @@
 #include "core/merl_brdf.h"
 #include "core/statistics.h"
 #include "core/sample_file.h"
+#include "spatial/material_render.h"
 #include "spatial/surface_points.h"
 #include "spatial/uniformity.h"
 #include "synth/material_map.h"
@@ -200,9 +201,10 @@ class TableOrFit : public BrdfModel {
 // Every cell of `located` as a combination of the reconstructed groups (their tables and fits, read back
 // from `out_dir`), and with a map truth the weights scored against the truth's.
 void ProjectCells(const std::string& out_dir, const MaterialMap* truth_map, const MaterialGroupsOptions& options,
-                  std::vector<LocatedSample>* located, MaterialGroupsResult* result) {
-  std::vector<std::unique_ptr<TableOrFit>> tables;
-  std::vector<const BrdfModel*> bases;
+                  std::vector<LocatedSample>* located, MaterialGroupsResult* result,
+                  std::vector<std::unique_ptr<TableOrFit>>* tables_out, std::vector<const BrdfModel*>* bases_out) {
+  std::vector<std::unique_ptr<TableOrFit>>& tables = *tables_out;
+  std::vector<const BrdfModel*>& bases = *bases_out;
   for (size_t g = 0; g < result->groups.size(); ++g) {
     const MaterialGroup& group = result->groups[g];
     if (!group.reconstructed) continue;
@@ -269,6 +271,11 @@ bool MaterialGroupsOptions::Check(std::string* why) const {
     *why = "neighbours must be 1 to 64";
     return false;
   }
+  if (hold_out && photo < 0) {
+    *why = "a held-out photo must be named (--photo N)";
+    return false;
+  }
+  if (!weights.Check(why) || !pbrt.Check(why)) return false;
   return true;
 }
 
@@ -289,7 +296,7 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
   result.confusion.assign(std::max(cells.groups, 0), std::vector<uint64_t>(n_truth, 0));
   // With groups: every located sample, its cell and group (each group's reconstruction takes its own,
   // and every cell is projected onto the reconstructed groups).
-  std::vector<LocatedSample> located;
+  std::vector<LocatedSample> located, held;
   std::vector<uint64_t> group_samples(std::max(cells.groups, 0), 0);
 
   // One group: the object's own reconstruction is the group's; the samples are only counted.
@@ -305,6 +312,7 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
       off_peak.assign(count, OffPeakSample{});
       tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 4096), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t i = range.begin(); i < range.end(); ++i) {
+          if (options.hold_out && rows[i].image == uint32_t(options.photo)) continue;
           const int group = OffPeakGroup(rows[i], cells, log_purity);
           if (group == kOnPeak) continue;
           Eigen::Vector3d point;
@@ -369,6 +377,12 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
           const Placed& p = placed[i];
           if (p.group == kNotLocated) {
             ++result.not_located;
+            continue;
+          }
+          if (options.hold_out && rows[i].image == uint32_t(options.photo)) {
+            // Held out: predicted from the model the other photos make, counted in no group.
+            held.push_back(LocatedSample{rows[i], p.point, -1, p.key});
+            ++result.held_out;
             continue;
           }
           if (split) located.push_back(LocatedSample{rows[i], p.point, int8_t(p.group), p.key});
@@ -458,19 +472,32 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
     group.material_name = reconstruct.name;
   }
   if (split) {
-    ProjectCells(out_dir, truth_map, options, &located, &result);
+    std::vector<std::unique_ptr<TableOrFit>> tables;
+    std::vector<const BrdfModel*> bases;
+    ProjectCells(out_dir, truth_map, options, &located, &result, &tables, &bases);
+    // The photo to predict: the one given, else the one with the most located samples.
+    size_t photo = options.photo >= 0 ? size_t(options.photo) : 0;
+    if (options.photo < 0) {
+      std::vector<uint64_t> per_photo(session.photos.size(), 0);
+      for (const LocatedSample& s : located) {
+        if (s.sample.image < per_photo.size()) ++per_photo[s.sample.image];
+      }
+      photo = size_t(std::max_element(per_photo.begin(), per_photo.end()) - per_photo.begin());
+    }
     if (!result.bases.empty()) {
+      std::unique_ptr<BrdfModel> single;
+      const std::string single_path = uniformity.value("brdf", "");
+      if (!single_path.empty() && std::filesystem::exists(single_path)) single = std::make_unique<MerlBrdf>(single_path);
+      result.prediction = PredictPhoto(session, photo, options.hold_out, options.hold_out ? held : located,
+                                       result.weights, bases, cells.origin, cells.cell_m, single.get(), truth_map,
+                                       out_dir);
+      Log(1, "materials: " + result.prediction.BriefReport());
       VertexMaterials vertices;
       result.mesh = WriteMaterialMesh(session, result.weights, result.bases, cells.origin, cells.cell_m,
                                       (std::filesystem::path(out_dir) / "materials.ply").string(), &vertices);
       Log(1, "materials: " + result.mesh.BriefReport());
       if (result.mesh.written) {
-        // The photo with the most located samples, rendered from the measured groups' pbrt-v4 materials.
-        std::vector<uint64_t> per_photo(session.photos.size(), 0);
-        for (const LocatedSample& s : located) {
-          if (s.sample.image < per_photo.size()) ++per_photo[s.sample.image];
-        }
-        const size_t photo = size_t(std::max_element(per_photo.begin(), per_photo.end()) - per_photo.begin());
+        // The photo predicted below, rendered from the measured groups' pbrt-v4 materials.
         std::vector<std::string> snippets, names;
         for (int g : result.bases) {
           const MaterialGroup& group = result.groups[size_t(g)];
@@ -561,6 +588,7 @@ std::string MaterialGroupsResult::BriefReport() const {
               " mixed cells)";
     }
   }
+  if (prediction.done) text += "; " + prediction.BriefReport();
   return text + "; " + Fixed(seconds, 1) + " s";
 }
 
@@ -593,7 +621,8 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
                             {"off_peak", off_peak_samples},
                             {"mixed", mixed},
                             {"mixed_away_from_boundaries", mixed_scored},
-                            {"ungrouped", ungrouped}}},
+                            {"ungrouped", ungrouped},
+                            {"held_out", held_out}}},
                           {"groups", list},
                           {"truth", truth_kind.empty() ? nlohmann::json(nullptr) : nlohmann::json(truth_kind)},
                           {"timings_s", {{"total", seconds}}}};
@@ -668,6 +697,7 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
       pbrt_json["reason"] = pbrt.not_written.empty() ? mesh_json.value("reason", "") : pbrt.not_written;
     }
     value["pbrt"] = pbrt_json;
+    if (prediction.done) value["prediction"] = prediction.ToJson();
   }
   value["verdicts"] = VerdictsToJson(verdicts);
   if (truth_kind == "map") {

@@ -30,6 +30,7 @@
 #include "core/verdict.h"
 #include "reconstruct/reconstruction_stage.h"
 #include "spatial/material_mesh.h"
+#include "spatial/material_render.h"
 #include "spatial/material_scene.h"
 #include "spatial/material_weights.h"
 
@@ -56,6 +57,10 @@ struct MaterialGroupsOptions {
   // Each cell's weights over the reconstructed materials, and the verdict on the cells none fits.
   MaterialWeightsOptions weights;
   PbrtSceneOptions pbrt;
+  // The photo predicted from the model (and rendered in the pbrt-v4 scene): -1, the one with the most
+  // samples. With hold_out its samples take no part in the grouping, reconstructions and weights.
+  int photo = -1;
+  bool hold_out = false;
 
   bool Check(std::string* why) const;
 };
@@ -97,6 +102,9 @@ struct MaterialGroupsResult {
   MaterialMeshResult mesh;
   // A pbrt-v4 scene of the photo with the most samples, rendered from the measured model.
   PbrtSceneResult pbrt;
+  // That photo's samples predicted from the model, beside the one BRDF and the truth.
+  PhotoPrediction prediction;
+  uint64_t held_out = 0;  // located samples of a held-out photo (in no group)
   // With a map truth: per fitted cell, half the L1 distance between its weights (normalised to sum 1,
   // each basis counted as its group's majority material) and the truth's mean weights over its samples;
   // the median and 95th percentile over all such cells and over the cells the truth mixes (no material

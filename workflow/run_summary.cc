@@ -134,6 +134,20 @@ void AddMaterials(const fs::path& dir, nlohmann::json* summary) {
     if (weights.contains("truth")) w["truth"] = weights["truth"];
     materials["weights"] = w;
   }
+  const nlohmann::json prediction = m->ValueOr("/prediction", nlohmann::json());
+  if (prediction.is_object()) {
+    materials["prediction"] = {
+        {"photo", prediction.value("photo", 0)},
+        {"held_out", prediction.value("held_out", false)},
+        {"model_median_abs_rel_error", prediction.value("model_median_abs_rel_error_all", nlohmann::json())},
+        {"single_brdf_median_abs_rel_error", prediction.value("single_brdf_median_abs_rel_error_all", nlohmann::json())},
+        {"truth_median_abs_rel_error", prediction.value("truth_median_abs_rel_error_all", nlohmann::json())},
+        {"image", prediction.value("image", nlohmann::json())}};
+  }
+  for (const char* file : {"mesh", "pbrt"}) {
+    const nlohmann::json part = m->ValueOr(std::string("/") + file, nlohmann::json());
+    if (part.is_object()) materials[file] = part;
+  }
   (*summary)["materials"] = materials;
 }
 

@@ -215,6 +215,37 @@ TEST(SynthMaterialMapCli, RecipeWithAMapStopsAtUniformityAndRunsWhenAccepted) {
     if (verdict.value("stage", "") == "materials") checks.insert(verdict.value("check", ""));
   }
   EXPECT_EQ(checks, (std::set<std::string>{"materials.measured", "materials.cells"})) << with.at("verdicts").dump(2);
+  // The photo with the most samples predicted from the model, far closer than the one average BRDF.
+  const nlohmann::json& prediction = with.at("materials").at("prediction");
+  EXPECT_FALSE(prediction.at("held_out").get<bool>());
+  ASSERT_TRUE(prediction.at("image").is_string()) << prediction.dump(2);
+  EXPECT_TRUE(fs::exists(dir / ("r/materials/" + prediction.at("image").get<std::string>())));
+  EXPECT_LT(2.0 * prediction.at("model_median_abs_rel_error").get<double>(),
+            prediction.at("single_brdf_median_abs_rel_error").get<double>())
+      << prediction.dump(2);
+
+  // A held-out photo: its samples are in no group (too few photos are left here to fit cells).
+  const auto held = RunIbrdf("materials " + (dir / "r/samples.npy") + " --uniformity " +
+                                 (dir / "r/uniformity/uniformity.json") + " --photo 1 --hold-out --no-fits --no-bsdf" +
+                                 " --min-group-samples 100 --accept all --out " + (dir / "held"),
+                             /*quiet=*/true);
+  ASSERT_EQ(held.exit_code, 0) << held.output;
+  const nlohmann::json held_json = ReadJsonFile(dir / "held/materials.json");
+  const nlohmann::json& counts = held_json.at("samples");
+  EXPECT_GT(counts.at("held_out").get<uint64_t>(), 0u) << counts.dump();
+  uint64_t in_groups = 0;
+  for (const nlohmann::json& group : held_json.at("groups")) in_groups += group.at("samples").get<uint64_t>();
+  EXPECT_EQ(in_groups + counts.at("mixed").get<uint64_t>() + counts.at("ungrouped").get<uint64_t>() +
+                counts.at("not_located").get<uint64_t>() + counts.at("held_out").get<uint64_t>(),
+            counts.at("rows").get<uint64_t>())
+      << counts.dump();
+  EXPECT_TRUE(held_json.at("prediction").at("held_out").get<bool>());
+  EXPECT_EQ(held_json.at("prediction").at("photo"), 1);
+  EXPECT_NE(RunIbrdf("materials " + (dir / "r/samples.npy") + " --uniformity " + (dir / "r/uniformity/uniformity.json") +
+                         " --hold-out --out " + (dir / "held2"),
+                     /*quiet=*/true)
+                .output.find("a held-out photo must be named (--photo N)"),
+            std::string::npos);
   EXPECT_NE(spatial.output.find("labels right on"), std::string::npos) << spatial.output;
 }
 
