@@ -1087,7 +1087,9 @@ def uniformity_html(run_dir):
 
 def materials_html(run_dir):
     """With `run --spatial` (materials/materials.json, docs/spatial.md): each group of cells measured as a material of
-    its own, the blends and the samples in no basis, and the scores against a synthetic truth."""
+    its own, the blends and the samples in no basis, each cell's weights over the groups, the verdicts, one photo
+    predicted from the model (with its picture), the mesh and pbrt-v4 outputs, and the scores against a synthetic
+    truth."""
     m = load_json(os.path.join(run_dir, "materials", "materials.json"))
     if not m:
         return ""
@@ -1107,14 +1109,53 @@ def materials_html(run_dir):
     labels = m.get("labels")
     score = (f" Against the synthetic map: labels right on {100 * labels['right_fraction']:.1f} % of "
              f"{labels['scored_samples']} samples away from its boundaries." if labels else "")
-    return (f"<h3>Materials (run --spatial)</h3>\n<p>Each group measured as a material of its own; "
+    text = (f"<h3>Materials (run --spatial)</h3>\n<p>Each group measured as a material of its own; "
             f"{counts.get('mixed', 0)} of {counts.get('rows', 0)} samples lie on a boundary or in a blend and are in no "
             f"group's reconstruction.{score} The BRDF above is still the whole object's average.</p>\n"
             f"<table><tr><th>group</th><th>samples</th><th>measured as</th></tr>{''.join(rows)}</table>\n")
+    w = m.get("weights")
+    if w:
+        truth = w.get("truth")
+        text += (f"<p>Each surface cell as a non-negative combination of groups {', '.join(str(b) for b in w['bases'])} "
+                 f"(Lensch et al. 2003's projection): {w['cells_fitted']} cells fitted, "
+                 f"{100 * w['not_fitting_fraction']:.1f} % fit no combination (materials.json's weights.cell_list), "
+                 f"median residual {100 * w['median_rel_rms']:.1f} %"
+                 + (f"; the weights are off the truth's by {100 * truth['error_median']:.1f} % median "
+                    f"({100 * truth['mixed_error_median']:.1f} % in {truth['mixed_cells']} mixed cells)" if truth else "")
+                 + ".</p>\n")
+    for v in m.get("verdicts", []):
+        text += (f"<p>materials {html.escape(v['check'])}: <b>{html.escape(v['verdict'])}</b>"
+                 + (" (accepted by the user)" if v.get("accepted") else "")
+                 + f": {html.escape(v.get('measured', ''))}; bound: {html.escape(v.get('bound', ''))}</p>\n")
+    p = m.get("prediction")
+    if p:
+        def pct(x):
+            return "n/a" if x is None else f"{100 * x:.1f} %"
+        text += (f"<p>Photo {p['photo']} {'held out of this stage' if p['held_out'] else '(in the measurement)'} "
+                 f"predicted from the model: {p['predicted']} of {p['samples']} samples, median |model / measured - 1| "
+                 f"{pct(p['model_median_abs_rel_error_all'])}; the one average BRDF "
+                 f"{pct(p['single_brdf_median_abs_rel_error_all'])}; the truth {pct(p['truth_median_abs_rel_error_all'])}"
+                 f".</p>\n")
+        image = os.path.join(run_dir, "materials", p["image"]) if p.get("image") else None
+        if image and os.path.exists(image):
+            with open(image, "rb") as f:
+                text += (f'<figure><img src="data:image/png;base64,{base64.b64encode(f.read()).decode("ascii")}" '
+                         f'alt="{html.escape(p["image"])}" style="max-width:960px"><figcaption>photo {p["photo"]}; the '
+                         f'photo as the model renders its sample pixels (model / measured times the photo); the ratio '
+                         f'(red: the model brighter, blue: darker, full colour at 1.5x) (materials/{html.escape(p["image"])})'
+                         f'</figcaption></figure>\n')
+    for key, what in (("mesh", "the mesh with each vertex's weights"), ("pbrt", "a pbrt-v4 scene of the photo")):
+        part = m.get(key, {})
+        if part.get("written"):
+            name = part.get("file") or part.get("scene")
+            text += f"<p>{what}: materials/{html.escape(name)}</p>\n"
+        elif part:
+            text += f"<p>{what}: not written ({html.escape(part.get('reason', ''))})</p>\n"
+    return text
 
 
 def notices_html(run_dir, side):
-    """Every calibration verdict that is not ok (response, align, lights white, colour, uniformity), the stages' warnings and the
+    """Every calibration verdict that is not ok (response, align, lights white, colour, uniformity, materials), the stages' warnings and the
     samples' scale, at the top of the report: what the run could not trust, or had to be told."""
     items = []
     if side.get("intensity_scale") == "relative":
@@ -1125,7 +1166,8 @@ def notices_html(run_dir, side):
     stage_jsons = [("response", load_json(os.path.join(run_dir, "response", "response.json")) or {}), ("align", align),
                    ("lights", load_json(os.path.join(run_dir, "lights", "white-reference.json")) or {}),
                    ("colour", load_json(os.path.join(run_dir, "colour", "colour.json")) or {}),
-                   ("uniformity", load_json(os.path.join(run_dir, "uniformity", "uniformity.json")) or {})]
+                   ("uniformity", load_json(os.path.join(run_dir, "uniformity", "uniformity.json")) or {}),
+                   ("materials", load_json(os.path.join(run_dir, "materials", "materials.json")) or {})]
     for stage, stage_json in stage_jsons:
         for v in stage_json.get("verdicts", []):
             if v.get("verdict") == "ok":
