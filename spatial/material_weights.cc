@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/logging.h"
 #include "core/statistics.h"
+#include "spatial/uniformity.h"
 
 namespace ibrdf {
 namespace {
@@ -98,27 +99,21 @@ void FitCell(const LocatedSample* begin, const LocatedSample* end, const std::ve
   cell->dominant = int(dominant);
   const Eigen::VectorXd fit = a * cell->weights;
   cell->rel_rms = std::sqrt((fit - b).squaredNorm() / double(n_rows));
-  // Per channel: the median of sample / combination and its standard error (1.4826 MAD is a sigma; the
-  // median of n values has sqrt(pi / 2) / sqrt(n) of it), as the uniformity check judges a cell.
-  const double log_bound = std::log1p(options.deviation);
+  // Per channel: the median of sample / combination and its standard error, judged as the uniformity
+  // check judges a cell (spatial/uniformity.h), against 1.
   cell->fits = true;
   for (int k = 0; k < 3; ++k) {
     if (per_channel[k] < options.min_cell_samples) continue;
-    std::vector<double> ratios, deviations;
+    std::vector<float> ratios;
     for (Eigen::Index i = 0; i < n_rows; ++i) {
-      if (channel[size_t(i)] == k && fit[i] > 0.0) ratios.push_back(b[i] / fit[i]);
+      if (channel[size_t(i)] == k && fit[i] > 0.0) ratios.push_back(float(b[i] / fit[i]));
     }
     if (ratios.size() < size_t(options.min_cell_samples)) {
       cell->fits = false;  // the combination is zero where the samples are not: nothing spans them
       continue;
     }
-    const double median = PercentileInPlace(&ratios, 0.5);
-    for (double r : ratios) deviations.push_back(std::abs(r - median));
-    const double noise = 1.4826 * PercentileInPlace(&deviations, 0.5) * 1.2533 / std::sqrt(double(ratios.size()));
-    cell->ratio[k] = median;
-    cell->noise[k] = noise;
-    const bool off = !(std::abs(std::log(std::max(median, 1e-12))) <= log_bound);
-    if (off && std::abs(median - 1.0) > options.noise_sigmas * noise) cell->fits = false;
+    MedianAndStandardError(&ratios, &cell->ratio[k], &cell->noise[k]);
+    if (RatioDeviates(cell->ratio[k], 1.0, cell->noise[k], options.deviation, options.noise_sigmas)) cell->fits = false;
   }
 }
 

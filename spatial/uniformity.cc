@@ -112,6 +112,19 @@ uint64_t UniformityCellKey(const Eigen::Vector3d& point, const Eigen::Vector3d& 
   return key;
 }
 
+void MedianAndStandardError(std::vector<float>* values, double* median, double* standard_error) {
+  *median = PercentileInPlace(values, 0.5);
+  std::vector<float> deviations(values->size());
+  for (size_t i = 0; i < values->size(); ++i) deviations[i] = float(std::abs((*values)[i] - *median));
+  *standard_error = 1.4826 * PercentileInPlace(&deviations, 0.5) * 1.2533 / std::sqrt(double(values->size()));
+}
+
+bool RatioDeviates(double ratio, double reference, double noise, double deviation, double noise_sigmas) {
+  const double relative = ratio / reference;
+  const bool off = !(std::abs(std::log(std::max(relative, 1e-12))) <= std::log1p(deviation));
+  return off && std::abs(ratio - reference) > noise_sigmas * noise;
+}
+
 bool UniformityOptions::Check(std::string* why) const {
   if (!clusters.Check(why)) return false;
   if (!(cell_m >= 0.0)) {
@@ -255,21 +268,14 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
     out.key = keys[cell];
     out.samples = located_in_cell[cell];
     out.centre = point_sums[cell] / double(located_in_cell[cell]);
-    std::vector<float> values, deviations;
+    std::vector<float> values;
     for (int k = 0; k < 3; ++k) {
       values.clear();
       for (size_t i = begin[cell]; i < begin[cell + 1]; ++i) {
         if (std::isfinite(grouped[i * 3 + k])) values.push_back(grouped[i * 3 + k]);
       }
       if (values.size() < size_t(options.min_cell_samples)) continue;
-      const double median = PercentileInPlace(&values, 0.5);
-      deviations.resize(values.size());
-      for (size_t i = 0; i < values.size(); ++i) deviations[i] = float(std::abs(values[i] - median));
-      // The median's standard error from the cell's own scatter: 1.4826 MAD is a sigma, the median of n
-      // values has sqrt(pi / 2) / sqrt(n) of it.
-      const double mad = PercentileInPlace(&deviations, 0.5);
-      out.ratio[k] = median;
-      out.noise[k] = 1.4826 * mad * 1.2533 / std::sqrt(double(values.size()));
+      MedianAndStandardError(&values, &out.ratio[k], &out.noise[k]);
       values.clear();
       for (size_t i = begin[cell]; i < begin[cell + 1]; ++i) {
         if (std::isfinite(off_peak_value[i * 3 + k])) values.push_back(off_peak_value[i * 3 + k]);
@@ -288,7 +294,6 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
   for (int k = 0; k < 3; ++k) {
     if (!per_channel[k].empty()) result.object_ratio[k] = Median(per_channel[k]);
   }
-  const double log_bound = std::log1p(options.deviation);
   std::vector<double> relative[3];
   double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
   for (UniformityCell& cell : result.cells) {
@@ -300,9 +305,9 @@ UniformityResult MeasureUniformity(const Session& session, const std::string& sa
       relative[k].push_back(r);
       lo = std::min(lo, r);
       hi = std::max(hi, r);
-      const bool off = !(std::abs(std::log(std::max(r, 1e-12))) <= log_bound);
-      const bool beyond_noise = std::abs(cell.ratio[k] - result.object_ratio[k]) > options.noise_sigmas * cell.noise[k];
-      if (off && beyond_noise) cell.deviates = true;
+      if (RatioDeviates(cell.ratio[k], result.object_ratio[k], cell.noise[k], options.deviation, options.noise_sigmas)) {
+        cell.deviates = true;
+      }
     }
     if (scored) ++result.cells_scored;
     if (cell.deviates) ++result.cells_deviating;

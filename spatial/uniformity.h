@@ -103,6 +103,15 @@ struct UniformityResult {
 // uniformity.json's "key" hold them.
 uint64_t UniformityCellKey(const Eigen::Vector3d& point, const Eigen::Vector3d& origin, double cell_m);
 
+// The median of `values` (reordered) and that median's standard error from their own scatter: 1.4826
+// MAD is a sigma, and the median of n values has sqrt(pi / 2) / sqrt(n) of it. `values` not empty.
+void MedianAndStandardError(std::vector<float>* values, double* median, double* standard_error);
+
+// Whether a cell's ratio deviates from `reference`: by more than the factor 1 + deviation either way and
+// by more than noise_sigmas of its standard error `noise` (the uniformity check's test, and the
+// materials stage's for a cell against its combination of the groups).
+bool RatioDeviates(double ratio, double reference, double noise, double deviation, double noise_sigmas);
+
 // Measures the session's samples (the file at `samples_path`) against `reference`, the BRDF
 // reconstructed from them. Throws Error naming the file for unreadable samples, and naming the session
 // when most samples cannot be located on its surface (not this session's samples).
