@@ -1,13 +1,17 @@
 // The mesh with each vertex's material: a vertex takes its own cell's weights, else the nearest fitted
 // cell's within 1.5 cell edges, else none, in the world frame of the session's world_from_mesh; an
-// analytic sample writes nothing and says why.
+// analytic sample writes nothing and says why; OpenMesh's PLY reader reads the file with its colours.
 #include "spatial/material_mesh.h"
 
+// OpenMesh's property containers trip GCC 12's -Wmaybe-uninitialized (as in scan/openmesh_adapters.cc).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <gtest/gtest.h>
 
 #include "scan/ply_io.h"
@@ -113,6 +117,21 @@ TEST(MaterialMesh, VerticesTakeTheirCellsWeightsInTheWorldFrame) {
   EXPECT_EQ(v[4].label, 0);
   EXPECT_EQ(v[4].rgb[0], 255);  // magenta: fits no combination
   EXPECT_EQ(v[4].rgb[1], 0);
+
+  // A reader nobody here wrote (OpenMesh's PLY reader) takes the file with its colours.
+  OpenMesh::TriMesh_ArrayKernelT<> om;
+  om.request_vertex_colors();
+  OpenMesh::IO::Options options = OpenMesh::IO::Options::VertexColor;
+  ASSERT_TRUE(OpenMesh::IO::read_mesh(om, dir / "materials.ply", options));
+  EXPECT_EQ(om.n_vertices(), 5u);
+  EXPECT_EQ(om.n_faces(), 2u);
+  ASSERT_TRUE(options.check(OpenMesh::IO::Options::VertexColor));
+  const auto magenta = om.color(OpenMesh::VertexHandle(4)), grey = om.color(OpenMesh::VertexHandle(3));
+  EXPECT_EQ(int(magenta[0]), 255);
+  EXPECT_EQ(int(magenta[1]), 0);
+  EXPECT_EQ(int(magenta[2]), 255);
+  EXPECT_EQ(int(grey[1]), 128);
+  EXPECT_NEAR(om.point(OpenMesh::VertexHandle(0))[0], 0.011, 1e-6);
 
   session.sample.kind = SampleSpec::Kind::kSphere;
   const MaterialMeshResult sphere =
