@@ -286,6 +286,11 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
   std::string why;
   if (!options.Check(&why)) ThrowError("material groups options", why);
   if (truth_map && !truth_file.empty()) ThrowError(truth_file, "a map truth and a material truth together");
+  if (options.photo >= 0 && size_t(options.photo) >= session.photos.size()) {
+    ThrowError(session.manifest_path, "photo " + std::to_string(options.photo) + " to predict: the session has " +
+                                          std::to_string(session.photos.size()) + " photos (0 to " +
+                                          std::to_string(int(session.photos.size()) - 1) + ")");
+  }
   const auto start = std::chrono::steady_clock::now();
   const GroupedCells cells = ReadGroupedCells(uniformity, uniformity_path);
   const SurfaceLocator locator(session);

@@ -246,6 +246,12 @@ TEST(SynthMaterialMapCli, RecipeWithAMapStopsAtUniformityAndRunsWhenAccepted) {
                      /*quiet=*/true)
                 .output.find("a held-out photo must be named (--photo N)"),
             std::string::npos);
+  EXPECT_NE(RunIbrdf("materials " + (dir / "r/samples.npy") + " --uniformity " + (dir / "r/uniformity/uniformity.json") +
+                         " --photo 99 --out " + (dir / "held3"),
+                     /*quiet=*/true)
+                .output.find("photo 99 to predict: the session has 4 photos (0 to 3)"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "held3"));
   EXPECT_NE(spatial.output.find("labels right on"), std::string::npos) << spatial.output;
 }
 
