@@ -124,15 +124,7 @@ bool MaterialWeightsOptions::Check(std::string* why) const {
     *why = "a cell needs at least 3 samples to be fitted";
     return false;
   }
-  if (!(deviation > 0.0) || !(noise_sigmas >= 0.0)) {
-    *why = "the deviation must be positive and the noise sigmas at least 0";
-    return false;
-  }
-  if (!(warn_fraction > 0.0 && warn_fraction <= fail_fraction && fail_fraction <= 1.0)) {
-    *why = "the warn and fail fractions must satisfy 0 < warn <= fail <= 1";
-    return false;
-  }
-  return true;
+  return CheckDeviationBound(deviation, noise_sigmas, warn_fraction, fail_fraction, why);
 }
 
 MaterialWeightsResult ProjectOntoBases(std::vector<LocatedSample>* samples, const std::vector<const BrdfModel*>& bases,

@@ -125,6 +125,19 @@ bool RatioDeviates(double ratio, double reference, double noise, double deviatio
   return off && std::abs(ratio - reference) > noise_sigmas * noise;
 }
 
+bool CheckDeviationBound(double deviation, double noise_sigmas, double warn_fraction, double fail_fraction,
+                         std::string* why) {
+  if (!(deviation > 0.0) || !(noise_sigmas >= 0.0)) {
+    *why = "the deviation must be positive and the noise sigmas at least 0";
+    return false;
+  }
+  if (!(warn_fraction > 0.0 && warn_fraction <= fail_fraction && fail_fraction <= 1.0)) {
+    *why = "need 0 < warn fraction <= fail fraction <= 1";
+    return false;
+  }
+  return true;
+}
+
 bool UniformityOptions::Check(std::string* why) const {
   if (!clusters.Check(why)) return false;
   if (!(cell_m >= 0.0)) {
@@ -135,14 +148,7 @@ bool UniformityOptions::Check(std::string* why) const {
     *why = "a cell needs at least 3 samples to be scored";
     return false;
   }
-  if (!(deviation > 0.0) || !(noise_sigmas >= 0.0)) {
-    *why = "the deviation must be positive and the noise sigmas at least 0";
-    return false;
-  }
-  if (!(warn_fraction > 0.0 && warn_fraction <= fail_fraction && fail_fraction <= 1.0)) {
-    *why = "need 0 < warn fraction <= fail fraction <= 1";
-    return false;
-  }
+  if (!CheckDeviationBound(deviation, noise_sigmas, warn_fraction, fail_fraction, why)) return false;
   if (chunk_rows == 0) {
     *why = "chunk rows must be positive";
     return false;

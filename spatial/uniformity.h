@@ -112,6 +112,11 @@ void MedianAndStandardError(std::vector<float>* values, double* median, double* 
 // materials stage's for a cell against its combination of the groups).
 bool RatioDeviates(double ratio, double reference, double noise, double deviation, double noise_sigmas);
 
+// Whether a deviation test's options are sane (false with `why`): deviation > 0, noise_sigmas >= 0, and
+// 0 < warn_fraction <= fail_fraction <= 1 (the uniformity check's options and the materials stage's).
+bool CheckDeviationBound(double deviation, double noise_sigmas, double warn_fraction, double fail_fraction,
+                         std::string* why);
+
 // Measures the session's samples (the file at `samples_path`) against `reference`, the BRDF
 // reconstructed from them. Throws Error naming the file for unreadable samples, and naming the session
 // when most samples cannot be located on its surface (not this session's samples).
