@@ -1148,7 +1148,12 @@ def materials_html(run_dir):
         part = m.get(key, {})
         if part.get("written"):
             name = part.get("file") or part.get("scene")
-            text += f"<p>{what}: materials/{html.escape(name)}</p>\n"
+            text += f"<p>{what}: materials/{html.escape(name)}"
+            if key == "pbrt" and part.get("ibrdf_image"):
+                folder = os.path.dirname(name)
+                text += (f"; ibrdf's own render of the same model, to compare pbrt's with: materials/"
+                         f"{html.escape(os.path.join(folder, part['ibrdf_image']))} ({part.get('ibrdf_pixels', 0)} pixels)")
+            text += "</p>\n"
         elif part:
             text += f"<p>{what}: not written ({html.escape(part.get('reason', ''))})</p>\n"
     return text

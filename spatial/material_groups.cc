@@ -514,6 +514,25 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
         });
         if (exported) {
           result.pbrt = WritePbrtScene(session, photo, vertices, snippets, names, out_dir, options.pbrt);
+          // ibrdf's render of the same model from the GGX fits the snippets were made from.
+          std::vector<std::unique_ptr<BrdfModel>> ggx;
+          std::vector<const BrdfModel*> fits;
+          for (int g : result.bases) {
+            const MaterialGroup& group = result.groups[size_t(g)];
+            const std::filesystem::path fit = std::filesystem::path(out_dir) / group.folder / "ggx.json";
+            if (!std::filesystem::exists(fit)) break;
+            ggx.push_back(LoadMaterial(fit.string()));
+            fits.push_back(ggx.back().get());
+          }
+          SceneModelRender render;
+          if (fits.size() == result.bases.size()) {
+            render = RenderSceneModel(session, photo, options.hold_out ? held : located, result.weights, fits,
+                                      cells.origin, cells.cell_m, out_dir);
+          }
+          if (render.written) {
+            result.pbrt.model_image = std::filesystem::path(render.image).filename().string();
+            result.pbrt.model_pixels = render.pixels;
+          }
         } else {
           result.pbrt.not_written = "a group has no pbrt-v4 material (its fits were not run: --no-fits)";
         }
@@ -695,6 +714,12 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
                         {"faces", pbrt.faces},
                         {"faces_without_weights", pbrt.faces_unmeasured},
                         {"undistorted", pbrt.undistorted},
+                        {"ibrdf_image", pbrt.model_image.empty() ? nlohmann::json(nullptr) : nlohmann::json(pbrt.model_image)},
+                        {"ibrdf_pixels", pbrt.model_pixels},
+                        {"weight_sums", {{"p05", pbrt.weight_sum_p05},
+                                         {"median", pbrt.weight_sum_median},
+                                         {"p95", pbrt.weight_sum_p95},
+                                         {"rendered_as", 1.0}}},
                         {"render", "cd " + std::filesystem::path(pbrt.file).parent_path().string() + " && pbrt " +
                                        std::filesystem::path(pbrt.file).filename().string() + " (writes " +
                                        pbrt.image + " there)"}});

@@ -6,12 +6,16 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <unordered_map>
 
 #include "core/error.h"
 #include "core/file_util.h"
+#include "core/image_io.h"
 #include "core/kind.h"
 #include "core/logging.h"
+#include "core/statistics.h"
 #include "scan/ply_io.h"
+#include "spatial/uniformity.h"
 
 namespace ibrdf {
 namespace {
@@ -51,8 +55,11 @@ std::string PbrtSceneResult::BriefReport() const {
   return file + ": photo " + std::to_string(photo) + ", " + std::to_string(faces) + " faces in " +
          std::to_string(materials) + " materials (" +
          Fixed(faces ? 100.0 * double(faces_unmeasured) / double(faces) : 0.0, 1) +
-         " % of faces without weights, black); render: cd " + std::filesystem::path(file).parent_path().string() +
-         " && pbrt " + std::filesystem::path(file).filename().string();
+         " % of faces without weights, black; the weights' sums, median " + Fixed(weight_sum_median, 2) + ", 5-95 % " +
+         Fixed(weight_sum_p05, 2) + "-" + Fixed(weight_sum_p95, 2) + ", rendered as 1); render: cd " + std::filesystem::path(file).parent_path().string() +
+         " && pbrt " + std::filesystem::path(file).filename().string() +
+         (model_image.empty() ? std::string() : "; ibrdf's render of the model: " + model_image + " (" +
+                                                    std::to_string(model_pixels) + " pixels)");
 }
 
 PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const VertexMaterials& vertices,
@@ -77,6 +84,7 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   // Each face: the mean of its vertices' weights, the two largest renormalised and rounded.
   std::map<FaceMaterial, std::vector<size_t>> parts;
   std::vector<size_t> unmeasured;
+  std::vector<double> weight_sums;
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     const Eigen::Vector3i& face = mesh.faces[f];
     Eigen::VectorXd w = Eigen::VectorXd::Zero(Eigen::Index(n_bases));
@@ -89,6 +97,7 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
       unmeasured.push_back(f);
       continue;
     }
+    weight_sums.push_back(w.sum() / 3.0);
     FaceMaterial material;
     Eigen::Index first = 0;
     w.maxCoeff(&first);
@@ -108,6 +117,11 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   }
   result.faces = mesh.faces.size();
   result.faces_unmeasured = unmeasured.size();
+  if (!weight_sums.empty()) {
+    result.weight_sum_p05 = Percentile(weight_sums, 0.05);
+    result.weight_sum_median = Percentile(weight_sums, 0.5);
+    result.weight_sum_p95 = Percentile(weight_sums, 0.95);
+  }
 
   const std::filesystem::path folder = std::filesystem::path(out_dir) / "pbrt";
   std::filesystem::create_directories(folder);
@@ -206,6 +220,76 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   out << scene.str();
   out.close();
   if (!out) ThrowError(path, "write failed (disk full?)");
+  result.written = true;
+  return result;
+}
+
+SceneModelRender RenderSceneModel(const Session& session, size_t photo, const std::vector<LocatedSample>& samples,
+                                  const MaterialWeightsResult& weights, const std::vector<const BrdfModel*>& fits,
+                                  const Eigen::Vector3d& origin, double cell_m, const std::string& out_dir) {
+  SceneModelRender result;
+  if (photo >= session.photos.size() || !session.photos[photo].camera_from_world) return result;
+  if (fits.size() != weights.bases) throw InternalError("RenderSceneModel: a fit per basis");
+  std::unordered_map<uint64_t, size_t> cell_of_key;
+  for (size_t c = 0; c < weights.cells.size(); ++c) {
+    if (weights.cells[c].fitted) cell_of_key.emplace(weights.cells[c].key, c);
+  }
+  const Camera& camera = session.camera;
+  const Light& light = session.lights[session.photos[photo].light];
+  Image sum(camera.width, camera.height, 4);
+  for (const LocatedSample& located : samples) {
+    const BrdfSample& s = located.sample;
+    if (s.image != photo) continue;
+    const auto it = cell_of_key.find(UniformityCellKey(located.point.cast<double>(), origin, cell_m));
+    if (it == cell_of_key.end()) continue;
+    // The scene's mix of the cell's two largest weights, renormalised (see the header).
+    const Eigen::VectorXd& cell = weights.cells[it->second].weights;
+    Eigen::Index first = 0;
+    cell.maxCoeff(&first);
+    Eigen::Index second = -1;
+    for (Eigen::Index b = 0; b < cell.size(); ++b) {
+      if (b != first && cell[b] > 0.0 && (second < 0 || cell[b] > cell[second])) second = b;
+    }
+    const double total = cell[first] + (second >= 0 ? cell[second] : 0.0);
+    if (!(total > 0.0)) continue;
+    Eigen::VectorXd w = Eigen::VectorXd::Zero(cell.size());
+    w[first] = cell[first] / total;
+    if (second >= 0) w[second] = cell[second] / total;
+    const Eigen::Vector3d wi(s.wi[0], s.wi[1], s.wi[2]), wo(s.wo[0], s.wo[1], s.wo[2]);
+    if (!(wi.z() > 0.0 && wo.z() > 0.0)) continue;
+    double irradiance = wi.z();  // of the unit light, per unit of its intensity or radiance
+    switch (light.kind) {
+      case Light::Kind::kPoint:
+        irradiance /= (light.position - located.point.cast<double>()).squaredNorm();
+        break;
+      case Light::Kind::kDirectional:
+        break;
+    }
+    Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
+    for (size_t b = 0; b < fits.size(); ++b) radiance += w[Eigen::Index(b)] * fits[b]->Eval(wi, wo);
+    radiance *= irradiance;
+    if (!radiance.allFinite()) continue;
+    // The pixel centre's ray, in the undistorted pinhole's raster.
+    const Eigen::Vector2d plane = camera.CamPlaneFromImage(Eigen::Vector2d(s.pixel[0] + 0.5, s.pixel[1] + 0.5));
+    const double u = camera.FocalX() * plane.x() + camera.PrincipalX();
+    const double v = camera.FocalY() * plane.y() + camera.PrincipalY();
+    if (!(u >= 0.0 && v >= 0.0 && u < camera.width && v < camera.height)) continue;
+    const int x = int(u), y = int(v);
+    for (int c = 0; c < 3; ++c) sum.at(x, y, c) += float(radiance[c]);
+    sum.at(x, y, 3) += 1.0f;
+  }
+  for (int y = 0; y < sum.height; ++y) {
+    for (int x = 0; x < sum.width; ++x) {
+      const float n = sum.at(x, y, 3);
+      if (n == 0.0f) continue;
+      for (int c = 0; c < 3; ++c) sum.at(x, y, c) /= n;
+      sum.at(x, y, 3) = 1.0f;
+      ++result.pixels;
+    }
+  }
+  result.image = "pbrt/photo-" + std::to_string(photo) + "-ibrdf.exr";
+  std::filesystem::create_directories(std::filesystem::path(out_dir) / "pbrt");
+  WriteImage((std::filesystem::path(out_dir) / result.image).string(), sum, PixelFormat::kFloat);
   result.written = true;
   return result;
 }

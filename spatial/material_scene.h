@@ -5,6 +5,12 @@
 // it shows what a renderer makes of the measurement (tests/spatial/material_scene_pbrt_test.cc renders
 // it with pbrt-v4 itself).
 //
+// pbrt-v4's mix picks one of two materials with a probability and cannot scale a material: a face renders
+// its two weights' proportions, and their sum (the cell's brightness against the groups) is lost; the
+// result states how far the sums are from 1. Every exported basis already uses its mix's full share
+// (reconstruct/model_fit.h: amount = 1 - max diffuse), so not even a brighter sum can be rebuilt from
+// the same parts.
+//
 // The film is the photo's size; the camera is the photo's pinhole (pbrt-v4's perspective camera with
 // a screen window that puts the principal point where the photo has it, y flipped to pbrt's raster);
 // the light has unit intensity, so that a pixel's value over (cos theta_i / r^2) of its surface point is
@@ -18,8 +24,12 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
+#include "core/brdf_model.h"
 #include "core/session.h"
 #include "spatial/material_mesh.h"
+#include "spatial/material_weights.h"
 
 namespace ibrdf {
 
@@ -35,11 +45,17 @@ struct PbrtSceneResult {
   size_t photo = 0;         // the session photo rendered
   std::string file;         // the scene, relative to the output folder ("pbrt/photo-3.pbrt")
   std::string image;        // the EXR pbrt writes, relative to the scene's folder
+  std::string model_image;  // ibrdf's own render of the same model (RenderSceneModel), relative to the scene's folder
+  uint64_t model_pixels = 0;  // and its rendered pixels
   bool undistorted = false;  // the camera has distortion that the render leaves out (see above)
   int materials = 0;        // named materials: the groups, and each mix used
   uint64_t faces = 0, faces_unmeasured = 0;
+  // The sum of each measured face's weights (mean over its vertices), which its mix renders as 1: the
+  // mixes keep the weights' proportions, not their scale.
+  double weight_sum_p05 = 0.0, weight_sum_median = 0.0, weight_sum_p95 = 0.0;
 
-  // "pbrt/photo-3.pbrt: 133367 faces in 14 materials (61 % unmeasured, black); render: pbrt pbrt/photo-3.pbrt"
+  // "pbrt/photo-3.pbrt: 133367 faces in 14 materials (61 % unmeasured, black); render: pbrt pbrt/photo-3.pbrt;
+  // ibrdf's render of the model: photo-3-ibrdf.exr"
   std::string BriefReport() const;
 };
 
@@ -49,5 +65,24 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
                                const std::vector<std::string>& basis_snippets,
                                const std::vector<std::string>& basis_names, const std::string& out_dir,
                                const PbrtSceneOptions& options);
+
+// ibrdf's own render of the scene's photo from the measured model, to hold pbrt-v4's render against: at
+// each of the photo's located samples in a fitted cell, the radiance the scene's unit light gives,
+// sum_b w_b f_b(wi, wo) cos(theta_i) / r^2 (a point light; a directional one without the 1 / r^2), with
+// `fits` f, each group's GGX fit (the source of its pbrt-v4 material), and w the cell's two largest
+// weights scaled to sum 1 (as the scene's mixes have them). Written
+// at the sample's pixel in the undistorted pinhole's raster (pbrt's, see above; samples that fall into one
+// pixel averaged) as a float RGBA EXR whose alpha is 1 where rendered and 0 elsewhere. The scene
+// still differs from this: its weights are per face (its vertices' mean) and rounded to the amount step;
+// each fit is a mix of a diffuse and a conductor (reconstruct/model_fit.h's RendererMaterials); and
+// pbrt's mixes are stochastic (noise that falls with the samples per pixel).
+struct SceneModelRender {
+  bool written = false;
+  std::string image;    // relative to the output folder ("pbrt/photo-3-ibrdf.exr")
+  uint64_t pixels = 0;  // rendered
+};
+SceneModelRender RenderSceneModel(const Session& session, size_t photo, const std::vector<LocatedSample>& samples,
+                                  const MaterialWeightsResult& weights, const std::vector<const BrdfModel*>& fits,
+                                  const Eigen::Vector3d& origin, double cell_m, const std::string& out_dir);
 
 }  // namespace ibrdf
