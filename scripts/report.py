@@ -1153,6 +1153,8 @@ def materials_html(run_dir):
                 folder = os.path.dirname(name)
                 text += (f"; ibrdf's own render of the same model, to compare pbrt's with: materials/"
                          f"{html.escape(os.path.join(folder, part['ibrdf_image']))} ({part.get('ibrdf_pixels', 0)} pixels)")
+            if key == "pbrt" and part.get("mitsuba_scene"):
+                text += f"; the same scene for Mitsuba 3: materials/{html.escape(part['mitsuba_scene'])}"
             text += "</p>\n"
         elif part:
             text += f"<p>{what}: not written ({html.escape(part.get('reason', ''))})</p>\n"

@@ -714,6 +714,10 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
                         {"faces", pbrt.faces},
                         {"faces_without_weights", pbrt.faces_unmeasured},
                         {"undistorted", pbrt.undistorted},
+                        {"mitsuba_scene", pbrt.mitsuba_file.empty() ? nlohmann::json(nullptr) : nlohmann::json(pbrt.mitsuba_file)},
+                        {"mitsuba_render", pbrt.mitsuba_file.empty() ? nlohmann::json(pbrt.mitsuba_not_written)
+                                                                     : nlohmann::json("cd mitsuba && mitsuba " +
+                                                                           std::filesystem::path(pbrt.mitsuba_file).filename().string())},
                         {"ibrdf_image", pbrt.model_image.empty() ? nlohmann::json(nullptr) : nlohmann::json(pbrt.model_image)},
                         {"ibrdf_pixels", pbrt.model_pixels},
                         {"weight_sums", {{"p05", pbrt.weight_sum_p05},

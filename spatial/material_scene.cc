@@ -59,7 +59,8 @@ std::string PbrtSceneResult::BriefReport() const {
          Fixed(weight_sum_p05, 2) + "-" + Fixed(weight_sum_p95, 2) + ", rendered as 1); render: cd " + std::filesystem::path(file).parent_path().string() +
          " && pbrt " + std::filesystem::path(file).filename().string() +
          (model_image.empty() ? std::string() : "; ibrdf's render of the model: " + model_image + " (" +
-                                                    std::to_string(model_pixels) + " pixels)");
+                                                    std::to_string(model_pixels) + " pixels)") +
+         (mitsuba_file.empty() ? "; no Mitsuba 3 scene: " + mitsuba_not_written : "; Mitsuba 3: " + mitsuba_file);
 }
 
 PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const VertexMaterials& vertices,
@@ -191,17 +192,27 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   for (size_t b = 0; b < n_bases; ++b) scene << "Include \"../" << basis_snippets[b] << "\"\n";
   scene << "MakeNamedMaterial \"unmeasured\" \"string type\" \"diffuse\" \"rgb reflectance\" [ 0 0 0 ]\n";
   int part = 0;
+  struct Mix {
+    std::string name;
+    size_t a = 0, b = 0;
+    double amount = 0.0;
+  };
+  std::vector<Mix> mixes;
+  std::vector<std::pair<std::string, std::string>> shapes;  // part file, material name
   for (const auto& [material, faces] : parts) {
     std::string name = basis_names[size_t(material.a)];
     if (material.b >= 0) {
       const double amount = material.steps * options.amount_step;
+      mixes.push_back({"", size_t(material.a), size_t(material.b), amount});
       name = "mix-" + std::to_string(vertices.bases[size_t(material.a)]) + "-" +
              std::to_string(vertices.bases[size_t(material.b)]) + "-" + Fixed(amount, 2);
       scene << "MakeNamedMaterial \"" << name << "\" \"string type\" \"mix\"\n    \"string materials\" [ \""
             << basis_names[size_t(material.a)] << "\" \"" << basis_names[size_t(material.b)]
             << "\" ] \"float amount\" " << Number(amount) << "\n";
+      mixes.back().name = name;
     }
     const std::string file = "part-" + std::to_string(part++) + ".ply";
+    shapes.emplace_back(file, name);
     write_part(faces, file);
     scene << "AttributeBegin\n  NamedMaterial \"" << name << "\"\n  Shape \"plymesh\" \"string filename\" \"" << file
           << "\"\nAttributeEnd\n";
@@ -210,6 +221,7 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
                                                  [](const auto& p) { return p.first.b >= 0; }));
   if (!unmeasured.empty()) {
     write_part(unmeasured, "unmeasured.ply");
+    shapes.emplace_back("unmeasured.ply", "unmeasured");
     scene << "AttributeBegin\n  NamedMaterial \"unmeasured\"\n  Shape \"plymesh\" \"string filename\" \"unmeasured.ply\"\n"
           << "AttributeEnd\n";
   }
@@ -220,6 +232,100 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   out << scene.str();
   out.close();
   if (!out) ThrowError(path, "write failed (disk full?)");
+
+  // The same scene for Mitsuba 3, its shapes the pbrt scene's parts. Its perspective camera
+  // (src/sensors/perspective.cpp and perspective_projection in include/mitsuba/render/sensor.h) looks
+  // down +z with +x to the image's left and +y up: the photo's camera frame turned 180 degrees about z.
+  // Film position s = ((1 + x / (z t)) / 2, (1 + aspect y / (z t)) / 2) in the photo's frame with
+  // t = tan(x_fov / 2), less principal_point_offset: x_fov = 2 atan(W / (2 fx)) and offset
+  // (0.5 - cx / W, 0.5 - cy / H) put pixel (u, v) at u = fx x / z + cx, v = fx y / z + cy (square
+  // pixels: Mitsuba has one focal length).
+  {
+    std::ostringstream xml;
+    const Eigen::Matrix3d world_from_camera = m.topLeftCorner<3, 3>().transpose();
+    const Eigen::Vector3d centre = -world_from_camera * m.topRightCorner<3, 1>();
+    Eigen::Matrix4d to_world = Eigen::Matrix4d::Identity();
+    to_world.topLeftCorner<3, 3>() = world_from_camera * Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal();
+    to_world.topRightCorner<3, 1>() = centre;
+    const double x_fov = 2.0 * std::atan(w / (2.0 * fx)) * 180.0 / 3.14159265358979323846;
+    xml << "<!-- Mitsuba 3: photo " << photo << " of " << session.manifest_path
+        << " rendered from ibrdf's measured spatially varying model,\n"
+        << "     as ../pbrt/" << std::filesystem::path(result.file).filename().string()
+        << " (the same parts, mixes and unit light; one bounce: max_depth 2).\n"
+        << "     Render: mitsuba photo-" << photo << ".xml (writes photo-" << photo << ".exr). -->\n";
+    if (std::abs(fy / fx - 1.0) > 1e-6) {
+      xml << "<!-- The photo's pixels are not square (fy / fx = " << Number(fy / fx)
+          << "): Mitsuba's camera has one focal length, fx. -->\n";
+    }
+    if (result.undistorted) xml << "<!-- The photo's lens distortion is not rendered: an undistorted pinhole. -->\n";
+    xml << "<scene version=\"3.0.0\">\n"
+        << "    <integrator type=\"path\">\n        <integer name=\"max_depth\" value=\"2\"/>\n    </integrator>\n"
+        << "    <sensor type=\"perspective\">\n"
+        << "        <string name=\"fov_axis\" value=\"x\"/>\n"
+        << "        <float name=\"fov\" value=\"" << Number(x_fov) << "\"/>\n"
+        << "        <float name=\"principal_point_offset_x\" value=\"" << Number(0.5 - cx / w) << "\"/>\n"
+        << "        <float name=\"principal_point_offset_y\" value=\"" << Number(0.5 - cy / h) << "\"/>\n"
+        << "        <transform name=\"to_world\">\n            <matrix value=\"";
+    for (int row = 0; row < 4; ++row) {
+      for (int col = 0; col < 4; ++col) xml << (row || col ? " " : "") << Number(to_world(row, col));
+    }
+    xml << "\"/>\n        </transform>\n"
+        << "        <sampler type=\"independent\">\n            <integer name=\"sample_count\" value=\""
+        << options.samples_per_pixel << "\"/>\n        </sampler>\n"
+        << "        <film type=\"hdrfilm\">\n"
+        << "            <integer name=\"width\" value=\"" << camera.width << "\"/>\n"
+        << "            <integer name=\"height\" value=\"" << camera.height << "\"/>\n"
+        << "            <string name=\"pixel_format\" value=\"rgb\"/>\n"
+        << "            <rfilter type=\"box\"/>\n        </film>\n    </sensor>\n";
+    switch (light.kind) {
+      case Light::Kind::kPoint:
+        xml << "    <emitter type=\"point\">\n        <point name=\"position\" x=\"" << Number(light.position.x())
+            << "\" y=\"" << Number(light.position.y()) << "\" z=\"" << Number(light.position.z())
+            << "\"/>\n        <rgb name=\"intensity\" value=\"1, 1, 1\"/>\n    </emitter>\n";
+        break;
+      case Light::Kind::kDirectional:
+        // Mitsuba's direction is the light's travel, away from the light.
+        xml << "    <emitter type=\"directional\">\n        <vector name=\"direction\" x=\""
+            << Number(-light.direction.x()) << "\" y=\"" << Number(-light.direction.y()) << "\" z=\""
+            << Number(-light.direction.z()) << "\"/>\n        <rgb name=\"irradiance\" value=\"1, 1, 1\"/>\n    </emitter>\n";
+        break;
+    }
+    // Each group's exported Mitsuba 3 material (NAME.xml beside NAME.pbrt), inlined.
+    for (size_t b = 0; b < n_bases; ++b) {
+      const std::filesystem::path snippet =
+          (std::filesystem::path(out_dir) / basis_snippets[b]).replace_extension(".xml");
+      std::ifstream in(snippet);
+      if (!in) {
+        result.mitsuba_not_written = snippet.string() + " cannot be read";
+        break;
+      }
+      std::stringstream text;
+      text << in.rdbuf();
+      xml << text.str() << (text.str().empty() || text.str().back() == '\n' ? "" : "\n");
+    }
+    for (const Mix& mix : mixes) {
+      xml << "<bsdf type=\"blendbsdf\" id=\"" << mix.name << "\">\n    <float name=\"weight\" value=\""
+          << Number(mix.amount) << "\"/>\n    <ref id=\"" << basis_names[mix.a] << "\"/>\n    <ref id=\""
+          << basis_names[mix.b] << "\"/>\n</bsdf>\n";
+    }
+    xml << "<bsdf type=\"diffuse\" id=\"unmeasured\">\n    <rgb name=\"reflectance\" value=\"0, 0, 0\"/>\n</bsdf>\n";
+    for (const auto& [file, name] : shapes) {
+      xml << "<shape type=\"ply\">\n    <string name=\"filename\" value=\"../pbrt/" << file
+          << "\"/>\n    <ref id=\"" << name << "\"/>\n</shape>\n";
+    }
+    xml << "</scene>\n";
+    if (!result.mitsuba_not_written.empty()) {
+      result.written = true;
+      return result;
+    }
+    result.mitsuba_file = "mitsuba/photo-" + std::to_string(photo) + ".xml";
+    std::filesystem::create_directories(std::filesystem::path(out_dir) / "mitsuba");
+    const std::string xml_path = (std::filesystem::path(out_dir) / result.mitsuba_file).string();
+    std::ofstream xml_out(xml_path);
+    xml_out << xml.str();
+    xml_out.close();
+    if (!xml_out) ThrowError(xml_path, "write failed (disk full?)");
+  }
   result.written = true;
   return result;
 }

@@ -45,6 +45,8 @@ struct PbrtSceneResult {
   size_t photo = 0;         // the session photo rendered
   std::string file;         // the scene, relative to the output folder ("pbrt/photo-3.pbrt")
   std::string image;        // the EXR pbrt writes, relative to the scene's folder
+  std::string mitsuba_file;  // the same scene for Mitsuba 3 ("mitsuba/photo-3.xml"), its shapes pbrt/'s parts
+  std::string mitsuba_not_written;  // why not, when not (a group without its NAME.xml)
   std::string model_image;  // ibrdf's own render of the same model (RenderSceneModel), relative to the scene's folder
   uint64_t model_pixels = 0;  // and its rendered pixels
   bool undistorted = false;  // the camera has distortion that the render leaves out (see above)
@@ -59,7 +61,8 @@ struct PbrtSceneResult {
   std::string BriefReport() const;
 };
 
-// Writes out_dir/pbrt/photo-N.pbrt and its mesh parts (part-K.ply). `basis_snippets[b]` is the pbrt-v4
+// Writes out_dir/pbrt/photo-N.pbrt and its mesh parts (part-K.ply), and out_dir/mitsuba/photo-N.xml, the
+// same scene for Mitsuba 3 (each group's NAME.xml beside its NAME.pbrt inlined; blendbsdf for the mixes). `basis_snippets[b]` is the pbrt-v4
 // material file of vertices.bases[b], relative to out_dir, defining `basis_names[b]`.
 PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const VertexMaterials& vertices,
                                const std::vector<std::string>& basis_snippets,

@@ -7,12 +7,14 @@
 // fits, times cos theta_i / r^2 of the unit light) within 2 % median over 7 x 7-pixel windows; per pixel
 // pbrt's stochastic mixes leave noise even at 1024 samples per pixel, and the scene's weights are per
 // face and in 0.1 steps (both reported, docs/spatial.md).
-// Skips with a message where the pbrt binary is absent or does not run.
+// The Mitsuba 3 scene of the same run is checked for its parts and materials. Skips the render with a
+// message where the pbrt binary is absent or does not run.
 #include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -37,9 +39,6 @@ using testing::RunShell;
 using testing::ScratchDir;
 
 TEST(MaterialScenePbrt, RendersTheSpatiallyVaryingSquashAsIbrdfDoes) {
-  std::string why;
-  const std::string pbrt = testing::PbrtOracle(&why);
-  if (pbrt.empty()) GTEST_SKIP() << "pbrt-v4 oracle not available: " << why;
   ScratchDir dir;
   // The recipe at 8 photos (the squash's 16 cost twice the derender; 6 photos measure too,
   // docs/spatial.md's hard cases).
@@ -58,6 +57,24 @@ TEST(MaterialScenePbrt, RendersTheSpatiallyVaryingSquashAsIbrdfDoes) {
   const nlohmann::json& scene = materials.at("pbrt");
   ASSERT_TRUE(scene.at("written").get<bool>()) << scene.dump(2);
   ASSERT_TRUE(scene.at("ibrdf_image").is_string()) << scene.dump(2);
+  // The Mitsuba 3 scene beside it: every group's material inlined and every part of the pbrt scene.
+  ASSERT_TRUE(scene.at("mitsuba_scene").is_string()) << scene.dump(2);
+  std::ifstream xml_file(dir / ("r/materials/" + scene.at("mitsuba_scene").get<std::string>()));
+  const std::string xml((std::istreambuf_iterator<char>(xml_file)), std::istreambuf_iterator<char>());
+  for (const nlohmann::json& group : materials.at("groups")) {
+    if (!group.value("reconstructed", false)) continue;
+    EXPECT_NE(xml.find("id=\"squash-materials-8-" + group.at("folder").get<std::string>() + "\""), std::string::npos)
+        << group.dump();
+  }
+  for (const auto& entry : fs::directory_iterator(dir / "r/materials/pbrt")) {
+    if (entry.path().extension() != ".ply") continue;
+    EXPECT_NE(xml.find("value=\"../pbrt/" + entry.path().filename().string() + "\""), std::string::npos)
+        << entry.path();
+  }
+
+  std::string why;
+  const std::string pbrt = testing::PbrtOracle(&why);
+  if (pbrt.empty()) GTEST_SKIP() << "pbrt-v4 oracle not available (the scenes were checked, not rendered): " << why;
   const fs::path folder = fs::path(dir / "r/materials") / fs::path(scene.at("scene").get<std::string>()).parent_path();
   const std::string file = fs::path(scene.at("scene").get<std::string>()).filename().string();
   const Image by_ibrdf = ReadImage((folder / scene.at("ibrdf_image").get<std::string>()).string());
