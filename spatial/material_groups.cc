@@ -532,6 +532,10 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
           if (render.written) {
             result.pbrt.model_image = std::filesystem::path(render.image).filename().string();
             result.pbrt.model_pixels = render.pixels;
+            result.pbrt.weight_sum_p05 = render.weight_sum_p05;
+            result.pbrt.weight_sum_median = render.weight_sum_median;
+            result.pbrt.weight_sum_p95 = render.weight_sum_p95;
+            result.pbrt.full_model_ratio = render.full_model_ratio;
           }
         } else {
           result.pbrt.not_written = "a group has no pbrt-v4 material (its fits were not run: --no-fits)";
@@ -723,7 +727,8 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
                         {"weight_sums", {{"p05", pbrt.weight_sum_p05},
                                          {"median", pbrt.weight_sum_median},
                                          {"p95", pbrt.weight_sum_p95},
-                                         {"rendered_as", 1.0}}},
+                                         {"rendered_as", 1.0},
+                                         {"full_weights_brightness_ratio", pbrt.full_model_ratio}}},
                         {"render", "cd " + std::filesystem::path(pbrt.file).parent_path().string() + " && pbrt " +
                                        std::filesystem::path(pbrt.file).filename().string() + " (writes " +
                                        pbrt.image + " there)"}});

@@ -55,11 +55,14 @@ std::string PbrtSceneResult::BriefReport() const {
   return file + ": photo " + std::to_string(photo) + ", " + std::to_string(faces) + " faces in " +
          std::to_string(materials) + " materials (" +
          Fixed(faces ? 100.0 * double(faces_unmeasured) / double(faces) : 0.0, 1) +
-         " % of faces without weights, black; the weights' sums, median " + Fixed(weight_sum_median, 2) + ", 5-95 % " +
-         Fixed(weight_sum_p05, 2) + "-" + Fixed(weight_sum_p95, 2) + ", rendered as 1); render: cd " + std::filesystem::path(file).parent_path().string() +
+         " % of faces without weights, black); render: cd " + std::filesystem::path(file).parent_path().string() +
          " && pbrt " + std::filesystem::path(file).filename().string() +
-         (model_image.empty() ? std::string() : "; ibrdf's render of the model: " + model_image + " (" +
-                                                    std::to_string(model_pixels) + " pixels)") +
+         (model_image.empty() ? std::string()
+                              : "; ibrdf's render of the model: " + model_image + " (" + std::to_string(model_pixels) +
+                                    " pixels; the cells' weight sums there, median " + Fixed(weight_sum_median, 2) +
+                                    ", 5-95 % " + Fixed(weight_sum_p05, 2) + "-" + Fixed(weight_sum_p95, 2) +
+                                    ", rendered as 1: the full model is " + Fixed(full_model_ratio, 3) +
+                                    "x as bright)") +
          (mitsuba_file.empty() ? "; no Mitsuba 3 scene: " + mitsuba_not_written : "; Mitsuba 3: " + mitsuba_file);
 }
 
@@ -85,7 +88,6 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   // Each face: the mean of its vertices' weights, the two largest renormalised and rounded.
   std::map<FaceMaterial, std::vector<size_t>> parts;
   std::vector<size_t> unmeasured;
-  std::vector<double> weight_sums;
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     const Eigen::Vector3i& face = mesh.faces[f];
     Eigen::VectorXd w = Eigen::VectorXd::Zero(Eigen::Index(n_bases));
@@ -98,7 +100,6 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
       unmeasured.push_back(f);
       continue;
     }
-    weight_sums.push_back(w.sum() / 3.0);
     FaceMaterial material;
     Eigen::Index first = 0;
     w.maxCoeff(&first);
@@ -118,11 +119,7 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   }
   result.faces = mesh.faces.size();
   result.faces_unmeasured = unmeasured.size();
-  if (!weight_sums.empty()) {
-    result.weight_sum_p05 = Percentile(weight_sums, 0.05);
-    result.weight_sum_median = Percentile(weight_sums, 0.5);
-    result.weight_sum_p95 = Percentile(weight_sums, 0.95);
-  }
+
 
   const std::filesystem::path folder = std::filesystem::path(out_dir) / "pbrt";
   std::filesystem::create_directories(folder);
@@ -343,6 +340,8 @@ SceneModelRender RenderSceneModel(const Session& session, size_t photo, const st
   const Camera& camera = session.camera;
   const Light& light = session.lights[session.photos[photo].light];
   Image sum(camera.width, camera.height, 4);
+  std::vector<double> sums;
+  double scene_sum = 0.0, full_sum = 0.0;
   for (const LocatedSample& located : samples) {
     const BrdfSample& s = located.sample;
     if (s.image != photo) continue;
@@ -361,6 +360,7 @@ SceneModelRender RenderSceneModel(const Session& session, size_t photo, const st
     Eigen::VectorXd w = Eigen::VectorXd::Zero(cell.size());
     w[first] = cell[first] / total;
     if (second >= 0) w[second] = cell[second] / total;
+    sums.push_back(cell.sum());
     const Eigen::Vector3d wi(s.wi[0], s.wi[1], s.wi[2]), wo(s.wo[0], s.wo[1], s.wo[2]);
     if (!(wi.z() > 0.0 && wo.z() > 0.0)) continue;
     double irradiance = wi.z();  // of the unit light, per unit of its intensity or radiance
@@ -371,10 +371,19 @@ SceneModelRender RenderSceneModel(const Session& session, size_t photo, const st
       case Light::Kind::kDirectional:
         break;
     }
-    Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
-    for (size_t b = 0; b < fits.size(); ++b) radiance += w[Eigen::Index(b)] * fits[b]->Eval(wi, wo);
+    Eigen::Vector3d radiance = Eigen::Vector3d::Zero(), full = Eigen::Vector3d::Zero();
+    for (size_t b = 0; b < fits.size(); ++b) {
+      const Eigen::Vector3d f = fits[b]->Eval(wi, wo);
+      radiance += w[Eigen::Index(b)] * f;
+      full += cell[Eigen::Index(b)] * f;
+    }
     radiance *= irradiance;
-    if (!radiance.allFinite()) continue;
+    if (!radiance.allFinite() || !full.allFinite()) {
+      sums.pop_back();
+      continue;
+    }
+    scene_sum += radiance.sum();
+    full_sum += irradiance * full.sum();
     // The pixel centre's ray, in the undistorted pinhole's raster.
     const Eigen::Vector2d plane = camera.CamPlaneFromImage(Eigen::Vector2d(s.pixel[0] + 0.5, s.pixel[1] + 0.5));
     const double u = camera.FocalX() * plane.x() + camera.PrincipalX();
@@ -393,6 +402,12 @@ SceneModelRender RenderSceneModel(const Session& session, size_t photo, const st
       ++result.pixels;
     }
   }
+  if (!sums.empty()) {
+    result.weight_sum_p05 = Percentile(sums, 0.05);
+    result.weight_sum_median = Percentile(sums, 0.5);
+    result.weight_sum_p95 = Percentile(sums, 0.95);
+  }
+  if (scene_sum > 0.0) result.full_model_ratio = full_sum / scene_sum;
   result.image = "pbrt/photo-" + std::to_string(photo) + "-ibrdf.exr";
   std::filesystem::create_directories(std::filesystem::path(out_dir) / "pbrt");
   WriteImage((std::filesystem::path(out_dir) / result.image).string(), sum, PixelFormat::kFloat);

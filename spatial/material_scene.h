@@ -7,9 +7,9 @@
 //
 // pbrt-v4's mix picks one of two materials with a probability and cannot scale a material: a face renders
 // its two weights' proportions, and their sum (the cell's brightness against the groups) is lost; the
-// result states how far the sums are from 1. Every exported basis already uses its mix's full share
-// (reconstruct/model_fit.h: amount = 1 - max diffuse), so not even a brighter sum can be rebuilt from
-// the same parts.
+// materials stage states how far the sums are from 1 where it renders (RenderSceneModel). Every
+// exported basis already uses its mix's full share (reconstruct/model_fit.h: amount = 1 - max
+// diffuse), so not even a brighter sum can be rebuilt from the same parts.
 //
 // The film is the photo's size; the camera is the photo's pinhole (pbrt-v4's perspective camera with
 // a screen window that puts the principal point where the photo has it, y flipped to pbrt's raster);
@@ -49,12 +49,11 @@ struct PbrtSceneResult {
   std::string mitsuba_not_written;  // why not, when not (a group without its NAME.xml)
   std::string model_image;  // ibrdf's own render of the same model (RenderSceneModel), relative to the scene's folder
   uint64_t model_pixels = 0;  // and its rendered pixels
+  // From RenderSceneModel: its samples' cells' weight sums, and the full model's brightness over the scene's.
+  double weight_sum_p05 = 0.0, weight_sum_median = 0.0, weight_sum_p95 = 0.0, full_model_ratio = 1.0;
   bool undistorted = false;  // the camera has distortion that the render leaves out (see above)
   int materials = 0;        // named materials: the groups, and each mix used
   uint64_t faces = 0, faces_unmeasured = 0;
-  // The sum of each measured face's weights (mean over its vertices), which its mix renders as 1: the
-  // mixes keep the weights' proportions, not their scale.
-  double weight_sum_p05 = 0.0, weight_sum_median = 0.0, weight_sum_p95 = 0.0;
 
   // "pbrt/photo-3.pbrt: 133367 faces in 14 materials (61 % unmeasured, black); render: pbrt pbrt/photo-3.pbrt;
   // ibrdf's render of the model: photo-3-ibrdf.exr"
@@ -83,6 +82,10 @@ struct SceneModelRender {
   bool written = false;
   std::string image;    // relative to the output folder ("pbrt/photo-3-ibrdf.exr")
   uint64_t pixels = 0;  // rendered
+  // The rendered samples' cells' weight sums (which the scene renders as 1), and the model with the
+  // cells' full weights against the scene's: sum of radiance over the samples, all channels.
+  double weight_sum_p05 = 0.0, weight_sum_median = 0.0, weight_sum_p95 = 0.0;
+  double full_model_ratio = 1.0;
 };
 SceneModelRender RenderSceneModel(const Session& session, size_t photo, const std::vector<LocatedSample>& samples,
                                   const MaterialWeightsResult& weights, const std::vector<const BrdfModel*>& fits,
