@@ -360,7 +360,6 @@ SceneModelRender RenderSceneModel(const Session& session, size_t photo, const st
     Eigen::VectorXd w = Eigen::VectorXd::Zero(cell.size());
     w[first] = cell[first] / total;
     if (second >= 0) w[second] = cell[second] / total;
-    sums.push_back(cell.sum());
     const Eigen::Vector3d wi(s.wi[0], s.wi[1], s.wi[2]), wo(s.wo[0], s.wo[1], s.wo[2]);
     if (!(wi.z() > 0.0 && wo.z() > 0.0)) continue;
     double irradiance = wi.z();  // of the unit light, per unit of its intensity or radiance
@@ -378,10 +377,8 @@ SceneModelRender RenderSceneModel(const Session& session, size_t photo, const st
       full += cell[Eigen::Index(b)] * f;
     }
     radiance *= irradiance;
-    if (!radiance.allFinite() || !full.allFinite()) {
-      sums.pop_back();
-      continue;
-    }
+    if (!radiance.allFinite() || !full.allFinite()) continue;
+    sums.push_back(cell.sum());
     scene_sum += radiance.sum();
     full_sum += irradiance * full.sum();
     // The pixel centre's ray, in the undistorted pinhole's raster.
