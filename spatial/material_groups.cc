@@ -527,7 +527,7 @@ MaterialGroupsResult MeasureMaterialGroups(const Session& session, const std::st
           SceneModelRender render;
           if (fits.size() == result.bases.size()) {
             render = RenderSceneModel(session, photo, options.hold_out ? held : located, result.weights, fits,
-                                      cells.origin, cells.cell_m, out_dir);
+                                      cells.origin, cells.cell_m, result.pbrt.light_scale, out_dir);
           }
           if (render.written) {
             result.pbrt.model_image = std::filesystem::path(render.image).filename().string();
@@ -718,6 +718,8 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
                         {"faces", pbrt.faces},
                         {"faces_without_weights", pbrt.faces_unmeasured},
                         {"undistorted", pbrt.undistorted},
+                        {"light_scale", pbrt.light_scale},
+                        {"faces_brighter_than_the_light_scale", pbrt.faces_scale_clipped},
                         {"mitsuba_scene", pbrt.mitsuba_file.empty() ? nlohmann::json(nullptr) : nlohmann::json(pbrt.mitsuba_file)},
                         {"mitsuba_render", pbrt.mitsuba_file.empty() ? nlohmann::json(pbrt.mitsuba_not_written)
                                                                      : nlohmann::json("cd mitsuba && mitsuba " +
@@ -727,7 +729,6 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
                         {"weight_sums", {{"p05", pbrt.weight_sum_p05},
                                          {"median", pbrt.weight_sum_median},
                                          {"p95", pbrt.weight_sum_p95},
-                                         {"rendered_as", 1.0},
                                          {"full_weights_brightness_ratio", pbrt.full_model_ratio}}},
                         {"render", "cd " + std::filesystem::path(pbrt.file).parent_path().string() + " && pbrt " +
                                        std::filesystem::path(pbrt.file).filename().string() + " (writes " +

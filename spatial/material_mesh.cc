@@ -96,10 +96,11 @@ MaterialMeshResult WriteMaterialMesh(const Session& session, const MaterialWeigh
   properties.push_back({"residual", PlyPropertyType::kFloat, std::vector<double>(n, -1.0)});
   properties.push_back({"fits", PlyPropertyType::kUchar, std::vector<double>(n, 0.0)});
   properties.push_back({"weights_from", PlyPropertyType::kUchar, std::vector<double>(n, 0.0)});
+  properties.push_back({"weight_sum", PlyPropertyType::kFloat, std::vector<double>(n, 0.0)});
   for (const char* colour : {"red", "green", "blue"}) {
     properties.push_back({colour, PlyPropertyType::kUchar, std::vector<double>(n, 128.0)});
   }
-  const size_t residual = 1 + n_bases, fits = residual + 1, from = fits + 1, red = from + 1;
+  const size_t residual = 1 + n_bases, fits = residual + 1, from = fits + 1, weight_sum = from + 1, red = weight_sum + 1;
   result.vertices = n;
   for (size_t v = 0; v < n; ++v) {
     const Eigen::Vector3d& p = mesh.points[v];
@@ -133,6 +134,7 @@ MaterialMeshResult WriteMaterialMesh(const Session& session, const MaterialWeigh
       properties[1 + b].values[v] = w;
       for (int k = 0; k < 3; ++k) colour[k] += w * kPalette[b % kPalette.size()][size_t(k)];
     }
+    properties[weight_sum].values[v] = sum;
     properties[residual].values[v] = cell->rel_rms;
     properties[fits].values[v] = cell->fits ? 1.0 : 0.0;
     if (!cell->fits) {
@@ -147,7 +149,9 @@ MaterialMeshResult WriteMaterialMesh(const Session& session, const MaterialWeigh
     vertices->label.assign(n, -1);
     vertices->fits.assign(n, 0);
     vertices->from.assign(n, VertexWeightsFrom::kNone);
+    vertices->scale.assign(n, 0.0);
     for (size_t v = 0; v < n; ++v) {
+      vertices->scale[v] = properties[weight_sum].values[v];
       for (size_t b = 0; b < n_bases; ++b) vertices->weights(Eigen::Index(v), Eigen::Index(b)) = properties[1 + b].values[v];
       vertices->label[v] = int(properties[0].values[v]);
       vertices->fits[v] = uint8_t(properties[fits].values[v]);

@@ -45,6 +45,7 @@ struct VertexMaterials {
   ScanMesh mesh;              // world frame (metres), with the mesh file's normals rotated where it has them
   std::vector<int> bases;     // the groups of the weights' columns
   Eigen::MatrixXd weights;    // vertices x bases, each row normalised to sum 1 (zero: no weights)
+  std::vector<double> scale;  // per vertex, its cell's weights' sum before normalising (0: no weights)
   std::vector<int> label;     // the group of the largest weight, -1 none
   std::vector<uint8_t> fits;  // 1: its cell fits its combination
   std::vector<VertexWeightsFrom> from;
@@ -55,7 +56,8 @@ struct VertexMaterials {
 // vertex: `label` (the group of the largest
 // weight, -1 none), one float `weight_group_K` per basis K of `bases` (normalised to sum 1; 0 none),
 // `residual` (the cell's relative RMS, -1 none), uchar `fits` (1: the cell fits its combination),
-// uchar `weights_from` (VertexWeightsFrom), and red, green, blue (the bases' colours mixed by weight;
+// uchar `weights_from` (VertexWeightsFrom), float `weight_sum` (the weights' sum before normalising:
+// the vertex's brightness against the groups; 0 none), and red, green, blue (the bases' colours mixed by weight;
 // magenta where the cell fits no combination, grey where none). `origin` and `cell_m` are the cells'
 // grid. Fills `vertices` when given and written. Throws Error naming the mesh file when it cannot be
 // read.

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <unordered_map>
 
@@ -24,8 +25,9 @@ namespace {
 struct FaceMaterial {
   int a = -1, b = -1;
   int steps = 0;  // amount = steps * amount_step
+  int level = 0;  // its brightness, level * scale_step of the light's scale (the full level: no black mixed in)
   bool operator<(const FaceMaterial& o) const {
-    return std::tie(a, b, steps) < std::tie(o.a, o.b, o.steps);
+    return std::tie(a, b, steps, level) < std::tie(o.a, o.b, o.steps, o.level);
   }
 };
 
@@ -43,6 +45,14 @@ bool PbrtSceneOptions::Check(std::string* why) const {
     *why = "the mixes' amount step must be in (0, 0.5]";
     return false;
   }
+  if (!(scale_step > 0.0 && scale_step <= 0.2)) {
+    *why = "the faces' brightness step must be in (0, 0.2]";
+    return false;
+  }
+  if (!(max_scale_percentile > 0.0 && max_scale_percentile <= 1.0)) {
+    *why = "the light's scale percentile must be in (0, 1]";
+    return false;
+  }
   if (samples_per_pixel < 1) {
     *why = "samples per pixel must be positive";
     return false;
@@ -55,13 +65,14 @@ std::string PbrtSceneResult::BriefReport() const {
   return file + ": photo " + std::to_string(photo) + ", " + std::to_string(faces) + " faces in " +
          std::to_string(materials) + " materials (" +
          Fixed(faces ? 100.0 * double(faces_unmeasured) / double(faces) : 0.0, 1) +
-         " % of faces without weights, black); render: cd " + std::filesystem::path(file).parent_path().string() +
+         " % of faces without weights, black); light scale " + Fixed(light_scale, 3) + " (" +
+         std::to_string(faces_scale_clipped) + " faces brighter, held at it); render: cd " + std::filesystem::path(file).parent_path().string() +
          " && pbrt " + std::filesystem::path(file).filename().string() +
          (model_image.empty() ? std::string()
                               : "; ibrdf's render of the model: " + model_image + " (" + std::to_string(model_pixels) +
                                     " pixels; the cells' weight sums there, median " + Fixed(weight_sum_median, 2) +
                                     ", 5-95 % " + Fixed(weight_sum_p05, 2) + "-" + Fixed(weight_sum_p95, 2) +
-                                    ", rendered as 1: the full model is " + Fixed(full_model_ratio, 3) +
+                                    "; the model with every weight is " + Fixed(full_model_ratio, 3) +
                                     "x as bright)") +
          (mitsuba_file.empty() ? "; no Mitsuba 3 scene: " + mitsuba_not_written : "; Mitsuba 3: " + mitsuba_file);
 }
@@ -86,7 +97,8 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   const ScanMesh& mesh = vertices.mesh;
 
   // Each face: the mean of its vertices' weights, the two largest renormalised and rounded.
-  std::map<FaceMaterial, std::vector<size_t>> parts;
+  std::vector<std::pair<FaceMaterial, size_t>> measured_faces;
+  std::vector<double> face_scales;
   std::vector<size_t> unmeasured;
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     const Eigen::Vector3i& face = mesh.faces[f];
@@ -115,7 +127,22 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
       material.steps = int(std::lround(second_weight / (w[first] + second_weight) / options.amount_step));
       if (material.steps == 0) material.b = -1;
     }
-    parts[material].push_back(f);
+    measured_faces.emplace_back(material, f);
+    double scale = 0.0;
+    for (int k = 0; k < 3; ++k) scale += vertices.scale.empty() ? 1.0 : vertices.scale[size_t(face[k])] / 3.0;
+    face_scales.push_back(vertices.scale.empty() ? 1.0 : scale);
+  }
+  // The faces' brightness: the light is scaled to the 99th percentile of the faces' weight sums (at least
+  // 1), and each face mixes its material with black to the rest; brighter faces are held at the light's.
+  result.light_scale = face_scales.empty() ? 1.0 : std::max(1.0, Percentile(face_scales, options.max_scale_percentile));
+  const int full_level = int(std::lround(1.0 / options.scale_step));
+  std::map<FaceMaterial, std::vector<size_t>> parts;
+  for (size_t i = 0; i < measured_faces.size(); ++i) {
+    FaceMaterial material = measured_faces[i].first;
+    const double t = face_scales[i] / result.light_scale;
+    if (t > 1.0 + 0.5 * options.scale_step) ++result.faces_scale_clipped;
+    material.level = std::clamp(int(std::lround(std::min(t, 1.0) / options.scale_step)), 1, full_level);
+    parts[material].push_back(measured_faces[i].second);
   }
   result.faces = mesh.faces.size();
   result.faces_unmeasured = unmeasured.size();
@@ -157,7 +184,9 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
         << " rendered from ibrdf's measured spatially varying model\n"
         << "# (each face a mix of the two groups of the largest weights, amounts in steps of "
         << Number(options.amount_step) << "; faces without weights black).\n"
-        << "# The light has unit intensity: a pixel over (cos theta_i / r^2) of its point is the rendered BRDF.\n"
+        << "# The light's intensity is its scale, the faces' weight sums' " << Number(100.0 * options.max_scale_percentile)
+        << "th percentile, and each face mixes\n# its material with black down to its own sum: a pixel over (cos theta_i / r^2) of its point is the\n"
+        << "# model's BRDF there.\n"
         << (result.undistorted ? "# The photo's lens distortion is not rendered (pbrt-v4's perspective camera has none): photo "
                                  "pixel p is\n# rendered at (fx x + cx, fy y + cy), (x, y) the undistorted image-plane point of p.\n"
                                : "")
@@ -179,11 +208,13 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   switch (light.kind) {
     case Light::Kind::kPoint:
       scene << "LightSource \"point\" \"point3 from\" [ " << Number(light.position.x()) << " "
-            << Number(light.position.y()) << " " << Number(light.position.z()) << " ]\n";
+            << Number(light.position.y()) << " " << Number(light.position.z()) << " ] \"float scale\" [ "
+            << Number(result.light_scale) << " ]\n";
       break;
     case Light::Kind::kDirectional:
       scene << "LightSource \"distant\" \"point3 from\" [ " << Number(light.direction.x()) << " "
-            << Number(light.direction.y()) << " " << Number(light.direction.z()) << " ] \"point3 to\" [ 0 0 0 ]\n";
+            << Number(light.direction.y()) << " " << Number(light.direction.z()) << " ] \"point3 to\" [ 0 0 0 ]"
+            << " \"float scale\" [ " << Number(result.light_scale) << " ]\n";
       break;
   }
   for (size_t b = 0; b < n_bases; ++b) scene << "Include \"../" << basis_snippets[b] << "\"\n";
@@ -194,19 +225,37 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
     size_t a = 0, b = 0;
     double amount = 0.0;
   };
+  struct Scaled {
+    std::string name, base;
+    double fraction = 1.0;
+  };
   std::vector<Mix> mixes;
   std::vector<std::pair<std::string, std::string>> shapes;  // part file, material name
+  std::set<std::string> defined;
+  std::vector<Scaled> scaled;
   for (const auto& [material, faces] : parts) {
     std::string name = basis_names[size_t(material.a)];
     if (material.b >= 0) {
       const double amount = material.steps * options.amount_step;
-      mixes.push_back({"", size_t(material.a), size_t(material.b), amount});
       name = "mix-" + std::to_string(vertices.bases[size_t(material.a)]) + "-" +
              std::to_string(vertices.bases[size_t(material.b)]) + "-" + Fixed(amount, 2);
-      scene << "MakeNamedMaterial \"" << name << "\" \"string type\" \"mix\"\n    \"string materials\" [ \""
-            << basis_names[size_t(material.a)] << "\" \"" << basis_names[size_t(material.b)]
-            << "\" ] \"float amount\" " << Number(amount) << "\n";
-      mixes.back().name = name;
+      if (defined.insert(name).second) {
+        mixes.push_back({name, size_t(material.a), size_t(material.b), amount});
+        scene << "MakeNamedMaterial \"" << name << "\" \"string type\" \"mix\"\n    \"string materials\" [ \""
+              << basis_names[size_t(material.a)] << "\" \"" << basis_names[size_t(material.b)]
+              << "\" ] \"float amount\" " << Number(amount) << "\n";
+      }
+    }
+    if (material.level < full_level) {
+      // The material at a fraction of the light's scale: black picked the rest of the time.
+      const double fraction = material.level * options.scale_step;
+      const std::string base = name;
+      name = base + "-at-" + Fixed(fraction, 2);
+      if (defined.insert(name).second) {
+        scaled.push_back({name, base, fraction});
+        scene << "MakeNamedMaterial \"" << name << "\" \"string type\" \"mix\"\n    \"string materials\" [ \"unmeasured\" \""
+              << base << "\" ] \"float amount\" " << Number(fraction) << "\n";
+      }
     }
     const std::string file = "part-" + std::to_string(part++) + ".ply";
     shapes.emplace_back(file, name);
@@ -214,8 +263,7 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
     scene << "AttributeBegin\n  NamedMaterial \"" << name << "\"\n  Shape \"plymesh\" \"string filename\" \"" << file
           << "\"\nAttributeEnd\n";
   }
-  result.materials = n_bases + int(std::count_if(parts.begin(), parts.end(),
-                                                 [](const auto& p) { return p.first.b >= 0; }));
+  result.materials = int(n_bases + mixes.size() + scaled.size());
   if (!unmeasured.empty()) {
     write_part(unmeasured, "unmeasured.ply");
     shapes.emplace_back("unmeasured.ply", "unmeasured");
@@ -248,7 +296,7 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
     xml << "<!-- Mitsuba 3: photo " << photo << " of " << session.manifest_path
         << " rendered from ibrdf's measured spatially varying model,\n"
         << "     as ../pbrt/" << std::filesystem::path(result.file).filename().string()
-        << " (the same parts, mixes and unit light; one bounce: max_depth 2).\n"
+        << " (the same parts, mixes and light; one bounce: max_depth 2).\n"
         << "     Render: mitsuba photo-" << photo << ".xml (writes photo-" << photo << ".exr). -->\n";
     if (std::abs(fy / fx - 1.0) > 1e-6) {
       xml << "<!-- The photo's pixels are not square (fy / fx = " << Number(fy / fx)
@@ -278,13 +326,15 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
       case Light::Kind::kPoint:
         xml << "    <emitter type=\"point\">\n        <point name=\"position\" x=\"" << Number(light.position.x())
             << "\" y=\"" << Number(light.position.y()) << "\" z=\"" << Number(light.position.z())
-            << "\"/>\n        <rgb name=\"intensity\" value=\"1, 1, 1\"/>\n    </emitter>\n";
+            << "\"/>\n        <rgb name=\"intensity\" value=\"" << Number(result.light_scale) << ", "
+            << Number(result.light_scale) << ", " << Number(result.light_scale) << "\"/>\n    </emitter>\n";
         break;
       case Light::Kind::kDirectional:
         // Mitsuba's direction is the light's travel, away from the light.
         xml << "    <emitter type=\"directional\">\n        <vector name=\"direction\" x=\""
             << Number(-light.direction.x()) << "\" y=\"" << Number(-light.direction.y()) << "\" z=\""
-            << Number(-light.direction.z()) << "\"/>\n        <rgb name=\"irradiance\" value=\"1, 1, 1\"/>\n    </emitter>\n";
+            << Number(-light.direction.z()) << "\"/>\n        <rgb name=\"irradiance\" value=\"" << Number(result.light_scale) << ", "
+            << Number(result.light_scale) << ", " << Number(result.light_scale) << "\"/>\n    </emitter>\n";
         break;
     }
     // Each group's exported Mitsuba 3 material (NAME.xml beside NAME.pbrt), inlined.
@@ -306,6 +356,11 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
           << basis_names[mix.b] << "\"/>\n</bsdf>\n";
     }
     xml << "<bsdf type=\"diffuse\" id=\"unmeasured\">\n    <rgb name=\"reflectance\" value=\"0, 0, 0\"/>\n</bsdf>\n";
+    for (const Scaled& material : scaled) {
+      xml << "<bsdf type=\"blendbsdf\" id=\"" << material.name << "\">\n    <float name=\"weight\" value=\""
+          << Number(material.fraction) << "\"/>\n    <ref id=\"unmeasured\"/>\n    <ref id=\"" << material.base
+          << "\"/>\n</bsdf>\n";
+    }
     for (const auto& [file, name] : shapes) {
       xml << "<shape type=\"ply\">\n    <string name=\"filename\" value=\"../pbrt/" << file
           << "\"/>\n    <ref id=\"" << name << "\"/>\n</shape>\n";
@@ -329,7 +384,8 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
 
 SceneModelRender RenderSceneModel(const Session& session, size_t photo, const std::vector<LocatedSample>& samples,
                                   const MaterialWeightsResult& weights, const std::vector<const BrdfModel*>& fits,
-                                  const Eigen::Vector3d& origin, double cell_m, const std::string& out_dir) {
+                                  const Eigen::Vector3d& origin, double cell_m, double light_scale,
+                                  const std::string& out_dir) {
   SceneModelRender result;
   if (photo >= session.photos.size() || !session.photos[photo].camera_from_world) return result;
   if (fits.size() != weights.bases) throw InternalError("RenderSceneModel: a fit per basis");
@@ -347,7 +403,7 @@ SceneModelRender RenderSceneModel(const Session& session, size_t photo, const st
     if (s.image != photo) continue;
     const auto it = cell_of_key.find(UniformityCellKey(located.point.cast<double>(), origin, cell_m));
     if (it == cell_of_key.end()) continue;
-    // The scene's mix of the cell's two largest weights, renormalised (see the header).
+    // The scene's mix of the cell's two largest weights, scaled to the cell's sum (see the header).
     const Eigen::VectorXd& cell = weights.cells[it->second].weights;
     Eigen::Index first = 0;
     cell.maxCoeff(&first);
@@ -357,12 +413,13 @@ SceneModelRender RenderSceneModel(const Session& session, size_t photo, const st
     }
     const double total = cell[first] + (second >= 0 ? cell[second] : 0.0);
     if (!(total > 0.0)) continue;
+    const double brightness = std::min(cell.sum(), light_scale);
     Eigen::VectorXd w = Eigen::VectorXd::Zero(cell.size());
-    w[first] = cell[first] / total;
-    if (second >= 0) w[second] = cell[second] / total;
+    w[first] = brightness * cell[first] / total;
+    if (second >= 0) w[second] = brightness * cell[second] / total;
     const Eigen::Vector3d wi(s.wi[0], s.wi[1], s.wi[2]), wo(s.wo[0], s.wo[1], s.wo[2]);
     if (!(wi.z() > 0.0 && wo.z() > 0.0)) continue;
-    double irradiance = wi.z();  // of the unit light, per unit of its intensity or radiance
+    double irradiance = wi.z();  // per unit of the light's intensity or radiance
     switch (light.kind) {
       case Light::Kind::kPoint:
         irradiance /= (light.position - located.point.cast<double>()).squaredNorm();

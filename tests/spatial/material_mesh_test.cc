@@ -27,10 +27,12 @@ struct Vertex {
   Eigen::Vector3d p;
   int32_t label;
   float w0, w3, residual;
-  uint8_t fits, from, rgb[3];
+  uint8_t fits, from;
+  float sum;
+  uint8_t rgb[3];
 };
 
-// The vertices of materials.ply with two bases (groups 0 and 3): 45 bytes each.
+// The vertices of materials.ply with two bases (groups 0 and 3): 49 bytes each.
 std::vector<Vertex> ReadVertices(const std::string& path, size_t n) {
   std::ifstream in(path, std::ios::binary);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -44,8 +46,9 @@ std::vector<Vertex> ReadVertices(const std::string& path, size_t n) {
     std::memcpy(&v.residual, at + 36, 4);
     v.fits = uint8_t(at[40]);
     v.from = uint8_t(at[41]);
-    for (int k = 0; k < 3; ++k) v.rgb[k] = uint8_t(at[42 + k]);
-    at += 45;
+    std::memcpy(&v.sum, at + 42, 4);
+    for (int k = 0; k < 3; ++k) v.rgb[k] = uint8_t(at[46 + k]);
+    at += 49;
   }
   return out;
 }
@@ -106,12 +109,14 @@ TEST(MaterialMesh, VerticesTakeTheirCellsWeightsInTheWorldFrame) {
     EXPECT_FLOAT_EQ(v[size_t(i)].w3, 0.75f) << i;
     EXPECT_FLOAT_EQ(v[size_t(i)].residual, 0.04f) << i;
     EXPECT_EQ(v[size_t(i)].fits, 1) << i;
+    EXPECT_FLOAT_EQ(v[size_t(i)].sum, 0.8f) << i;  // the weights before normalising: the cell's brightness
   }
   EXPECT_EQ(v[0].from, uint8_t(VertexWeightsFrom::kOwnCell));
   EXPECT_EQ(v[2].from, uint8_t(VertexWeightsFrom::kNearCell));
   EXPECT_EQ(v[3].from, uint8_t(VertexWeightsFrom::kNone));
   EXPECT_EQ(v[3].label, -1);
   EXPECT_EQ(v[3].w0 + v[3].w3, 0.0f);
+  EXPECT_EQ(v[3].sum, 0.0f);
   EXPECT_EQ(v[3].rgb[0], 128);  // grey: no weights
   EXPECT_EQ(v[4].fits, 0);
   EXPECT_EQ(v[4].label, 0);

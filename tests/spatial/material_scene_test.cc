@@ -224,6 +224,34 @@ TEST(MaterialScene, FacesTakeTheirVerticesMixAndUnweightedFacesAreBlack) {
       WritePbrtScene(session, 1, Square(), {"group-0/a.pbrt", "group-3/b.pbrt"}, {"a", "b"}, dir / "x", options);
   EXPECT_FALSE(no_pose.written);
   EXPECT_NE(no_pose.not_written.find("no pose"), std::string::npos);
+  // The weights' sums: carried by the light's scale (their 99th percentile, at least 1) and black mixed in.
+  VertexMaterials dim = Square();
+  dim.scale = {0.5, 0.5, 0.0, 0.5, 0.5, 0.0};
+  const PbrtSceneResult dimmed =
+      WritePbrtScene(session, 0, dim, {"group-0/a.pbrt", "group-3/b.pbrt"}, {"a", "b"}, dir.str(), options);
+  EXPECT_DOUBLE_EQ(dimmed.light_scale, 1.0);
+  const std::string dim_scene = ReadText(dir / dimmed.file);
+  EXPECT_NE(dim_scene.find("MakeNamedMaterial \"mix-0-3-0.20-at-0.50\" \"string type\" \"mix\"\n"
+                           "    \"string materials\" [ \"unmeasured\" \"mix-0-3-0.20\" ] \"float amount\" 0.5"),
+            std::string::npos)
+      << dim_scene;
+  EXPECT_NE(dim_scene.find("\"float scale\" [ 1 ]"), std::string::npos) << dim_scene;
+  EXPECT_NE(ReadText(dir / dimmed.mitsuba_file).find("<bsdf type=\"blendbsdf\" id=\"mix-0-3-0.40-at-0.50\">\n    <float name=\"weight\" value=\"0.5\"/>\n    <ref id=\"unmeasured\"/>"),
+            std::string::npos);
+  VertexMaterials bright = Square();
+  bright.scale = {2.0, 2.0, 0.0, 1.0, 2.0, 0.0};
+  const PbrtSceneResult brighter =
+      WritePbrtScene(session, 0, bright, {"group-0/a.pbrt", "group-3/b.pbrt"}, {"a", "b"}, dir.str(), options);
+  // Face {0, 1, 4} sums to 2, face {0, 4, 3} to 5 / 3: the light at the 99th percentile (nearest rank)
+  // of the two, the dimmer face mixed with black to 5 / 6 of it (in steps of 0.02: 0.84).
+  EXPECT_DOUBLE_EQ(brighter.light_scale, 2.0);
+  EXPECT_EQ(brighter.faces_scale_clipped, 0u);
+  EXPECT_NE(ReadText(dir / brighter.mitsuba_file).find("<rgb name=\"intensity\" value=\"2, 2, 2\"/>"), std::string::npos)
+      << ReadText(dir / brighter.mitsuba_file);
+  EXPECT_NE(ReadText(dir / brighter.file).find("[ \"unmeasured\" \"mix-0-3-0.20\" ] \"float amount\" 0.84"),
+            std::string::npos)
+      << ReadText(dir / brighter.file);
+
   // A group without its Mitsuba 3 material: the pbrt-v4 scene alone, and why.
   WriteSnippets(dir / "y");
   std::filesystem::remove(dir / "y/group-3/b.xml");
