@@ -711,28 +711,31 @@ nlohmann::json MaterialGroupsResult::ToJson() const {
     value["mesh"] = mesh_json;
     nlohmann::json pbrt_json = {{"written", pbrt.written}};
     if (pbrt.written) {
-      pbrt_json.update({{"scene", pbrt.file},
-                        {"image", pbrt.image},
-                        {"photo", pbrt.photo},
-                        {"materials", pbrt.materials},
-                        {"faces", pbrt.faces},
-                        {"faces_without_weights", pbrt.faces_unmeasured},
-                        {"undistorted", pbrt.undistorted},
-                        {"light_scale", pbrt.light_scale},
-                        {"faces_brighter_than_the_light_scale", pbrt.faces_scale_clipped},
-                        {"mitsuba_scene", pbrt.mitsuba_file.empty() ? nlohmann::json(nullptr) : nlohmann::json(pbrt.mitsuba_file)},
-                        {"mitsuba_render", pbrt.mitsuba_file.empty() ? nlohmann::json(pbrt.mitsuba_not_written)
-                                                                     : nlohmann::json("cd mitsuba && mitsuba " +
-                                                                           std::filesystem::path(pbrt.mitsuba_file).filename().string())},
-                        {"ibrdf_image", pbrt.model_image.empty() ? nlohmann::json(nullptr) : nlohmann::json(pbrt.model_image)},
-                        {"ibrdf_pixels", pbrt.model_pixels},
-                        {"weight_sums", {{"p05", pbrt.weight_sum_p05},
-                                         {"median", pbrt.weight_sum_median},
-                                         {"p95", pbrt.weight_sum_p95},
-                                         {"full_weights_brightness_ratio", pbrt.full_model_ratio}}},
-                        {"render", "cd " + std::filesystem::path(pbrt.file).parent_path().string() + " && pbrt " +
-                                       std::filesystem::path(pbrt.file).filename().string() + " (writes " +
-                                       pbrt.image + " there)"}});
+      pbrt_json.update(
+          {{"scene", pbrt.file},
+           {"image", pbrt.image},
+           {"photo", pbrt.photo},
+           {"materials", pbrt.materials},
+           {"faces", pbrt.faces},
+           {"faces_without_weights", pbrt.faces_unmeasured},
+           {"undistorted", pbrt.undistorted},
+           {"light_scale", pbrt.light_scale},
+           {"faces_brighter_than_the_light_scale", pbrt.faces_scale_clipped},
+           {"mitsuba_scene", pbrt.mitsuba_file.empty() ? nlohmann::json(nullptr) : nlohmann::json(pbrt.mitsuba_file)},
+           {"mitsuba_render", pbrt.mitsuba_file.empty()
+                                  ? nlohmann::json(pbrt.mitsuba_not_written)
+                                  : nlohmann::json("cd mitsuba && mitsuba " +
+                                                   std::filesystem::path(pbrt.mitsuba_file).filename().string())},
+           {"ibrdf_image", pbrt.model_image.empty() ? nlohmann::json(nullptr) : nlohmann::json(pbrt.model_image)},
+           {"ibrdf_pixels", pbrt.model_pixels},
+           {"weight_sums",
+            {{"p05", pbrt.weight_sum_p05},
+             {"median", pbrt.weight_sum_median},
+             {"p95", pbrt.weight_sum_p95},
+             {"full_weights_brightness_ratio", pbrt.full_model_ratio}}},
+           {"render", "cd " + std::filesystem::path(pbrt.file).parent_path().string() + " && pbrt " +
+                          std::filesystem::path(pbrt.file).filename().string() + " (writes " + pbrt.image +
+                          " there)"}});
     } else {
       pbrt_json["reason"] = pbrt.not_written.empty() ? mesh_json.value("reason", "") : pbrt.not_written;
     }

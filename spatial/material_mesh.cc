@@ -100,7 +100,8 @@ MaterialMeshResult WriteMaterialMesh(const Session& session, const MaterialWeigh
   for (const char* colour : {"red", "green", "blue"}) {
     properties.push_back({colour, PlyPropertyType::kUchar, std::vector<double>(n, 128.0)});
   }
-  const size_t residual = 1 + n_bases, fits = residual + 1, from = fits + 1, weight_sum = from + 1, red = weight_sum + 1;
+  const size_t residual = 1 + n_bases, fits = residual + 1, from = fits + 1, weight_sum = from + 1,
+               red = weight_sum + 1;
   result.vertices = n;
   for (size_t v = 0; v < n; ++v) {
     const Eigen::Vector3d& p = mesh.points[v];

@@ -66,14 +66,14 @@ std::string PbrtSceneResult::BriefReport() const {
          std::to_string(materials) + " materials (" +
          Fixed(faces ? 100.0 * double(faces_unmeasured) / double(faces) : 0.0, 1) +
          " % of faces without weights, black); light scale " + Fixed(light_scale, 3) + " (" +
-         std::to_string(faces_scale_clipped) + " faces brighter, held at it); render: cd " + std::filesystem::path(file).parent_path().string() +
-         " && pbrt " + std::filesystem::path(file).filename().string() +
+         std::to_string(faces_scale_clipped) + " faces brighter, held at it); render: cd " +
+         std::filesystem::path(file).parent_path().string() + " && pbrt " +
+         std::filesystem::path(file).filename().string() +
          (model_image.empty() ? std::string()
                               : "; ibrdf's render of the model: " + model_image + " (" + std::to_string(model_pixels) +
                                     " pixels; the cells' weight sums there, median " + Fixed(weight_sum_median, 2) +
                                     ", 5-95 % " + Fixed(weight_sum_p05, 2) + "-" + Fixed(weight_sum_p95, 2) +
-                                    "; the model with every weight is " + Fixed(full_model_ratio, 3) +
-                                    "x as bright)") +
+                                    "; the model with every weight is " + Fixed(full_model_ratio, 3) + "x as bright)") +
          (mitsuba_file.empty() ? "; no Mitsuba 3 scene: " + mitsuba_not_written : "; Mitsuba 3: " + mitsuba_file);
 }
 
@@ -147,7 +147,6 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   result.faces = mesh.faces.size();
   result.faces_unmeasured = unmeasured.size();
 
-
   const std::filesystem::path folder = std::filesystem::path(out_dir) / "pbrt";
   std::filesystem::create_directories(folder);
   // One PLY per material: its faces and the vertices they use (normals kept).
@@ -180,23 +179,27 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   const double w = double(camera.width), h = double(camera.height);
 
   std::ostringstream scene;
-  scene << "# pbrt-v4: photo " << photo << " of " << session.manifest_path
-        << " rendered from ibrdf's measured spatially varying model\n"
-        << "# (each face a mix of the two groups of the largest weights, amounts in steps of "
-        << Number(options.amount_step) << "; faces without weights black).\n"
-        << "# The light's intensity is its scale, the faces' weight sums' " << Number(100.0 * options.max_scale_percentile)
-        << "th percentile, and each face mixes\n# its material with black down to its own sum: a pixel over (cos theta_i / r^2) of its point is the\n"
-        << "# model's BRDF there.\n"
-        << (result.undistorted ? "# The photo's lens distortion is not rendered (pbrt-v4's perspective camera has none): photo "
-                                 "pixel p is\n# rendered at (fx x + cx, fy y + cy), (x, y) the undistorted image-plane point of p.\n"
-                               : "")
-        << "Film \"rgb\" \"integer xresolution\" [ " << camera.width << " ] \"integer yresolution\" [ "
-        << camera.height << " ]\n    \"string filename\" \"photo-" << photo << ".exr\" \"bool savefp16\" false\n"
-        << "PixelFilter \"box\" \"float xradius\" [ 0.5 ] \"float yradius\" [ 0.5 ]\n"
-        << "Sampler \"zsobol\" \"integer pixelsamples\" [ " << options.samples_per_pixel << " ]\n"
-        << "Integrator \"path\" \"integer maxdepth\" [ 1 ]\n"
-        << "# The photo's camera_from_world, y flipped: pbrt's camera looks down +z with +y up, the photo's y is down.\n"
-        << "Scale 1 -1 1\nConcatTransform [";
+  scene
+      << "# pbrt-v4: photo " << photo << " of " << session.manifest_path
+      << " rendered from ibrdf's measured spatially varying model\n"
+      << "# (each face a mix of the two groups of the largest weights, amounts in steps of "
+      << Number(options.amount_step) << "; faces without weights black).\n"
+      << "# The light's intensity is its scale, the faces' weight sums' "
+      << Number(100.0 * options.max_scale_percentile)
+      << "th percentile, and each face mixes\n# its material with black down to its own sum: a pixel over (cos theta_i "
+         "/ r^2) of its point is the\n"
+      << "# model's BRDF there.\n"
+      << (result.undistorted
+              ? "# The photo's lens distortion is not rendered (pbrt-v4's perspective camera has none): photo "
+                "pixel p is\n# rendered at (fx x + cx, fy y + cy), (x, y) the undistorted image-plane point of p.\n"
+              : "")
+      << "Film \"rgb\" \"integer xresolution\" [ " << camera.width << " ] \"integer yresolution\" [ " << camera.height
+      << " ]\n    \"string filename\" \"photo-" << photo << ".exr\" \"bool savefp16\" false\n"
+      << "PixelFilter \"box\" \"float xradius\" [ 0.5 ] \"float yradius\" [ 0.5 ]\n"
+      << "Sampler \"zsobol\" \"integer pixelsamples\" [ " << options.samples_per_pixel << " ]\n"
+      << "Integrator \"path\" \"integer maxdepth\" [ 1 ]\n"
+      << "# The photo's camera_from_world, y flipped: pbrt's camera looks down +z with +y up, the photo's y is down.\n"
+      << "Scale 1 -1 1\nConcatTransform [";
   for (int col = 0; col < 4; ++col) {
     for (int row = 0; row < 4; ++row) scene << " " << Number(m(row, col));
   }
@@ -253,8 +256,9 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
       name = base + "-at-" + Fixed(fraction, 2);
       if (defined.insert(name).second) {
         scaled.push_back({name, base, fraction});
-        scene << "MakeNamedMaterial \"" << name << "\" \"string type\" \"mix\"\n    \"string materials\" [ \"unmeasured\" \""
-              << base << "\" ] \"float amount\" " << Number(fraction) << "\n";
+        scene << "MakeNamedMaterial \"" << name
+              << "\" \"string type\" \"mix\"\n    \"string materials\" [ \"unmeasured\" \"" << base
+              << "\" ] \"float amount\" " << Number(fraction) << "\n";
       }
     }
     const std::string file = "part-" + std::to_string(part++) + ".ply";
@@ -333,8 +337,9 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
         // Mitsuba's direction is the light's travel, away from the light.
         xml << "    <emitter type=\"directional\">\n        <vector name=\"direction\" x=\""
             << Number(-light.direction.x()) << "\" y=\"" << Number(-light.direction.y()) << "\" z=\""
-            << Number(-light.direction.z()) << "\"/>\n        <rgb name=\"irradiance\" value=\"" << Number(result.light_scale) << ", "
-            << Number(result.light_scale) << ", " << Number(result.light_scale) << "\"/>\n    </emitter>\n";
+            << Number(-light.direction.z()) << "\"/>\n        <rgb name=\"irradiance\" value=\""
+            << Number(result.light_scale) << ", " << Number(result.light_scale) << ", " << Number(result.light_scale)
+            << "\"/>\n    </emitter>\n";
         break;
     }
     // Each group's exported Mitsuba 3 material (NAME.xml beside NAME.pbrt), inlined.
@@ -362,8 +367,8 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
           << "\"/>\n</bsdf>\n";
     }
     for (const auto& [file, name] : shapes) {
-      xml << "<shape type=\"ply\">\n    <string name=\"filename\" value=\"../pbrt/" << file
-          << "\"/>\n    <ref id=\"" << name << "\"/>\n</shape>\n";
+      xml << "<shape type=\"ply\">\n    <string name=\"filename\" value=\"../pbrt/" << file << "\"/>\n    <ref id=\""
+          << name << "\"/>\n</shape>\n";
     }
     xml << "</scene>\n";
     if (!result.mitsuba_not_written.empty()) {

@@ -14,8 +14,8 @@
 //
 // The film is the photo's size; the camera is the photo's pinhole (pbrt-v4's perspective camera with
 // a screen window that puts the principal point where the photo has it, y flipped to pbrt's raster);
-// the light has the intensity of its scale (below), so that a pixel's value over (cos theta_i / r^2) of its surface point is
-// the rendered BRDF; one bounce (ibrdf measures direct reflection). Faces without weights on all three
+// the light's intensity is its scale (above), so that a pixel's value over (cos theta_i / r^2) of its
+// surface point is the model's BRDF; one bounce (ibrdf measures direct reflection). Faces without weights on all three
 // vertices are black diffuse (they still cast shadows). pbrt-v4's perspective camera has no lens
 // distortion: the image is the undistorted pinhole's, photo pixel p rendered at (fx x + cx, fy y + cy)
 // with (x, y) = Camera::CamPlaneFromImage(p). A photo without a pose is not written.
@@ -48,17 +48,17 @@ struct PbrtSceneResult {
   size_t photo = 0;         // the session photo rendered
   std::string file;         // the scene, relative to the output folder ("pbrt/photo-3.pbrt")
   std::string image;        // the EXR pbrt writes, relative to the scene's folder
-  std::string mitsuba_file;  // the same scene for Mitsuba 3 ("mitsuba/photo-3.xml"), its shapes pbrt/'s parts
+  std::string mitsuba_file;         // the same scene for Mitsuba 3 ("mitsuba/photo-3.xml"), its shapes pbrt/'s parts
   std::string mitsuba_not_written;  // why not, when not (a group without its NAME.xml)
-  std::string model_image;  // ibrdf's own render of the same model (RenderSceneModel), relative to the scene's folder
+  std::string model_image;    // ibrdf's own render of the same model (RenderSceneModel), relative to the scene's folder
   uint64_t model_pixels = 0;  // and its rendered pixels
   // From RenderSceneModel: its samples' cells' weight sums, and the full model's brightness over its render's.
   double weight_sum_p05 = 0.0, weight_sum_median = 0.0, weight_sum_p95 = 0.0, full_model_ratio = 1.0;
   bool undistorted = false;  // the camera has distortion that the render leaves out (see above)
   int materials = 0;        // named materials: the groups, and each mix used
   uint64_t faces = 0, faces_unmeasured = 0;
-  double light_scale = 1.0;           // the light's intensity: the faces' weight sums' percentile, at least 1
-  uint64_t faces_scale_clipped = 0;   // faces brighter than it, rendered at it
+  double light_scale = 1.0;          // the light's intensity: the faces' weight sums' percentile, at least 1
+  uint64_t faces_scale_clipped = 0;  // faces brighter than it, rendered at it
 
   // "pbrt/photo-3.pbrt: 133367 faces in 14 materials (61 % unmeasured, black); render: pbrt pbrt/photo-3.pbrt;
   // ibrdf's render of the model: photo-3-ibrdf.exr"
@@ -66,8 +66,9 @@ struct PbrtSceneResult {
 };
 
 // Writes out_dir/pbrt/photo-N.pbrt and its mesh parts (part-K.ply), and out_dir/mitsuba/photo-N.xml, the
-// same scene for Mitsuba 3 (each group's NAME.xml beside its NAME.pbrt inlined; blendbsdf for the mixes). `basis_snippets[b]` is the pbrt-v4
-// material file of vertices.bases[b], relative to out_dir, defining `basis_names[b]`.
+// same scene for Mitsuba 3 (each group's NAME.xml beside its NAME.pbrt inlined; blendbsdf for the mixes).
+// `basis_snippets[b]` is the pbrt-v4 material file of vertices.bases[b], relative to out_dir, defining
+// `basis_names[b]`.
 PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const VertexMaterials& vertices,
                                const std::vector<std::string>& basis_snippets,
                                const std::vector<std::string>& basis_names, const std::string& out_dir,

@@ -4,16 +4,16 @@
 // markers) through `ibrdf run --spatial`, then `pbrt` on materials/pbrt/photo-N.pbrt. pbrt's camera,
 // light, mesh parts, mixes and the groups' exported materials must together reproduce ibrdf's
 // radiance (the cells' two largest weights scaled to the cell's sum of weights, as the scene's mixes
-// with black under its scaled light have them, over the groups' GGX fits, times cos theta_i / r^2) within 2 % median over 7 x 7-pixel windows; per pixel
-// pbrt's stochastic mixes leave noise even at 1024 samples per pixel, and the scene's weights are per
-// face and in 0.1 steps (both reported, docs/spatial.md).
-// The Mitsuba 3 scene of the same run is checked for its parts and materials. Skips the render with a
-// message where the pbrt binary is absent or does not run.
+// with black under its scaled light have them, over the groups' GGX fits, times cos theta_i / r^2) within 2 % median
+// over 7 x 7-pixel windows; per pixel pbrt's stochastic mixes leave noise even at 1024 samples per pixel, and the
+// scene's weights are per face and in 0.1 steps (both reported, docs/spatial.md). The Mitsuba 3 scene of the same run
+// is checked for its parts and materials. Skips the render with a message where the pbrt binary is absent or does not
+// run.
 #include <algorithm>
 #include <cmath>
-#include <iostream>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <string>
 #include <vector>

@@ -75,7 +75,8 @@ Eigen::Vector2d MitsubaRaster(const std::string& xml, const Eigen::Vector3d& p_w
   const std::vector<double> m = Numbers(xml, R"re(<matrix value="([^"]*)")re");
   const std::vector<double> width = Numbers(xml, R"re(name="width" value="([^"]*)")re");
   const std::vector<double> height = Numbers(xml, R"re(name="height" value="([^"]*)")re");
-  if (fov.size() != 1 || ox.size() != 1 || oy.size() != 1 || m.size() != 16 || width.size() != 1 || height.size() != 1) {
+  if (fov.size() != 1 || ox.size() != 1 || oy.size() != 1 || m.size() != 16 || width.size() != 1 ||
+      height.size() != 1) {
     return {};
   }
   Eigen::Matrix4d to_world;
@@ -83,8 +84,10 @@ Eigen::Vector2d MitsubaRaster(const std::string& xml, const Eigen::Vector3d& p_w
     for (int col = 0; col < 4; ++col) to_world(row, col) = m[size_t(row * 4 + col)];
   }
   // No scale allowed (perspective.cpp's constructor): a rotation.
-  EXPECT_NEAR((to_world.topLeftCorner<3, 3>() * to_world.topLeftCorner<3, 3>().transpose() - Eigen::Matrix3d::Identity()).norm(),
-              0.0, 1e-9);
+  EXPECT_NEAR(
+      (to_world.topLeftCorner<3, 3>() * to_world.topLeftCorner<3, 3>().transpose() - Eigen::Matrix3d::Identity())
+          .norm(),
+      0.0, 1e-9);
   const Eigen::Vector4d p = to_world.inverse() * p_world.homogeneous();
   const double t = std::tan(fov[0] * M_PI / 360.0), aspect = width[0] / height[0];
   const double sx = p.x() / (p.z() * t), sy = p.y() / (p.z() * t);
@@ -130,7 +133,8 @@ void WriteSnippets(const std::string& root) {
   for (const std::string name : {"a", "b"}) {
     const std::string folder = root + (name == std::string("a") ? "/group-0" : "/group-3");
     std::filesystem::create_directories(folder);
-    std::ofstream(folder + "/" + name + ".pbrt") << "MakeNamedMaterial \"" << name << "\" \"string type\" \"diffuse\"\n";
+    std::ofstream(folder + "/" + name + ".pbrt")
+        << "MakeNamedMaterial \"" << name << "\" \"string type\" \"diffuse\"\n";
     std::ofstream(folder + "/" + name + ".xml") << "<bsdf type=\"diffuse\" id=\"" << name << "\"/>\n";
   }
 }
@@ -165,7 +169,6 @@ void ExpectCameraMatches(const Camera& camera) {
   }
   EXPECT_EQ(xml.find("are not square") != std::string::npos, camera.FocalX() != camera.FocalY()) << xml;
 }
-
 
 TEST(MaterialScene, PbrtsCameraSeesEachPointWhereThePhotoDoes) {
   ExpectCameraMatches(Camera::Create(CameraModelId::kPinhole, 800, 600, {1200.0, 1190.0, 410.5, 290.25}));
@@ -211,7 +214,8 @@ TEST(MaterialScene, FacesTakeTheirVerticesMixAndUnweightedFacesAreBlack) {
   EXPECT_NE(xml.find("<point name=\"position\" x=\"0.1\" y=\"0.2\" z=\"0.6\"/>"), std::string::npos) << xml;
   EXPECT_NE(xml.find("<integer name=\"max_depth\" value=\"2\"/>"), std::string::npos) << xml;
   size_t shapes = 0;
-  for (size_t at = xml.find("<shape type=\"ply\">"); at != std::string::npos; at = xml.find("<shape type=\"ply\">", at + 1)) {
+  for (size_t at = xml.find("<shape type=\"ply\">"); at != std::string::npos;
+       at = xml.find("<shape type=\"ply\">", at + 1)) {
     ++shapes;
   }
   EXPECT_EQ(shapes, 3u);
@@ -236,7 +240,9 @@ TEST(MaterialScene, FacesTakeTheirVerticesMixAndUnweightedFacesAreBlack) {
             std::string::npos)
       << dim_scene;
   EXPECT_NE(dim_scene.find("\"float scale\" [ 1 ]"), std::string::npos) << dim_scene;
-  EXPECT_NE(ReadText(dir / dimmed.mitsuba_file).find("<bsdf type=\"blendbsdf\" id=\"mix-0-3-0.40-at-0.50\">\n    <float name=\"weight\" value=\"0.5\"/>\n    <ref id=\"unmeasured\"/>"),
+  EXPECT_NE(ReadText(dir / dimmed.mitsuba_file)
+                .find("<bsdf type=\"blendbsdf\" id=\"mix-0-3-0.40-at-0.50\">\n    <float name=\"weight\" "
+                      "value=\"0.5\"/>\n    <ref id=\"unmeasured\"/>"),
             std::string::npos);
   VertexMaterials bright = Square();
   bright.scale = {2.0, 2.0, 0.0, 1.0, 2.0, 0.0};
@@ -246,7 +252,8 @@ TEST(MaterialScene, FacesTakeTheirVerticesMixAndUnweightedFacesAreBlack) {
   // of the two, the dimmer face mixed with black to 5 / 6 of it (in steps of 0.02: 0.84).
   EXPECT_DOUBLE_EQ(brighter.light_scale, 2.0);
   EXPECT_EQ(brighter.faces_scale_clipped, 0u);
-  EXPECT_NE(ReadText(dir / brighter.mitsuba_file).find("<rgb name=\"intensity\" value=\"2, 2, 2\"/>"), std::string::npos)
+  EXPECT_NE(ReadText(dir / brighter.mitsuba_file).find("<rgb name=\"intensity\" value=\"2, 2, 2\"/>"),
+            std::string::npos)
       << ReadText(dir / brighter.mitsuba_file);
   EXPECT_NE(ReadText(dir / brighter.file).find("[ \"unmeasured\" \"mix-0-3-0.20\" ] \"float amount\" 0.84"),
             std::string::npos)
@@ -255,8 +262,8 @@ TEST(MaterialScene, FacesTakeTheirVerticesMixAndUnweightedFacesAreBlack) {
   // A group without its Mitsuba 3 material: the pbrt-v4 scene alone, and why.
   WriteSnippets(dir / "y");
   std::filesystem::remove(dir / "y/group-3/b.xml");
-  const PbrtSceneResult without = WritePbrtScene(session, 0, Square(), {"group-0/a.pbrt", "group-3/b.pbrt"}, {"a", "b"},
-                                                 dir / "y", options);
+  const PbrtSceneResult without =
+      WritePbrtScene(session, 0, Square(), {"group-0/a.pbrt", "group-3/b.pbrt"}, {"a", "b"}, dir / "y", options);
   EXPECT_TRUE(without.written);
   EXPECT_TRUE(without.mitsuba_file.empty());
   EXPECT_NE(without.mitsuba_not_written.find("b.xml cannot be read"), std::string::npos) << without.mitsuba_not_written;
