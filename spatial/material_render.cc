@@ -73,10 +73,7 @@ PhotoPrediction PredictPhoto(const Session& session, size_t photo, bool held_out
   result.done = true;
   result.photo = photo;
   result.held_out = held_out;
-  std::unordered_map<uint64_t, size_t> cell_of_key;
-  for (size_t c = 0; c < weights.cells.size(); ++c) {
-    if (weights.cells[c].fitted) cell_of_key.emplace(weights.cells[c].key, c);
-  }
+  const std::unordered_map<uint64_t, size_t> cell_of_key = FittedCellsByKey(weights);
   const Camera& camera = session.camera;
   // Per predicted sample: its pixel, and model / measured per channel (NaN where not predicted).
   struct Drawn {

@@ -31,6 +31,17 @@ struct FaceMaterial {
   }
 };
 
+// The largest weight's index and the second largest positive one's (-1: none).
+std::pair<Eigen::Index, Eigen::Index> LargestTwo(const Eigen::VectorXd& w) {
+  Eigen::Index first = 0;
+  w.maxCoeff(&first);
+  Eigen::Index second = -1;
+  for (Eigen::Index b = 0; b < w.size(); ++b) {
+    if (b != first && w[b] > 0.0 && (second < 0 || w[b] > w[second])) second = b;
+  }
+  return {first, second};
+}
+
 std::string Number(double value) {
   std::ostringstream out;
   out.precision(12);
@@ -113,24 +124,20 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
       continue;
     }
     FaceMaterial material;
-    Eigen::Index first = 0;
-    w.maxCoeff(&first);
+    const auto [first, second] = LargestTwo(w);
     material.a = int(first);
-    double second_weight = 0.0;
-    for (Eigen::Index b = 0; b < w.size(); ++b) {
-      if (b != first && w[b] > second_weight) {
-        second_weight = w[b];
-        material.b = int(b);
-      }
-    }
-    if (material.b >= 0) {
-      material.steps = int(std::lround(second_weight / (w[first] + second_weight) / options.amount_step));
+    if (second >= 0) {
+      material.b = int(second);
+      material.steps = int(std::lround(w[second] / (w[first] + w[second]) / options.amount_step));
       if (material.steps == 0) material.b = -1;
     }
     measured_faces.emplace_back(material, f);
-    double scale = 0.0;
-    for (int k = 0; k < 3; ++k) scale += vertices.scale.empty() ? 1.0 : vertices.scale[size_t(face[k])] / 3.0;
-    face_scales.push_back(vertices.scale.empty() ? 1.0 : scale);
+    double scale = 1.0;  // without sums (no scale given), every face at the light's
+    if (!vertices.scale.empty()) {
+      scale = 0.0;
+      for (int k = 0; k < 3; ++k) scale += vertices.scale[size_t(face[k])] / 3.0;
+    }
+    face_scales.push_back(scale);
   }
   // The faces' brightness: the light is scaled to the 99th percentile of the faces' weight sums (at least
   // 1), and each face mixes its material with black to the rest; brighter faces are held at the light's.
@@ -282,15 +289,32 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
   out.close();
   if (!out) ThrowError(path, "write failed (disk full?)");
 
-  // The same scene for Mitsuba 3, its shapes the pbrt scene's parts. Its perspective camera
-  // (src/sensors/perspective.cpp and perspective_projection in include/mitsuba/render/sensor.h) looks
-  // down +z with +x to the image's left and +y up: the photo's camera frame turned 180 degrees about z.
-  // Film position s = ((1 + x / (z t)) / 2, (1 + aspect y / (z t)) / 2) in the photo's frame with
-  // t = tan(x_fov / 2), less principal_point_offset: x_fov = 2 atan(W / (2 fx)) and offset
-  // (0.5 - cx / W, 0.5 - cy / H) put pixel (u, v) at u = fx x / z + cx, v = fx y / z + cy (square
-  // pixels: Mitsuba has one focal length).
-  {
+  // The same scene for Mitsuba 3, its shapes the pbrt scene's parts and each group's exported Mitsuba 3
+  // material (NAME.xml beside NAME.pbrt) inlined.
+  std::vector<std::string> mitsuba_materials;
+  for (size_t b = 0; b < n_bases; ++b) {
+    const std::filesystem::path snippet =
+        (std::filesystem::path(out_dir) / basis_snippets[b]).replace_extension(".xml");
+    std::ifstream in(snippet);
+    if (!in) {
+      result.mitsuba_not_written = snippet.string() + " cannot be read";
+      break;
+    }
+    std::stringstream text;
+    text << in.rdbuf();
+    mitsuba_materials.push_back(text.str());
+  }
+  if (result.mitsuba_not_written.empty()) {
     std::ostringstream xml;
+    const std::string intensity =
+        Number(result.light_scale) + ", " + Number(result.light_scale) + ", " + Number(result.light_scale);
+    // Mitsuba 3's perspective camera
+    // (src/sensors/perspective.cpp and perspective_projection in include/mitsuba/render/sensor.h) looks
+    // down +z with +x to the image's left and +y up: the photo's camera frame turned 180 degrees about z.
+    // Film position s = ((1 + x / (z t)) / 2, (1 + aspect y / (z t)) / 2) in the photo's frame with
+    // t = tan(x_fov / 2), less principal_point_offset: x_fov = 2 atan(W / (2 fx)) and offset
+    // (0.5 - cx / W, 0.5 - cy / H) put pixel (u, v) at u = fx x / z + cx, v = fx y / z + cy (square
+    // pixels: Mitsuba has one focal length).
     const Eigen::Matrix3d world_from_camera = m.topLeftCorner<3, 3>().transpose();
     const Eigen::Vector3d centre = -world_from_camera * m.topRightCorner<3, 1>();
     Eigen::Matrix4d to_world = Eigen::Matrix4d::Identity();
@@ -330,30 +354,18 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
       case Light::Kind::kPoint:
         xml << "    <emitter type=\"point\">\n        <point name=\"position\" x=\"" << Number(light.position.x())
             << "\" y=\"" << Number(light.position.y()) << "\" z=\"" << Number(light.position.z())
-            << "\"/>\n        <rgb name=\"intensity\" value=\"" << Number(result.light_scale) << ", "
-            << Number(result.light_scale) << ", " << Number(result.light_scale) << "\"/>\n    </emitter>\n";
+            << "\"/>\n        <rgb name=\"intensity\" value=\"" << intensity << "\"/>\n    </emitter>\n";
         break;
       case Light::Kind::kDirectional:
         // Mitsuba's direction is the light's travel, away from the light.
         xml << "    <emitter type=\"directional\">\n        <vector name=\"direction\" x=\""
             << Number(-light.direction.x()) << "\" y=\"" << Number(-light.direction.y()) << "\" z=\""
-            << Number(-light.direction.z()) << "\"/>\n        <rgb name=\"irradiance\" value=\""
-            << Number(result.light_scale) << ", " << Number(result.light_scale) << ", " << Number(result.light_scale)
+            << Number(-light.direction.z()) << "\"/>\n        <rgb name=\"irradiance\" value=\"" << intensity
             << "\"/>\n    </emitter>\n";
         break;
     }
-    // Each group's exported Mitsuba 3 material (NAME.xml beside NAME.pbrt), inlined.
-    for (size_t b = 0; b < n_bases; ++b) {
-      const std::filesystem::path snippet =
-          (std::filesystem::path(out_dir) / basis_snippets[b]).replace_extension(".xml");
-      std::ifstream in(snippet);
-      if (!in) {
-        result.mitsuba_not_written = snippet.string() + " cannot be read";
-        break;
-      }
-      std::stringstream text;
-      text << in.rdbuf();
-      xml << text.str() << (text.str().empty() || text.str().back() == '\n' ? "" : "\n");
+    for (const std::string& text : mitsuba_materials) {
+      xml << text << (text.empty() || text.back() == '\n' ? "" : "\n");
     }
     for (const Mix& mix : mixes) {
       xml << "<bsdf type=\"blendbsdf\" id=\"" << mix.name << "\">\n    <float name=\"weight\" value=\""
@@ -371,10 +383,6 @@ PbrtSceneResult WritePbrtScene(const Session& session, size_t photo, const Verte
           << name << "\"/>\n</shape>\n";
     }
     xml << "</scene>\n";
-    if (!result.mitsuba_not_written.empty()) {
-      result.written = true;
-      return result;
-    }
     result.mitsuba_file = "mitsuba/photo-" + std::to_string(photo) + ".xml";
     std::filesystem::create_directories(std::filesystem::path(out_dir) / "mitsuba");
     const std::string xml_path = (std::filesystem::path(out_dir) / result.mitsuba_file).string();
@@ -394,10 +402,7 @@ SceneModelRender RenderSceneModel(const Session& session, size_t photo, const st
   SceneModelRender result;
   if (photo >= session.photos.size() || !session.photos[photo].camera_from_world) return result;
   if (fits.size() != weights.bases) throw InternalError("RenderSceneModel: a fit per basis");
-  std::unordered_map<uint64_t, size_t> cell_of_key;
-  for (size_t c = 0; c < weights.cells.size(); ++c) {
-    if (weights.cells[c].fitted) cell_of_key.emplace(weights.cells[c].key, c);
-  }
+  const std::unordered_map<uint64_t, size_t> cell_of_key = FittedCellsByKey(weights);
   const Camera& camera = session.camera;
   const Light& light = session.lights[session.photos[photo].light];
   Image sum(camera.width, camera.height, 4);
@@ -410,12 +415,7 @@ SceneModelRender RenderSceneModel(const Session& session, size_t photo, const st
     if (it == cell_of_key.end()) continue;
     // The scene's mix of the cell's two largest weights, scaled to the cell's sum (see the header).
     const Eigen::VectorXd& cell = weights.cells[it->second].weights;
-    Eigen::Index first = 0;
-    cell.maxCoeff(&first);
-    Eigen::Index second = -1;
-    for (Eigen::Index b = 0; b < cell.size(); ++b) {
-      if (b != first && cell[b] > 0.0 && (second < 0 || cell[b] > cell[second])) second = b;
-    }
+    const auto [first, second] = LargestTwo(cell);
     const double total = cell[first] + (second >= 0 ? cell[second] : 0.0);
     if (!(total > 0.0)) continue;
     const double brightness = std::min(cell.sum(), light_scale);

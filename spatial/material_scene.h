@@ -55,7 +55,7 @@ struct PbrtSceneResult {
   // From RenderSceneModel: its samples' cells' weight sums, and the full model's brightness over its render's.
   double weight_sum_p05 = 0.0, weight_sum_median = 0.0, weight_sum_p95 = 0.0, full_model_ratio = 1.0;
   bool undistorted = false;  // the camera has distortion that the render leaves out (see above)
-  int materials = 0;        // named materials: the groups, and each mix used
+  int materials = 0;         // named materials: the groups, each mix used and each at a fraction of the light
   uint64_t faces = 0, faces_unmeasured = 0;
   double light_scale = 1.0;          // the light's intensity: the faces' weight sums' percentile, at least 1
   uint64_t faces_scale_clipped = 0;  // faces brighter than it, rendered at it

@@ -173,4 +173,12 @@ std::string MaterialWeightsResult::BriefReport(const MaterialWeightsOptions& opt
          " sigma); median residual " + Fixed(100.0 * median_rel_rms, 1) + " %; " + Fixed(seconds, 1) + " s";
 }
 
+std::unordered_map<uint64_t, size_t> FittedCellsByKey(const MaterialWeightsResult& weights) {
+  std::unordered_map<uint64_t, size_t> cell_of_key;
+  for (size_t c = 0; c < weights.cells.size(); ++c) {
+    if (weights.cells[c].fitted) cell_of_key.emplace(weights.cells[c].key, c);
+  }
+  return cell_of_key;
+}
+
 }  // namespace ibrdf

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -84,5 +85,8 @@ struct MaterialWeightsResult {
 // options.
 MaterialWeightsResult ProjectOntoBases(std::vector<LocatedSample>* samples, const std::vector<const BrdfModel*>& bases,
                                        const MaterialWeightsOptions& options);
+
+// The fitted cells of `weights` by their key (UniformityCellKey), as indices into its `cells`.
+std::unordered_map<uint64_t, size_t> FittedCellsByKey(const MaterialWeightsResult& weights);
 
 }  // namespace ibrdf
