@@ -5,7 +5,7 @@
 // light, mesh parts, mixes and the groups' exported materials must together reproduce ibrdf's
 // radiance (the cells' two largest weights scaled to the cell's sum of weights, as the scene's mixes
 // with black under its scaled light have them, over the groups' GGX fits, times cos theta_i / r^2) within 2 % median
-// over 7 x 7-pixel windows; per pixel pbrt's stochastic mixes leave noise even at 1024 samples per pixel, and the
+// over 7 x 7-pixel windows; per pixel pbrt's stochastic mixes leave noise even at 2048 samples per pixel, and the
 // scene's weights are per face and in 0.1 steps (both reported, docs/spatial.md). The Mitsuba 3 scene of the same run
 // is checked for its parts and materials. Skips the render with a message where the pbrt binary is absent or does not
 // run.
@@ -82,7 +82,7 @@ TEST(MaterialScenePbrt, RendersTheSpatiallyVaryingSquashAsIbrdfDoes) {
   const std::string file = fs::path(scene.at("scene").get<std::string>()).filename().string();
   const Image by_ibrdf = ReadImage((folder / scene.at("ibrdf_image").get<std::string>()).string());
   ASSERT_EQ(by_ibrdf.channels, 4);
-  // pbrt renders the rendered pixels' bounding box only, at 1024 samples per pixel: its mixes pick one
+  // pbrt renders the rendered pixels' bounding box only, at 2048 samples per pixel: its mixes pick one
   // material per sample, and at the scene's 64 their noise is 13 % per pixel here.
   int x0 = by_ibrdf.width, y0 = by_ibrdf.height, x1 = 0, y1 = 0;
   size_t pixels = 0;
@@ -99,7 +99,7 @@ TEST(MaterialScenePbrt, RendersTheSpatiallyVaryingSquashAsIbrdfDoes) {
   ASSERT_EQ(pixels, scene.at("ibrdf_pixels").get<size_t>());
   ASSERT_GT(pixels, 3000u) << "too few rendered pixels to judge";
   const RunResult rendered =
-      RunShell("cd '" + folder.string() + "' && " + pbrt + " --nthreads 2 --quiet --spp 1024 --pixelbounds " +
+      RunShell("cd '" + folder.string() + "' && " + pbrt + " --nthreads 2 --quiet --spp 2048 --pixelbounds " +
                std::to_string(x0) + "," + std::to_string(x1) + "," + std::to_string(y0) + "," + std::to_string(y1) +
                " " + file + " 2>&1");
   ASSERT_EQ(rendered.exit_code, 0) << rendered.output;
@@ -150,7 +150,7 @@ TEST(MaterialScenePbrt, RendersTheSpatiallyVaryingSquashAsIbrdfDoes) {
   const double pixel_median = Median(per_pixel), window_median = Median(per_window);
   const double window_p90 = Percentile(per_window, 0.90);
   const Eigen::Vector3d ratio = sum_pbrt.cwiseQuotient(sum_ibrdf);
-  std::cout << "pbrt-v4 (1024 spp) against ibrdf's render of the scene's model: " << pixels
+  std::cout << "pbrt-v4 (2048 spp) against ibrdf's render of the scene's model: " << pixels
             << " pixels; median |pbrt / ibrdf - 1| per pixel " << 100.0 * pixel_median << " %, over 7 x 7 windows "
             << 100.0 * window_median << " % (p90 " << 100.0 * window_p90 << " %); colour ratio " << ratio.transpose()
             << "; pixels black in pbrt " << black << "\n";
